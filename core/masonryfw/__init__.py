@@ -1,0 +1,38 @@
+"""masonryfw: failure analysis of dry-joint masonry walls under foundation settlements.
+
+The public API. Data flows one way::
+
+    spec --build--> model --solve(plugin)--> result --compare/plot--> ...
+
+Solver plugins import only the names exported here.
+"""
+from __future__ import annotations
+
+from importlib.metadata import PackageNotFoundError, version as _dist_version
+
+try:
+    __version__ = _dist_version("masonryfw")
+except PackageNotFoundError:  # running from a source tree that is not installed
+    __version__ = "0+unknown"
+
+from .errors import MasonryError, ModelError, PluginError, SolveError, SpecError
+from .progress import ProgressCallback, no_progress
+from .hookspecs import Comparator, Option, Plotter, Solver, hookimpl
+from .schema import FORMAT_VERSION, flags, load_schema, variable_attrs
+from .geometry import (
+    block_bounds,
+    block_offsets,
+    derive_geometry,
+    interface_frame,
+    model_scale,
+    node_block,
+    polygon_area_centroid,
+)
+from .interfaces import detect_interfaces
+from .checks import Problem, check
+from .io import add_history, open_dataset, open_model, save, sha256_file
+from .builder import build, load_spec
+from .datasets import bundled_cases, bundled_spec_path
+from .plugins import compare, get_comparator, get_plotter, get_solver, plugin_manager, solve
+
+__all__ = [name for name in dir() if not name.startswith("_")]

@@ -1,0 +1,4 @@
+"""``python -m masonryfw`` runs the command-line interface."""
+from .cli import main
+
+main()

@@ -1,0 +1,1 @@
+"""Machine-readable schemas of the masonryfw data format (one JSON file per dataset kind)."""
