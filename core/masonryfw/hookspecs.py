@@ -116,7 +116,7 @@ class Plotter:
 
 
 class MasonryfwSpec:
-    """Hook specifications. Every hook takes no arguments and returns records."""
+    """Hook specifications. Every hook takes no arguments and returns a list."""
 
     @hookspec
     def masonryfw_solvers(self) -> list[Solver]:
@@ -129,3 +129,11 @@ class MasonryfwSpec:
     @hookspec
     def masonryfw_plotters(self) -> list[Plotter]:
         """Return the plot kinds this plugin contributes."""
+
+    @hookspec
+    def masonryfw_commands(self) -> list[Any]:
+        """Return extra ``click.Command`` objects added to the ``masonryfw`` CLI.
+
+        For whole workflows a plugin owns (e.g. ``gallery``, ``export``); a command
+        whose name is already taken is an error naming both plugins.
+        """
