@@ -34,47 +34,51 @@ def next_node(block_node_count: np.ndarray) -> np.ndarray:
     counts = np.asarray(block_node_count, dtype=np.int64)
     start = block_offsets(counts)[:-1]
     idx = np.arange(counts.sum()) + 1
-    last = start + counts - 1
-    idx[last] = start
+    has = counts > 0
+    idx[(start + counts - 1)[has]] = start[has]
     return idx
 
 
 def polygon_area_centroid(node_x, node_y, block_node_count):
     """Signed area (positive counter-clockwise) and centroid of every block.
 
-    Coordinates are shifted by each block's first vertex before the shoelace sum
-    so that walls far from the origin keep full precision.
+    Coordinates are shifted by each block's vertex mean before the shoelace sum,
+    so walls far from the origin keep full precision. Where the area vanishes
+    (degenerate polygons, blocks with fewer than 3 vertices) the centroid is the
+    vertex mean, so a validator can still say where the block is.
     """
     x = np.asarray(node_x, dtype=float)
     y = np.asarray(node_y, dtype=float)
     counts = np.asarray(block_node_count, dtype=np.int64)
-    start = block_offsets(counts)[:-1]
+    n = counts.size
     owner = node_block(counts)
-    x0, y0 = x[start][owner], y[start][owner]
-    xs, ys = x - x0, y - y0
     nxt = next_node(counts)
-    cross = xs * ys[nxt] - xs[nxt] * ys
-    area2 = np.add.reduceat(cross, start)
-    cx = np.add.reduceat((xs + xs[nxt]) * cross, start)
-    cy = np.add.reduceat((ys + ys[nxt]) * cross, start)
-    area = 0.5 * area2
-    with np.errstate(divide="ignore", invalid="ignore"):
-        cx = cx / (3.0 * area2) + x[start]
-        cy = cy / (3.0 * area2) + y[start]
-    return area, cx, cy
+    with np.errstate(invalid="ignore", divide="ignore"):
+        mean_x = np.bincount(owner, x, minlength=n) / counts
+        mean_y = np.bincount(owner, y, minlength=n) / counts
+        xs, ys = x - mean_x[owner], y - mean_y[owner]
+        cross = xs * ys[nxt] - xs[nxt] * ys
+        area = 0.5 * np.bincount(owner, cross, minlength=n)
+        cx = np.bincount(owner, (xs + xs[nxt]) * cross, minlength=n) / (6 * area) + mean_x
+        cy = np.bincount(owner, (ys + ys[nxt]) * cross, minlength=n) / (6 * area) + mean_y
+    flat = ~np.isfinite(cx) | ~np.isfinite(cy) | (area == 0)
+    return area, np.where(flat, mean_x, cx), np.where(flat, mean_y, cy)
 
 
 def block_bounds(node_x, node_y, block_node_count):
-    """Per-block bounding boxes ``(xmin, xmax, ymin, ymax)``."""
+    """Per-block bounding boxes ``(xmin, xmax, ymin, ymax)`` (NaN for a block without vertices)."""
     x = np.asarray(node_x, dtype=float)
     y = np.asarray(node_y, dtype=float)
-    start = block_offsets(block_node_count)[:-1]
-    return (
-        np.minimum.reduceat(x, start),
-        np.maximum.reduceat(x, start),
-        np.minimum.reduceat(y, start),
-        np.maximum.reduceat(y, start),
-    )
+    counts = np.asarray(block_node_count, dtype=np.int64)
+    start = block_offsets(counts)[:-1]
+    has = counts > 0
+    out = []
+    for values, reduce in ((x, np.minimum), (x, np.maximum), (y, np.minimum), (y, np.maximum)):
+        bound = np.full(counts.size, np.nan)
+        if values.size:
+            bound[has] = reduce.reduceat(values, start[has])
+        out.append(bound)
+    return tuple(out)
 
 
 def model_scale(node_x, node_y) -> float:

@@ -58,3 +58,15 @@ def test_interface_normal_points_away_from_side0_and_tangent_is_n_rotated_minus_
     np.testing.assert_allclose([nx[0], ny[0], tx[0], ty[0]], [0, 1, 1, 0], atol=1e-15)
     np.testing.assert_allclose([nx[1], ny[1]], [np.sqrt(0.5), np.sqrt(0.5)])
     np.testing.assert_allclose([tx[1], ty[1]], [np.sqrt(0.5), -np.sqrt(0.5)])
+
+
+def test_degenerate_blocks_get_the_vertex_mean_and_nan_bounds():
+    """A collinear 'polygon' has zero area; its centroid falls back to the vertex mean so errors can point at it."""
+    x = np.array([0.0, 1.0, 2.0, 5.0, 6.0, 6.0])
+    y = np.array([0.0, 0.0, 0.0, 5.0, 5.0, 6.0])
+    counts = np.array([3, 0, 3])
+    area, cx, cy = mf.polygon_area_centroid(x, y, counts)
+    assert area[0] == 0.0 and cx[0] == 1.0 and cy[0] == 0.0
+    assert area[2] == pytest.approx(0.5)
+    xmin, xmax, _, _ = mf.block_bounds(x, y, counts)
+    assert np.isnan(xmin[1]) and xmax[2] == 6.0
