@@ -20,6 +20,7 @@ from .progress import ProgressCallback, no_progress
 from .hookspecs import Comparator, Option, Plotter, Solver, hookimpl
 from .schema import FORMAT_VERSION, flags, load_schema, variable_attrs
 from .geometry import (
+    DERIVED_GEOMETRY_VARIABLES,
     block_bounds,
     block_offsets,
     derive_geometry,
@@ -30,7 +31,7 @@ from .geometry import (
 )
 from .interfaces import detect_interfaces
 from .checks import Problem, check
-from .io import add_history, open_dataset, open_model, save, sha256_file
+from .io import add_history, content_sha256, open_dataset, open_model, save, sha256_file
 from .builder import build, load_spec
 from .datasets import bundled_cases, bundled_spec_path
 from .plugins import compare, get_comparator, get_plotter, get_solver, plugin_manager, solve

@@ -111,6 +111,20 @@ def interface_frame(interface_x, interface_y, side0_cx, side0_cy):
     return length, nx, ny, ny, -nx
 
 
+#: Variables added by :func:`derive_geometry`: recomputed on every load, never
+#: trusted from a file, and left out of the content hash.
+DERIVED_GEOMETRY_VARIABLES = (
+    "block_area",
+    "block_centroid_x",
+    "block_centroid_y",
+    "interface_length",
+    "interface_normal_x",
+    "interface_normal_y",
+    "interface_tangent_x",
+    "interface_tangent_y",
+)
+
+
 def derive_geometry(ds: xr.Dataset) -> xr.Dataset:
     """Return ``ds`` with block areas, centroids, interface lengths, normals and tangents.
 

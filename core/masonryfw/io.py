@@ -1,0 +1,358 @@
+"""netCDF read/write: whole-file reads, atomic CF-1.11 writes, history lines and hashes.
+
+Reading loads the whole file into memory and closes it, so no handle stays
+open and the file can be replaced afterwards. Writing goes to a temporary file
+in the target's directory that replaces the target only once complete, so a
+failed write never leaves a half-written or damaged file behind.
+
+Every dataset is written in one normal form (:func:`cf_normalized`): the
+schema's ``units``/``long_name`` on every format variable, flag variables as
+``int8`` with ``flag_values`` of the same dtype, the CF geometry container for
+block polygons. :func:`content_sha256` hashes that same normal form, so a
+dataset and the file written from it share one content hash.
+"""
+from __future__ import annotations
+
+import hashlib
+import os
+import secrets
+import shutil
+from datetime import datetime, timezone
+from pathlib import Path
+
+import numpy as np
+import xarray as xr
+
+from .errors import MasonryError, ModelError
+from .geometry import derive_geometry
+from .geometry import DERIVED_GEOMETRY_VARIABLES
+from .schema import load_schema, variable_attrs
+
+CONVENTIONS = "CF-1.11"
+COMPRESSION = {"zlib": True, "complevel": 4, "shuffle": True}
+
+_NODE_AXES = {"node_x": "X", "node_y": "Y"}
+_GEOMETRY_VARIABLES = ("node_x", "node_y", "block_node_count")
+
+_NETCDF3_SIGNATURES = (b"CDF\x01", b"CDF\x02", b"CDF\x05")
+_HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
+_HASH_CHUNK = 1 << 20
+
+
+# ---------------------------------------------------------------- hashing
+
+def sha256_file(path: str | os.PathLike) -> str:
+    """Hex SHA-256 of a file's bytes, read in 1 MiB chunks."""
+    digest = hashlib.sha256()
+    with open(path, "rb") as stream:
+        for chunk in iter(lambda: stream.read(_HASH_CHUNK), b""):
+            digest.update(chunk)
+    return digest.hexdigest()
+
+
+def _feed(digest, *tokens: bytes) -> None:
+    """Length-prefix every token so that no two token sequences hash alike."""
+    for token in tokens:
+        digest.update(len(token).to_bytes(8, "little"))
+        digest.update(token)
+
+
+def _strings_bytes(values) -> bytes:
+    encoded = [(v if isinstance(v, bytes) else str(v).encode("utf-8")) for v in np.ravel(values)]
+    return b"".join(len(e).to_bytes(8, "little") + e for e in encoded)
+
+
+def _canonical_bytes(value) -> tuple[bytes, bytes]:
+    """(type tag, bytes) of an attribute value, independent of its container (list, tuple,
+    scalar, 1-element array) and integer/float width: files return attributes as arrays."""
+    if isinstance(value, bytes):
+        value = value.decode("utf-8", errors="replace")
+    array = np.asarray(value)
+    if array.dtype.kind in "USO":
+        return b"str", _strings_bytes(array)
+    if array.dtype.kind in "biu":
+        return b"int", np.ascontiguousarray(array, dtype="<i8").tobytes()
+    if array.dtype.kind == "f":
+        # One NaN bit pattern: a NaN read back from a file may carry another payload.
+        canonical = np.where(np.isnan(array), np.nan, array)
+        return b"float", np.ascontiguousarray(canonical, dtype="<f8").tobytes()
+    return b"repr", repr(value).encode("utf-8")
+
+
+def _variable_bytes(values: np.ndarray) -> tuple[bytes, bytes]:
+    """(dtype tag, bytes) of variable data; unlike attributes the exact dtype counts."""
+    if values.dtype.kind in "USO":
+        return b"str", _strings_bytes(values)
+    little = values.dtype.newbyteorder("<")
+    if values.dtype.kind == "f":
+        values = np.where(np.isnan(values), np.nan, values).astype(values.dtype)
+    return little.str.encode(), np.ascontiguousarray(values, dtype=little).tobytes()
+
+
+def _feed_attrs(digest, attrs: dict) -> None:
+    _feed(digest, str(len(attrs)).encode())
+    for key in sorted(map(str, attrs)):
+        _feed(digest, key.encode(), *_canonical_bytes(attrs[key]))
+
+
+def content_sha256(ds: xr.Dataset) -> str:
+    """Hex SHA-256 of what a dataset holds, not of how a file stores it.
+
+    Hashes the normal form that :func:`save` writes (:func:`cf_normalized`):
+    every variable's name, dims, shape, dtype and values, its attributes, and the
+    global attributes except ``history``. Variables and attributes are taken in
+    sorted order, so their order does not matter; the derived geometry is left
+    out (it is recomputed from the vertices on every load). A dataset and the
+    file :func:`save` writes from it therefore hash alike.
+    """
+    normal = cf_normalized(ds)
+    digest = hashlib.sha256()
+    _feed(digest, b"attributes")
+    _feed_attrs(digest, {k: v for k, v in normal.attrs.items() if k != "history"})
+    names = sorted(str(n) for n in normal.variables if n not in DERIVED_GEOMETRY_VARIABLES)
+    for name in names:
+        variable = normal.variables[name]
+        dtype_tag, data = _variable_bytes(np.asarray(variable.values))
+        _feed(digest, b"variable", name.encode(), " ".join(map(str, variable.dims)).encode())
+        _feed(digest, np.asarray(variable.shape, dtype="<i8").tobytes(), dtype_tag, data)
+        _feed_attrs(digest, variable.attrs)
+    return digest.hexdigest()
+
+
+# ---------------------------------------------------------------- reading
+
+def _netcdf_problem(path: Path) -> str | None:
+    """Why ``path`` cannot be a netCDF file, or None if it looks like one.
+
+    Checks the signature: netCDF-3 files start with ``CDF``; netCDF-4 files are
+    HDF5 files, whose signature sits at byte 0 or after a user block of 512,
+    1024, 2048, ... bytes.
+    """
+    if not path.exists():
+        return "no such file" + (" (broken symbolic link)" if path.is_symlink() else "")
+    if path.is_dir():
+        return "is a directory, not a netCDF file"
+    if not path.is_file():
+        return "is not a regular file"
+    size = path.stat().st_size
+    if size == 0:
+        return "is empty (0 bytes), not a netCDF file"
+    with path.open("rb") as stream:
+        head = stream.read(8)
+        if head[:4] in _NETCDF3_SIGNATURES or head == _HDF5_SIGNATURE:
+            return None
+        offset = 512
+        while offset + len(_HDF5_SIGNATURE) <= size:
+            stream.seek(offset)
+            if stream.read(len(_HDF5_SIGNATURE)) == _HDF5_SIGNATURE:
+                return None
+            offset *= 2
+    return (
+        f"is not a netCDF file (it starts with {head!r}; netCDF-3 files start with "
+        f"b'CDF', netCDF-4 files with the HDF5 signature b'\\x89HDF')"
+    )
+
+
+def open_dataset(path: str | os.PathLike) -> xr.Dataset:
+    """Read a masonryfw netCDF file (model, result or comparison) wholly into memory.
+
+    The file is closed before returning. ``ds.encoding["source"]`` holds its
+    absolute path and ``ds.encoding["sha256"]`` the hash of its bytes. Times are
+    not decoded: the format holds plain SI numbers only.
+    """
+    file = Path(path)
+    try:
+        problem = _netcdf_problem(file)
+        digest = None if problem else sha256_file(file)
+    except OSError as exc:
+        raise ModelError(f"{file}: cannot be read ({exc.strerror or exc})") from exc
+    if problem:
+        raise ModelError(f"{file}: {problem}")
+    try:
+        with xr.open_dataset(file, engine="netcdf4", decode_times=False, decode_timedelta=False) as src:
+            ds = src.load()
+    except Exception as exc:  # netCDF4/HDF5 raise OSError, RuntimeError, ValueError, ...
+        raise ModelError(
+            f"{file}: has a netCDF signature but cannot be read ({type(exc).__name__}: {exc}); "
+            "is it truncated or damaged?"
+        ) from exc
+    ds.encoding["source"] = str(file.resolve())
+    ds.encoding["sha256"] = digest
+    return ds
+
+
+def _bundled_model(name: str) -> xr.Dataset:
+    from .builder import build
+    from .datasets import bundled_cases, bundled_spec_path
+
+    cases = list(bundled_cases())
+    if name not in cases:
+        raise ModelError(
+            f"{name}: no such file, and not a bundled case; bundled cases: {', '.join(cases) or '(none)'}"
+        )
+    return build(bundled_spec_path(name))
+
+
+def open_model(path_or_name: str | os.PathLike, *, validate: bool = True) -> xr.Dataset:
+    """A model (or a result, which holds its model) from a file or a bundled case name.
+
+    With ``validate`` every problem found by :func:`masonryfw.checks.check` is
+    raised at once in one :class:`ModelError`. Derived geometry stored in the
+    file is dropped and recomputed from the vertices.
+    """
+    from .checks import check
+
+    where = str(path_or_name)
+    if Path(path_or_name).exists():
+        ds = open_dataset(path_or_name)
+    else:
+        ds = _bundled_model(where)
+    ds = ds.drop_vars([v for v in DERIVED_GEOMETRY_VARIABLES if v in ds.variables])
+    if validate:
+        problems = check(ds)
+        if problems:
+            raise ModelError(f"{where}: {len(problems)} problem(s)", problems)
+    missing = [v for v in _GEOMETRY_VARIABLES if v not in ds.variables]
+    if missing:
+        raise ModelError(f"{where}: not a model: missing variable(s) {', '.join(missing)}")
+    return derive_geometry(ds)
+
+
+# ---------------------------------------------------------------- writing
+
+def add_history(ds: xr.Dataset, command: str) -> xr.Dataset:
+    """A new dataset whose ``history`` has one more line: ``<UTC time> masonryfw <version>: <command>``."""
+    from . import __version__
+
+    stamp = datetime.now(timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")
+    line = f"{stamp} masonryfw {__version__}: {' '.join(str(command).split())}"
+    previous = str(ds.attrs.get("history", "")).rstrip("\n")
+    return ds.assign_attrs(history=f"{previous}\n{line}" if previous else line)
+
+
+def _as_int8_flags(name: str, values: np.ndarray) -> np.ndarray:
+    """``values`` as int8, refusing anything the cast would change (fractions, NaN, overflow)."""
+    if values.dtype.kind in "iuf":
+        with np.errstate(invalid="ignore"):
+            exact = np.isfinite(values) & (values >= -128) & (values <= 127) & (values == np.trunc(values))
+        if not exact.all():
+            bad = np.flatnonzero(~exact.ravel())
+            raise ModelError(
+                f"variable {name!r}: flag values must be integers in -128..127; "
+                f"found {values.ravel()[bad[0]].item()!r} at flat index {bad[0]} ({bad.size} such value(s))"
+            )
+    elif values.dtype.kind != "b":
+        raise ModelError(f"variable {name!r}: flag values must be integers, not {values.dtype}")
+    return values.astype(np.int8)
+
+
+def cf_normalized(ds: xr.Dataset) -> xr.Dataset:
+    """``ds`` in the form :func:`save` writes it (the caller's dataset is not changed).
+
+    Adds what is missing: ``Conventions``; ``units``, ``long_name`` (and the
+    schema's other attributes) on every format variable; ``axis`` on the node
+    coordinates (CF 7.5 asks it of a geometry container's nodes); the ``block_geometry`` container when the dataset has polygons.
+    Flag variables become ``int8`` with ``flag_values`` of the same dtype.
+    """
+    schema_variables = load_schema("result")["variables"]
+    out = ds.copy(deep=False)
+    out.attrs.setdefault("Conventions", CONVENTIONS)
+    if all(v in out.variables for v in _GEOMETRY_VARIABLES) and "block_geometry" not in out.variables:
+        out = out.assign(block_geometry=xr.Variable((), np.int32(0)))
+    coords, data_vars = {}, {}  # replaced in one assignment each: every xarray assignment is a merge
+    for name in [n for n in out.variables if n in schema_variables]:
+        variable = out.variables[name]
+        attrs = dict(variable.attrs)
+        for key, value in variable_attrs(name).items():
+            attrs.setdefault(key, value)
+        if name in _NODE_AXES:
+            attrs.setdefault("axis", _NODE_AXES[name])
+        data = variable.data
+        if "flag_values" in schema_variables[name]:
+            data = _as_int8_flags(name, np.asarray(variable.values))
+            attrs["flag_values"] = _as_int8_flags(f"{name}.flag_values", np.asarray(attrs["flag_values"]))
+        replaced = xr.Variable(variable.dims, data, attrs, encoding=variable.encoding)
+        (coords if name in out.coords else data_vars)[name] = replaced
+    return out.assign_coords(coords).assign(data_vars)
+
+
+def _netcdf_encoding(ds: xr.Dataset) -> dict[str, dict]:
+    """zlib (level 4, shuffle) on every non-scalar numeric variable; no integer fill values,
+    which would make readers decode integers (flags, indices) to floats."""
+    encoding = {}
+    for name, variable in ds.variables.items():
+        kind = variable.dtype.kind
+        entry = dict(COMPRESSION) if kind in "biuf" and variable.ndim > 0 else {}
+        if kind in "biu":
+            entry["_FillValue"] = None
+        encoding[name] = entry
+    return encoding
+
+
+def _write_netcdf(ds: xr.Dataset, path: Path) -> None:
+    """Write ``ds`` as netCDF-4, ignoring any encoding it carries from the file it came from."""
+    fresh = ds.copy(deep=False)
+    fresh.encoding = {}
+    for variable in fresh.variables.values():
+        variable.encoding = {}
+    fresh.to_netcdf(path, mode="w", format="NETCDF4", engine="netcdf4", encoding=_netcdf_encoding(fresh))
+    with open(path, "rb") as stream:
+        os.fsync(stream.fileno())
+
+
+def _same_file(a: Path, b: Path) -> bool:
+    """Same file, through symbolic links, relative paths and hard links."""
+    if a.resolve() == b.resolve():
+        return True
+    return a.exists() and b.exists() and os.path.samefile(a, b)
+
+
+def _refusal(target: Path, ds: xr.Dataset, protect) -> str | None:
+    """Why writing ``target`` would destroy an input, or None."""
+    guarded = [(p, "a protected file") for p in protect]
+    guarded.append((ds.encoding.get("source"), "the file this dataset was read from"))
+    guarded.append((ds.attrs.get("source_file"), "the model file this result was computed from"))
+    for candidate, what in guarded:
+        if candidate and _same_file(target, Path(str(candidate))):
+            return f"{what} ({candidate})"
+    return None
+
+
+def save(
+    ds: xr.Dataset,
+    path: str | os.PathLike,
+    *,
+    command: str | None = None,
+    protect=(),
+) -> Path:
+    """Write ``ds`` atomically as compressed CF-1.11 netCDF-4 and return the absolute path.
+
+    The dataset is written in the normal form of :func:`cf_normalized` with one
+    history line (``command``, or ``save``) appended. The file is written next
+    to the target and renamed over it only when complete; on failure the target
+    is left as it was. Refuses to write over any path in ``protect``, the file
+    ``ds`` was read from, and the model file a result was computed from.
+    """
+    target = Path(path).resolve()
+    if not target.parent.is_dir():
+        raise ModelError(f"{path}: cannot write: directory {target.parent} does not exist")
+    if target.is_dir():
+        raise ModelError(f"{path}: cannot write: is a directory")
+    refusal = _refusal(target, ds, protect)
+    if refusal:
+        raise ModelError(f"{path}: refusing to overwrite {refusal}; write to another path")
+    prepared = add_history(cf_normalized(ds), command or "save")
+    temporary = target.with_name(f".{target.name}.{secrets.token_hex(6)}.tmp")
+    try:
+        _write_netcdf(prepared, temporary)
+        if target.exists():
+            shutil.copymode(target, temporary)
+        os.replace(temporary, target)
+    except BaseException as exc:
+        temporary.unlink(missing_ok=True)
+        if isinstance(exc, MasonryError) or not isinstance(exc, Exception):
+            raise
+        raise ModelError(
+            f"{path}: could not write ({type(exc).__name__}: {exc}); any existing file is unchanged"
+        ) from exc
+    return target
