@@ -1,0 +1,267 @@
+"""The ``crack`` comparator: agreement scores of two results of the same model.
+
+Scores (each present only where both results carry what it needs; see
+docs/agreement.md for the definitions and the choice of the threshold):
+
+- ``crack_indicator`` (per interface): counts, precision, recall, F1 and Jaccard
+  of the cracked sets (indicator > ``threshold``), the length-weighted overlap
+  ``sum(L min) / sum(L max)`` and the Spearman rank correlation (threshold-free);
+- ``macro_block``: adjusted Rand index of the two partitions of the masonry blocks;
+- ``block_displacement``: cosine of the two rigid displacement fields;
+- the failure locus (cracked joints, or plastic points of a continuum result):
+  mean distance from one locus to the other, normalised by the model size.
+
+Result ``a`` is the reference: precision is the share of ``b``'s cracks that ``a``
+also has.
+"""
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+from typing import Any, Mapping
+
+import numpy as np
+import xarray as xr
+
+import masonryfw as mf
+
+from . import scores
+from .shapes import (
+    block_polar_moment,
+    distance_to_points,
+    distance_to_segments,
+    segment_samples,
+    with_geometry,
+)
+
+DEFAULT_THRESHOLD = 0.1
+OPTIONS = (
+    mf.Option(
+        "threshold",
+        float,
+        DEFAULT_THRESHOLD,
+        "a joint counts as cracked where crack_indicator > threshold (0 <= threshold < 1)",
+    ),
+)
+# Option names under which solvers record their numerical backend (la: "solver").
+BACKEND_OPTION_NAMES = ("solver", "backend", "method")
+# Model variables that must be present to tell two models apart and to score them.
+GEOMETRY_VARIABLES = (
+    "node_x", "node_y", "block_node_count", "block_role",
+    "interface_blocks", "interface_x", "interface_y",
+)
+
+
+def resolve(options: Mapping[str, Any]) -> dict[str, Any]:
+    """Defaults overlaid by ``options``; an unknown name or a bad threshold is a PluginError."""
+    known = {o.name: o for o in OPTIONS}
+    unknown = sorted(set(options) - set(known))
+    if unknown:
+        raise mf.PluginError(
+            f"comparator 'crack': unknown option(s) {', '.join(unknown)}; valid options: "
+            + ", ".join(sorted(known))
+        )
+    resolved = {o.name: o.default for o in OPTIONS}
+    resolved.update({k: known[k].parse(v) for k, v in options.items()})
+    if not 0.0 <= resolved["threshold"] < 1.0:
+        raise mf.PluginError(
+            f"comparator 'crack': option 'threshold' must lie in [0, 1), got {resolved['threshold']!r}"
+        )
+    return resolved
+
+
+def _first_difference(a: np.ndarray, b: np.ndarray) -> int | None:
+    """Index (flat) of the first element that differs beyond round-off, or None."""
+    if a.dtype.kind == "f" or b.dtype.kind == "f":
+        a, b = a.astype(float), b.astype(float)
+        tol = 1e-9 * max(np.max(np.abs(a), initial=0.0), np.max(np.abs(b), initial=0.0))
+        differs = ~(np.abs(a - b) <= tol)
+    else:
+        differs = a != b
+    hits = np.flatnonzero(differs)
+    return int(hits[0]) if hits.size else None
+
+
+def _different_models(a: xr.Dataset, b: xr.Dataset, detail: str) -> mf.ModelError:
+    """The refusal, with the recorded model hashes when both results carry them."""
+    message = f"cannot compare results of different models: {detail}"
+    hashes = a.attrs.get("model_sha256"), b.attrs.get("model_sha256")
+    if all(hashes):
+        message += f" (model_sha256 {hashes[0][:12]}... vs {hashes[1][:12]}...)"
+    return mf.ModelError(message)
+
+
+def ensure_same_model(a: xr.Dataset, b: xr.Dataset) -> None:
+    """Refuse (ModelError) two results that were not computed on the same model.
+
+    Compares the block, node and interface counts, then every model variable
+    both results hold (geometry, roles, materials, loads, supports) value by value.
+    """
+    for which, ds in (("a", a), ("b", b)):
+        missing = [n for n in GEOMETRY_VARIABLES if n not in ds]
+        if missing:
+            raise mf.ModelError(f"result {which} has no {', '.join(missing)}: it holds no model to compare")
+    for dim in ("block", "node", "interface"):
+        if a.sizes.get(dim, 0) != b.sizes.get(dim, 0):
+            raise _different_models(
+                a, b, f"{a.sizes.get(dim, 0)} vs {b.sizes.get(dim, 0)} {dim}s "
+                f"({a.attrs.get('title', '?')!r} vs {b.attrs.get('title', '?')!r})",
+            )
+    for name in mf.load_schema("model")["variables"]:
+        if name not in a or name not in b:
+            continue
+        va, vb = np.asarray(a[name].values), np.asarray(b[name].values)
+        if va.shape != vb.shape:
+            raise _different_models(a, b, f"{name} has shape {va.shape} vs {vb.shape}")
+        where = _first_difference(va.ravel(), vb.ravel())
+        if where is not None:
+            index = np.unravel_index(where, va.shape)
+            at = ", ".join(f"{d} {i}" for d, i in zip(a[name].dims, index))
+            raise _different_models(a, b, f"{name} differs at {at} ({va.ravel()[where].item()!r} vs {vb.ravel()[where].item()!r})")
+
+
+def masonry_blocks(geo: xr.Dataset) -> np.ndarray:
+    """Mask of the units and lintels (support blocks are boundary conditions, not masonry)."""
+    role = mf.flags("block_role")
+    return np.isin(geo.block_role.values, [role["unit"], role["lintel"]])
+
+
+def interface_scores(a: xr.Dataset, b: xr.Dataset, length: np.ndarray, threshold: float) -> dict:
+    """Scores on ``crack_indicator``: thresholded set scores and the threshold-free ones."""
+    if "crack_indicator" not in a or "crack_indicator" not in b:
+        return {}
+    ca = a.crack_indicator.values.astype(float)
+    cb = b.crack_indicator.values.astype(float)
+    out = scores.confusion_scores(ca > threshold, cb > threshold)
+    out["crack_overlap"] = scores.weighted_overlap(ca, cb, length)
+    out["crack_spearman"] = scores.spearman(ca, cb)
+    return out
+
+
+def partition_scores(a: xr.Dataset, b: xr.Dataset, masonry: np.ndarray) -> dict:
+    """Adjusted Rand index of the macro-block partitions of the masonry blocks."""
+    if "macro_block" not in a or "macro_block" not in b:
+        return {}
+    return {"macro_block_ari": scores.adjusted_rand_index(a.macro_block.values[masonry], b.macro_block.values[masonry])}
+
+
+def mechanism_scores(a: xr.Dataset, b: xr.Dataset, geo: xr.Dataset, masonry: np.ndarray) -> dict:
+    """Cosine of the rigid displacement fields over the masonry blocks."""
+    if "block_displacement" not in a or "block_displacement" not in b:
+        return {}
+    area = geo.block_area.values
+    polar = block_polar_moment(geo.node_x.values, geo.node_y.values, geo.block_node_count.values)
+    return {
+        "mechanism_cosine": scores.rigid_field_cosine(
+            a.block_displacement.values[masonry], b.block_displacement.values[masonry],
+            area[masonry], polar[masonry],
+        )
+    }
+
+
+@dataclass(frozen=True)
+class Locus:
+    """Where a result fails: weighted sample points and, for joints, the segments themselves."""
+
+    x: np.ndarray
+    y: np.ndarray
+    weight: np.ndarray
+    segments_x: np.ndarray | None = None
+    segments_y: np.ndarray | None = None
+
+    def distance_from(self, px: np.ndarray, py: np.ndarray) -> np.ndarray:
+        """Distance from each point to the nearest element of this locus."""
+        if self.segments_x is not None:
+            return distance_to_segments(px, py, self.segments_x, self.segments_y)
+        return distance_to_points(px, py, self.x, self.y)
+
+
+def failure_locus(ds: xr.Dataset, threshold: float) -> Locus | None:
+    """Plastic points (qp_failure != 0) of a continuum result, else its cracked joints; None if empty.
+
+    Joints are sampled along their length (midpoint rule) and weighted by length,
+    so a long crack counts more than a short one.
+    """
+    if "qp_failure" in ds:
+        plastic = ds.qp_failure.values != mf.flags("qp_failure")["elastic"]
+        if not plastic.any():
+            return None
+        x, y = ds.qp_x.values[plastic], ds.qp_y.values[plastic]
+        return Locus(x, y, np.ones(x.size))
+    if "crack_indicator" not in ds:
+        return None
+    cracked = ds.crack_indicator.values > threshold
+    if not cracked.any():
+        return None
+    sx, sy = ds.interface_x.values[cracked], ds.interface_y.values[cracked]
+    x, y, weight = segment_samples(sx, sy)
+    return Locus(x, y, weight, sx, sy)
+
+
+def locus_scores(a: xr.Dataset, b: xr.Dataset, size: float, threshold: float) -> dict:
+    """Mean distance between the failure loci, both ways and averaged, over the model size."""
+    la, lb = failure_locus(a, threshold), failure_locus(b, threshold)
+    if la is None or lb is None:
+        return {}
+    a_to_b = float(np.average(lb.distance_from(la.x, la.y), weights=la.weight)) / size
+    b_to_a = float(np.average(la.distance_from(lb.x, lb.y), weights=lb.weight)) / size
+    return {
+        "locus_distance_a_to_b": a_to_b,
+        "locus_distance_b_to_a": b_to_a,
+        "locus_distance": 0.5 * (a_to_b + b_to_a),
+    }
+
+
+def multiplier_values(a: xr.Dataset, b: xr.Dataset) -> dict:
+    """Both collapse multipliers, side by side, when both results are limit analyses."""
+    if "collapse_multiplier" not in a or "collapse_multiplier" not in b:
+        return {}
+    return {
+        "collapse_multiplier_a": float(a.collapse_multiplier.values),
+        "collapse_multiplier_b": float(b.collapse_multiplier.values),
+    }
+
+
+def solver_label(ds: xr.Dataset) -> str:
+    """``solver`` plus the backend it chose when its options name one, e.g. ``la (highs)``."""
+    name = str(ds.attrs.get("solver", ds.attrs.get("plugin", "?")))
+    try:
+        options = json.loads(ds.attrs.get("solver_options", "{}"))
+    except (TypeError, ValueError):
+        options = {}
+    detail = [str(options[k]) for k in BACKEND_OPTION_NAMES if isinstance(options, dict) and k in options]
+    return f"{name} ({', '.join(detail)})" if detail else name
+
+
+def comparison_variables(values: Mapping[str, float | int | None]) -> xr.Dataset:
+    """One scalar variable per computable score (None = not computable, left out), attributes from the schema.
+
+    The core (:func:`masonryfw.compare`) adds the global attributes: comparator,
+    options, the inputs' hashes and the history line.
+    """
+    spec = mf.load_schema("comparison")["variables"]
+    data = {}
+    for name, value in values.items():
+        if value is None:
+            continue
+        attrs = {"units": spec[name]["units"], "long_name": spec[name]["long_name"]}
+        dtype = np.int64 if spec[name]["dtype"] == "int" else np.float64
+        data[name] = xr.Variable((), np.asarray(value, dtype=dtype), attrs)
+    return xr.Dataset(data)
+
+
+def compare(a: xr.Dataset, b: xr.Dataset, options: Mapping[str, Any] | None = None) -> xr.Dataset:
+    """Score result ``b`` against result ``a`` (same model); returns the score variables."""
+    opts = resolve(options or {})
+    ensure_same_model(a, b)
+    geo = with_geometry(a[list(GEOMETRY_VARIABLES)])
+    masonry = masonry_blocks(geo)
+    threshold = opts["threshold"]
+    size = mf.model_scale(geo.node_x.values, geo.node_y.values)
+    values: dict[str, float | int | None] = {"length_scale": size}
+    values.update(multiplier_values(a, b))
+    values.update(interface_scores(a, b, geo.interface_length.values, threshold))
+    values.update(partition_scores(a, b, masonry))
+    values.update(mechanism_scores(a, b, geo, masonry))
+    values.update(locus_scores(a, b, size, threshold))
+    return comparison_variables(values)

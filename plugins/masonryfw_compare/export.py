@@ -1,0 +1,173 @@
+"""Export of a result to VTK (ParaView) through meshio.
+
+``export_vtk(result, "wall.vtu")`` writes one unstructured-grid file per kind of
+geometry and a multiblock index that opens them together:
+
+| file | cells | data |
+|---|---|---|
+| ``wall.vtu`` | one polygon per block (triangle / quad / polygon) | cell: ``block_index``, ``block_role``, ``macro_block``, ``centroid_displacement`` (ux, uy, 0), ``rotation`` (rz); point: ``displacement`` (rigid motion at each vertex, for *Warp By Vector*) |
+| ``wall_joints.vtu`` | one line per interface | cell: ``interface_index``, ``interface_kind``, ``interface_state``, ``crack_indicator``; point (the two ends): ``interface_opening``, ``interface_slip``, ``interface_normal_force``, ``interface_shear_force`` |
+| ``wall_mesh.vtu`` | continuum mesh faces (``mesh_face_nodes``) | cell: ``face_index`` |
+| ``wall_qp.vtu`` | one vertex per quadrature point | point: ``qp_failure`` (0 elastic, 1 tensile, 2 shear, 3 both) |
+| ``wall.vtm`` | VTK multiblock index of the files above | |
+
+Blocks are grouped into cell blocks by vertex count, so the cell order can
+differ from the block order: ``block_index`` maps each cell back. Each block
+has its own vertices (the CF ragged layout), so per-vertex data is exact.
+Variables a result lacks are left out; files with nothing in them are not written.
+"""
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import numpy as np
+import xarray as xr
+
+import masonryfw as mf
+
+from .shapes import padded_block_nodes, rigid_point_motion, with_geometry
+
+JOINT_POINT_VARIABLES = ("interface_opening", "interface_slip", "interface_normal_force", "interface_shear_force")
+JOINT_CELL_VARIABLES = ("interface_kind", "interface_state", "crack_indicator")
+
+
+def _meshio():
+    try:
+        import meshio
+    except ImportError:
+        raise mf.MasonryError("VTK export needs the meshio package: pip install meshio") from None
+    return meshio
+
+
+def _cell_type(count: int) -> str:
+    return {2: "line", 3: "triangle", 4: "quad"}.get(count, "polygon")
+
+
+def _points(x, y) -> np.ndarray:
+    return np.column_stack([np.ravel(x), np.ravel(y), np.zeros(np.size(x))])
+
+
+def _grouped_cells(connectivity: np.ndarray, count: np.ndarray):
+    """Cell blocks by vertex count: ``[(type, connectivity)]`` and the row order they use."""
+    groups, order = [], []
+    for size in np.unique(count):
+        rows = np.flatnonzero(count == size)
+        groups.append((_cell_type(int(size)), connectivity[rows, :size]))
+        order.append(rows)
+    return groups, order
+
+
+def _split(values: np.ndarray, order) -> list[np.ndarray]:
+    return [np.asarray(values)[rows] for rows in order]
+
+
+def _as_vtk(values: np.ndarray) -> np.ndarray:
+    """VTK-friendly dtypes: int32 for integers and flags, float64 for the rest."""
+    values = np.asarray(values)
+    return values.astype(np.int32) if values.dtype.kind in "iub" else values.astype(np.float64)
+
+
+def _write(mesh, path: Path) -> Path:
+    """meshio write to a temporary file in the same folder, then an atomic rename."""
+    temporary = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+    try:
+        mesh.write(temporary, file_format="vtu")
+        os.replace(temporary, path)
+    finally:
+        temporary.unlink(missing_ok=True)
+    return path
+
+
+def blocks_mesh(ds: xr.Dataset):
+    """Blocks as polygons with their role, macro-block and motion."""
+    meshio = _meshio()
+    geo = with_geometry(ds)
+    counts = geo.block_node_count.values.astype(np.int64)
+    cells, order = _grouped_cells(padded_block_nodes(counts), counts)
+    cell_data = {
+        "block_index": _split(np.arange(counts.size, dtype=np.int32), order),
+        "block_role": _split(_as_vtk(geo.block_role.values), order),
+    }
+    point_data = {}
+    if "macro_block" in ds:
+        cell_data["macro_block"] = _split(_as_vtk(ds.macro_block.values), order)
+    if "block_displacement" in ds:
+        u = ds.block_displacement.values.astype(float)
+        cell_data["centroid_displacement"] = _split(np.column_stack([u[:, 0], u[:, 1], np.zeros(len(u))]), order)
+        cell_data["rotation"] = _split(u[:, 2], order)
+        ux, uy = rigid_point_motion(
+            u, geo.block_centroid_x.values, geo.block_centroid_y.values,
+            geo.node_x.values, geo.node_y.values, mf.node_block(counts),
+        )
+        point_data["displacement"] = _points(ux, uy)
+    return meshio.Mesh(_points(geo.node_x.values, geo.node_y.values), cells, point_data=point_data, cell_data=cell_data)
+
+
+def joints_mesh(ds: xr.Dataset):
+    """Interfaces as lines; per-end variables on their two end points."""
+    meshio = _meshio()
+    n = ds.sizes["interface"]
+    cell_data = {"interface_index": [np.arange(n, dtype=np.int32)]}
+    cell_data.update({name: [_as_vtk(ds[name].values)] for name in JOINT_CELL_VARIABLES if name in ds})
+    point_data = {name: _as_vtk(ds[name].values).ravel() for name in JOINT_POINT_VARIABLES if name in ds}
+    return meshio.Mesh(
+        _points(ds.interface_x.values, ds.interface_y.values),
+        [("line", np.arange(2 * n).reshape(n, 2))],
+        point_data=point_data,
+        cell_data=cell_data,
+    )
+
+
+def continuum_mesh(ds: xr.Dataset):
+    """The continuum mesh faces (padding indices, negative or masked, dropped)."""
+    meshio = _meshio()
+    faces = np.asarray(ds.mesh_face_nodes.to_masked_array().filled(-1), dtype=np.int64)
+    count = (faces >= 0).sum(axis=1)
+    cells, order = _grouped_cells(faces, count)
+    return meshio.Mesh(
+        _points(ds.mesh_node_x.values, ds.mesh_node_y.values), cells,
+        cell_data={"face_index": _split(np.arange(faces.shape[0], dtype=np.int32), order)},
+    )
+
+
+def plastic_points(ds: xr.Dataset):
+    """Quadrature points as a point cloud carrying their failure flag."""
+    meshio = _meshio()
+    n = ds.sizes["qp"]
+    return meshio.Mesh(
+        _points(ds.qp_x.values, ds.qp_y.values),
+        [("vertex", np.arange(n).reshape(n, 1))],
+        point_data={"qp_failure": _as_vtk(ds.qp_failure.values)},
+    )
+
+
+def _multiblock(pieces: list[tuple[str, Path]]) -> str:
+    entries = "\n".join(
+        f'    <DataSet index="{i}" name="{name}" file="{path.name}"/>' for i, (name, path) in enumerate(pieces)
+    )
+    return (
+        '<?xml version="1.0"?>\n<VTKFile type="vtkMultiBlockDataSet" version="1.0">\n'
+        f"  <vtkMultiBlockDataSet>\n{entries}\n  </vtkMultiBlockDataSet>\n</VTKFile>\n"
+    )
+
+
+def export_vtk(ds: xr.Dataset, path: str | os.PathLike) -> list[Path]:
+    """Write the VTK files of a result (see the module docstring); returns the paths written."""
+    path = Path(path)
+    if path.suffix.lower() != ".vtu":
+        raise mf.MasonryError(f"VTK export file {str(path)!r}: the name must end in .vtu")
+    path.parent.mkdir(parents=True, exist_ok=True)
+    stem = path.with_suffix("")
+    pieces = [("blocks", _write(blocks_mesh(ds), path))]
+    if ds.sizes.get("interface", 0) > 0:
+        pieces.append(("joints", _write(joints_mesh(ds), Path(f"{stem}_joints.vtu"))))
+    if "mesh_face_nodes" in ds:
+        pieces.append(("mesh", _write(continuum_mesh(ds), Path(f"{stem}_mesh.vtu"))))
+    if "qp_failure" in ds:
+        pieces.append(("plastic_points", _write(plastic_points(ds), Path(f"{stem}_qp.vtu"))))
+    index = path.with_suffix(".vtm")
+    temporary = index.with_name(f".{index.name}.{os.getpid()}.tmp")
+    temporary.write_text(_multiblock(pieces))
+    os.replace(temporary, index)
+    return [p for _, p in pieces] + [index]
