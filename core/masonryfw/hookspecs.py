@@ -16,6 +16,7 @@ attributes (``plugin``, ``plugin_version``, ``solver``, ``solver_options``,
 """
 from __future__ import annotations
 
+import importlib
 from dataclasses import dataclass, field
 from typing import Any, Callable, Mapping, Sequence
 
@@ -77,6 +78,26 @@ def resolve_options(
     resolved = {o.name: o.default for o in declared}
     resolved.update({k: by_name[k].parse(v) for k, v in given.items()})
     return resolved
+
+
+def lazy(target: str) -> Callable[..., Any]:
+    """A callable that imports ``"package.module:function"`` on its first call.
+
+    Plugins build their records with ``lazy(...)`` callables, so listing the
+    plugins or running one solver never imports another plugin's heavy
+    dependencies (numba, matplotlib, dask, ...).
+    """
+    module_name, _, attribute = target.partition(":")
+    if not module_name or not attribute:
+        raise PluginError(f"lazy target {target!r} is not of the form 'package.module:function'")
+
+    def call(*args: Any, **kwargs: Any) -> Any:
+        return getattr(importlib.import_module(module_name), attribute)(*args, **kwargs)
+
+    call.__name__ = call.__qualname__ = attribute
+    call.__module__ = module_name
+    call.__doc__ = f"Calls {target} (imported on first use)."
+    return call
 
 
 @dataclass(frozen=True)

@@ -1,34 +1,32 @@
 """``compare``: crack-pattern agreement scores, plots, the gallery and the VTK export.
 
-Registration only; the work lives in :mod:`.comparison` (the ``crack``
+Registration only (cheap to import: see :mod:`.records`); the work lives in :mod:`.comparison` (the ``crack``
 comparator), :mod:`.scores` (the score functions), :mod:`.plotting` (the plot
 kinds, :func:`plot`, :func:`save_figure`), :mod:`.gallery` and :mod:`.export`.
 """
 from __future__ import annotations
 
+import importlib
+
 import masonryfw as mf
 
 from .commands import COMMANDS
-from .comparison import OPTIONS, compare
-from .export import export_vtk
-from .plotting import PLOTTERS, plot, save_figure
+from .records import COMPARATOR, PLOTTERS, __version__
 
-__version__ = mf.__version__
-__all__ = ["compare", "export_vtk", "plot", "save_figure"]
+#: The Python API, imported on first access (PEP 562) so registering stays cheap.
+_PUBLIC = {"compare": "comparison", "plot": "plotting", "save_figure": "plotting", "export_vtk": "export"}
+__all__ = sorted(_PUBLIC)
+
+
+def __getattr__(name: str):
+    if name in _PUBLIC:
+        return getattr(importlib.import_module(f".{_PUBLIC[name]}", __name__), name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 @mf.hookimpl
 def masonryfw_comparators():
-    return [
-        mf.Comparator(
-            name="crack",
-            summary="crack-pattern agreement: F1/Jaccard, overlap, Spearman, macro-block ARI, "
-            "mechanism cosine, failure-locus distance",
-            compare=compare,
-            version=__version__,
-            options=OPTIONS,
-        )
-    ]
+    return [COMPARATOR]
 
 
 @mf.hookimpl

@@ -7,9 +7,6 @@ import click
 
 import masonryfw as mf
 
-from .export import export_vtk
-from .gallery import run_gallery
-
 
 @click.command("gallery")
 @click.option("-o", "--output", type=click.Path(file_okay=False), default="docs/gallery", show_default=True,
@@ -19,6 +16,8 @@ from .gallery import run_gallery
 @click.option("--case", "cases", multiple=True, help="Only this bundled case (repeatable) [default: all ten].")
 def gallery_command(output: str, agreement: str | None, cases: tuple[str, ...]) -> None:
     """Solve every bundled wall with every installed method, draw and score them."""
+    from .gallery import run_gallery  # imported here: the CLI starts without matplotlib
+
     out = Path(output)
     table = Path(agreement) if agreement else out.parent / "agreement.md"
     for path in run_gallery(out, table, list(cases) or None, echo=click.echo):
@@ -31,6 +30,8 @@ def gallery_command(output: str, agreement: str | None, cases: tuple[str, ...]) 
 @click.option("-o", "--output", type=click.Path(dir_okay=False), help="[default: <result>.vtu]")
 def export_command(result: str, file_format: str, output: str | None) -> None:
     """Write RESULT as VTK files for ParaView: blocks, joints, mesh, plastic points, and a .vtm index."""
+    from .export import export_vtk  # imported here: the CLI starts without meshio
+
     dataset = mf.open_dataset(result)
     for path in export_vtk(dataset, Path(output) if output else Path(result).with_suffix(".vtu")):
         click.echo(f"wrote {path}")

@@ -26,6 +26,7 @@ import xarray as xr
 import masonryfw as mf
 
 from . import scores
+from .records import COMPARE_OPTIONS, DEFAULT_THRESHOLD
 from .shapes import (
     block_polar_moment,
     distance_to_points,
@@ -34,15 +35,6 @@ from .shapes import (
     with_geometry,
 )
 
-DEFAULT_THRESHOLD = 0.1
-OPTIONS = (
-    mf.Option(
-        "threshold",
-        float,
-        DEFAULT_THRESHOLD,
-        "a joint counts as cracked where crack_indicator > threshold (0 <= threshold < 1)",
-    ),
-)
 # Option names under which solvers record their numerical backend (la: "solver").
 BACKEND_OPTION_NAMES = ("solver", "backend", "method")
 # Model variables that must be present to tell two models apart and to score them.
@@ -54,15 +46,7 @@ GEOMETRY_VARIABLES = (
 
 def resolve(options: Mapping[str, Any]) -> dict[str, Any]:
     """Defaults overlaid by ``options``; an unknown name or a bad threshold is a PluginError."""
-    known = {o.name: o for o in OPTIONS}
-    unknown = sorted(set(options) - set(known))
-    if unknown:
-        raise mf.PluginError(
-            f"comparator 'crack': unknown option(s) {', '.join(unknown)}; valid options: "
-            + ", ".join(sorted(known))
-        )
-    resolved = {o.name: o.default for o in OPTIONS}
-    resolved.update({k: known[k].parse(v) for k, v in options.items()})
+    resolved = mf.resolve_options("comparator 'crack'", COMPARE_OPTIONS, options)
     if not 0.0 <= resolved["threshold"] < 1.0:
         raise mf.PluginError(
             f"comparator 'crack': option 'threshold' must lie in [0, 1), got {resolved['threshold']!r}"

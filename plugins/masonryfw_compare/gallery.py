@@ -19,7 +19,8 @@ import xarray as xr
 
 import masonryfw as mf
 
-from .comparison import DEFAULT_THRESHOLD, solver_label
+from .comparison import solver_label
+from .records import DEFAULT_THRESHOLD
 from .plotting import plot, save_figure
 
 METHODS = ("la", "fdem", "jmm")

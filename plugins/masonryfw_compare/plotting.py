@@ -20,7 +20,8 @@ from matplotlib.lines import Line2D
 
 import masonryfw as mf
 
-from .comparison import DEFAULT_THRESHOLD, compare, masonry_blocks, solver_label
+from .comparison import compare, masonry_blocks, solver_label
+from .records import DEFAULT_THRESHOLD, PLOTTERS
 from .shapes import (
     deformed_nodes,
     deformed_points,
@@ -341,40 +342,8 @@ def draw_compare(datasets: Sequence[xr.Dataset], ax, options: Mapping[str, Any])
     ax.figure.suptitle(str(datasets[0].attrs.get("title", "")), fontsize="large")
 
 
-THRESHOLD_OPTION = mf.Option("threshold", float, DEFAULT_THRESHOLD, "joints with crack_indicator above this are cracks")
-AMPLIFICATION_OPTION = mf.Option(
-    "amplification", float, 0.0, "displacement amplification; 0 = the largest motion drawn as 10 % of the model size"
-)
-PLOTTERS = {
-    plotter.name: plotter for plotter in (
-        mf.Plotter("mechanism", "amplified deformed wall, macro-blocks coloured, cracks heavy", draw_mechanism,
-                   mf.__version__, (AMPLIFICATION_OPTION, THRESHOLD_OPTION)),
-        mf.Plotter("cracks", "joints that open, slide or both, in colours", draw_cracks, mf.__version__,
-                   (THRESHOLD_OPTION,)),
-        mf.Plotter("forces", "contact forces at collapse as thrust segments", draw_forces, mf.__version__,
-                   (mf.Option("scale", float, 1.0, "largest segment, in median interface lengths"),)),
-        mf.Plotter("plastic", "plastic quadrature points over the mesh (continuum results)", draw_plastic,
-                   mf.__version__, (mf.Option("marker_size", float, 4.0, "marker area [pt^2]"),)),
-        mf.Plotter("history", "reaction on the moving support against settlement", draw_history, mf.__version__),
-        mf.Plotter("compare", "two or more results side by side with their scores", draw_compare, mf.__version__,
-                   (AMPLIFICATION_OPTION, THRESHOLD_OPTION)),
-    )
-}
 DEFAULT_SIZE = (7.0, 4.5)  # inches
 COMPARE_PANEL_WIDTH = 4.5
-
-
-def _resolve_plot_options(plotter: mf.Plotter, given: Mapping[str, Any]) -> dict[str, Any]:
-    known = {o.name: o for o in plotter.options}
-    unknown = sorted(set(given) - set(known))
-    if unknown:
-        raise mf.PluginError(
-            f"plot kind {plotter.name!r}: unknown option(s) {', '.join(unknown)}; valid options: "
-            + (", ".join(sorted(known)) or "(none)")
-        )
-    resolved = {o.name: o.default for o in plotter.options}
-    resolved.update({k: known[k].parse(v) for k, v in given.items()})
-    return resolved
 
 
 def plot(result: xr.Dataset | Sequence[xr.Dataset], kind: str, ax=None, **options):
@@ -385,7 +354,7 @@ def plot(result: xr.Dataset | Sequence[xr.Dataset], kind: str, ax=None, **option
     """
     plotter = PLOTTERS.get(kind) or mf.get_plotter(kind)
     datasets = [result] if isinstance(result, xr.Dataset) else list(result)
-    resolved = _resolve_plot_options(plotter, options)
+    resolved = mf.resolve_options(f"plot kind {plotter.name!r}", plotter.options, options)
     if ax is None:
         width = COMPARE_PANEL_WIDTH * len(datasets) if kind == "compare" else DEFAULT_SIZE[0]
         ax = Figure(figsize=(width, DEFAULT_SIZE[1]), layout="constrained").add_subplot()

@@ -1,0 +1,52 @@
+"""The records this plugin registers: names, summaries and options only.
+
+Importing this module is cheap (no matplotlib, scipy or meshio): the work is
+imported on first use through :func:`masonryfw.lazy`.
+"""
+from __future__ import annotations
+
+import masonryfw as mf
+
+__version__ = mf.__version__
+
+DEFAULT_THRESHOLD = 0.1
+THRESHOLD_OPTION = mf.Option(
+    "threshold",
+    float,
+    DEFAULT_THRESHOLD,
+    "a joint counts as cracked where crack_indicator > threshold (0 <= threshold < 1)",
+)
+AMPLIFICATION_OPTION = mf.Option(
+    "amplification", float, 0.0, "displacement amplification; 0 = the largest motion drawn as 10 % of the model size"
+)
+COMPARE_OPTIONS = (THRESHOLD_OPTION,)
+
+COMPARATOR = mf.Comparator(
+    name="crack",
+    summary="crack-pattern agreement: F1/Jaccard, overlap, Spearman, macro-block ARI, "
+    "mechanism cosine, failure-locus distance",
+    compare=mf.lazy("masonryfw_compare.comparison:compare"),
+    version=__version__,
+    options=COMPARE_OPTIONS,
+)
+
+
+def _plotter(name: str, summary: str, options: tuple = ()) -> mf.Plotter:
+    return mf.Plotter(name, summary, mf.lazy(f"masonryfw_compare.plotting:draw_{name}"), __version__, options)
+
+
+PLOTTERS = {
+    plotter.name: plotter
+    for plotter in (
+        _plotter("mechanism", "amplified deformed wall, macro-blocks coloured, cracks heavy",
+                 (AMPLIFICATION_OPTION, THRESHOLD_OPTION)),
+        _plotter("cracks", "joints that open, slide or both, in colours", (THRESHOLD_OPTION,)),
+        _plotter("forces", "contact forces at collapse as thrust segments",
+                 (mf.Option("scale", float, 1.0, "largest segment, in median interface lengths"),)),
+        _plotter("plastic", "plastic quadrature points over the mesh (continuum results)",
+                 (mf.Option("marker_size", float, 4.0, "marker area [pt^2]"),)),
+        _plotter("history", "reaction on the moving support against settlement"),
+        _plotter("compare", "two or more results side by side with their scores",
+                 (AMPLIFICATION_OPTION, THRESHOLD_OPTION)),
+    )
+}
