@@ -318,6 +318,39 @@ def _refusal(target: Path, ds: xr.Dataset, protect) -> str | None:
     return None
 
 
+def _writable_target(path: str | os.PathLike, refusal: str | None) -> Path:
+    """The absolute target of a write, or a ModelError saying why it must not be written."""
+    target = Path(path).resolve()
+    if not target.parent.is_dir():
+        raise ModelError(f"{path}: cannot write: directory {target.parent} does not exist")
+    if target.is_dir():
+        raise ModelError(f"{path}: cannot write: is a directory")
+    if refusal:
+        raise ModelError(f"{path}: refusing to overwrite {refusal}; write to another path")
+    return target
+
+
+def _write_atomically(target: Path, write, shown: str | os.PathLike) -> Path:
+    """Call ``write(temporary)`` next to ``target``, then rename it over ``target``.
+
+    On any failure the temporary file is removed and an existing target is left as it was.
+    """
+    temporary = target.with_name(f".{target.name}.{secrets.token_hex(6)}.tmp{target.suffix}")
+    try:
+        write(temporary)
+        if target.exists():
+            shutil.copymode(target, temporary)
+        os.replace(temporary, target)
+    except BaseException as exc:
+        temporary.unlink(missing_ok=True)
+        if isinstance(exc, MasonryError) or not isinstance(exc, Exception):
+            raise
+        raise ModelError(
+            f"{shown}: could not write ({type(exc).__name__}: {exc}); any existing file is unchanged"
+        ) from exc
+    return target
+
+
 def save(
     ds: xr.Dataset,
     path: str | os.PathLike,
@@ -333,26 +366,24 @@ def save(
     is left as it was. Refuses to write over any path in ``protect``, the file
     ``ds`` was read from, and the model file a result was computed from.
     """
-    target = Path(path).resolve()
-    if not target.parent.is_dir():
-        raise ModelError(f"{path}: cannot write: directory {target.parent} does not exist")
-    if target.is_dir():
-        raise ModelError(f"{path}: cannot write: is a directory")
-    refusal = _refusal(target, ds, protect)
-    if refusal:
-        raise ModelError(f"{path}: refusing to overwrite {refusal}; write to another path")
+    target = _writable_target(path, _refusal(Path(path).resolve(), ds, protect))
     prepared = add_history(cf_normalized(ds), command or "save")
-    temporary = target.with_name(f".{target.name}.{secrets.token_hex(6)}.tmp")
-    try:
-        _write_netcdf(prepared, temporary)
-        if target.exists():
-            shutil.copymode(target, temporary)
-        os.replace(temporary, target)
-    except BaseException as exc:
-        temporary.unlink(missing_ok=True)
-        if isinstance(exc, MasonryError) or not isinstance(exc, Exception):
-            raise
-        raise ModelError(
-            f"{path}: could not write ({type(exc).__name__}: {exc}); any existing file is unchanged"
-        ) from exc
-    return target
+    return _write_atomically(target, lambda temporary: _write_netcdf(prepared, temporary), path)
+
+
+FIGURE_FORMATS = (".png", ".svg", ".pdf")
+
+
+def save_figure(figure, path: str | os.PathLike, *, protect=(), dpi: float | None = None) -> Path:
+    """Write a matplotlib ``figure`` to ``path`` (.png, .svg or .pdf) atomically; never onto ``protect``."""
+    suffix = Path(path).suffix.lower()
+    if suffix not in FIGURE_FORMATS:
+        raise MasonryError(
+            f"{path}: unknown image type {suffix or '(none)'!r}; use one of {', '.join(FIGURE_FORMATS)}"
+        )
+    target = Path(path).resolve()
+    refusal = next((f"the input {p}" for p in protect if _same_file(target, Path(p))), None)
+    target = _writable_target(path, refusal)
+    return _write_atomically(
+        target, lambda temporary: figure.savefig(temporary, format=suffix[1:], dpi=dpi or "figure"), path
+    )

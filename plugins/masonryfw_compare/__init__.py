@@ -1,8 +1,9 @@
 """``compare``: crack-pattern agreement scores, plots, the gallery and the VTK export.
 
-Registration only (cheap to import: see :mod:`.records`); the work lives in :mod:`.comparison` (the ``crack``
-comparator), :mod:`.scores` (the score functions), :mod:`.plotting` (the plot
-kinds, :func:`plot`, :func:`save_figure`), :mod:`.gallery` and :mod:`.export`.
+Registration only (cheap to import: see :mod:`.records`); the work lives in
+:mod:`.comparison` (the ``crack`` comparator), :mod:`.scores` (the score
+functions), :mod:`.plotting` (the plot kinds, drawn through ``masonryfw.render``),
+:mod:`.gallery` and :mod:`.export`.
 """
 from __future__ import annotations
 
@@ -14,7 +15,7 @@ from .commands import COMMANDS
 from .records import COMPARATOR, PLOTTERS, __version__
 
 #: The Python API, imported on first access (PEP 562) so registering stays cheap.
-_PUBLIC = {"compare": "comparison", "plot": "plotting", "save_figure": "plotting", "export_vtk": "export"}
+_PUBLIC = {"compare": "comparison", "export_vtk": "export"}
 __all__ = sorted(_PUBLIC)
 
 

@@ -26,7 +26,7 @@ import xarray as xr
 import masonryfw as mf
 
 from . import scores
-from .records import COMPARE_OPTIONS, DEFAULT_THRESHOLD
+from .records import COMPARE_OPTIONS
 from .shapes import (
     block_polar_moment,
     distance_to_points,

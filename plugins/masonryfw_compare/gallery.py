@@ -21,7 +21,6 @@ import masonryfw as mf
 
 from .comparison import solver_label
 from .records import DEFAULT_THRESHOLD
-from .plotting import plot, save_figure
 
 METHODS = ("la", "fdem", "jmm")
 LA_BACKENDS = ("highs", "clarabel", "osqp")
@@ -105,10 +104,10 @@ def case_figure(outcome: CaseOutcome, path: Path) -> Path | None:
     if not outcome.results:
         return None
     if len(outcome.results) == 1:
-        figure, _ = plot(outcome.results[0], "mechanism")
+        figure = mf.render([outcome.results[0]], "mechanism")
     else:
-        figure, _ = plot(outcome.results, "compare")
-    return save_figure(figure, path, dpi=GALLERY_DPI)
+        figure = mf.render(outcome.results, "compare")
+    return mf.save_figure(figure, path, dpi=GALLERY_DPI)
 
 
 def _cell(comparison: xr.Dataset, name: str | None, number: str) -> str:

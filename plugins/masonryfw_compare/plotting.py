@@ -1,4 +1,4 @@
-"""Plot kinds (``Plotter`` records) and the Python entry points :func:`plot` and :func:`save_figure`.
+"""Plot kinds: the drawing functions behind the ``Plotter`` records of :mod:`.records`.
 
 Every kind draws on one matplotlib Axes with equal axes, metres on both axes and
 a title made of the model's ``title`` and the solver; ``history`` plots reaction
@@ -7,21 +7,17 @@ a :class:`masonryfw.MasonryError` naming the variable and the kind of result it 
 """
 from __future__ import annotations
 
-import os
-from pathlib import Path
 from typing import Any, Mapping, Sequence
 
 import numpy as np
 import xarray as xr
 from matplotlib import colormaps
 from matplotlib.collections import LineCollection, PolyCollection
-from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
 import masonryfw as mf
 
 from .comparison import compare, masonry_blocks, solver_label
-from .records import DEFAULT_THRESHOLD, PLOTTERS
 from .shapes import (
     deformed_nodes,
     deformed_points,
@@ -33,7 +29,6 @@ from .shapes import (
 
 # Default amplification: the largest vertex displacement drawn as this share of the model size.
 DRAWN_MOTION_SHARE = 0.10
-FIGURE_FORMATS = (".png", ".svg", ".pdf")
 STATE_COLOURS = {"open": "tab:red", "slide": "tab:blue", "open_slide": "tab:purple"}
 FAILURE_COLOURS = {"tensile": "tab:blue", "shear": "0.55", "tensile_shear": "navy"}
 SUPPORT_COLOUR = "0.45"
@@ -340,39 +335,3 @@ def draw_compare(datasets: Sequence[xr.Dataset], ax, options: Mapping[str, Any])
         alpha = f", alpha = {ds.collapse_multiplier.item():.4g}" if "collapse_multiplier" in ds else ""
         panel.set_title(f"{solver_label(ds)}{alpha}\n{caption}", fontsize="medium")
     ax.figure.suptitle(str(datasets[0].attrs.get("title", "")), fontsize="large")
-
-
-DEFAULT_SIZE = (7.0, 4.5)  # inches
-COMPARE_PANEL_WIDTH = 4.5
-
-
-def plot(result: xr.Dataset | Sequence[xr.Dataset], kind: str, ax=None, **options):
-    """Draw ``result`` (or several, for ``compare``) as plot ``kind``; returns ``(figure, axes)``.
-
-    Without ``ax`` a new figure (not registered with pyplot) is made. Kinds other
-    than this package's are looked up through the plugin manager.
-    """
-    plotter = PLOTTERS.get(kind) or mf.get_plotter(kind)
-    datasets = [result] if isinstance(result, xr.Dataset) else list(result)
-    resolved = mf.resolve_options(f"plot kind {plotter.name!r}", plotter.options, options)
-    if ax is None:
-        width = COMPARE_PANEL_WIDTH * len(datasets) if kind == "compare" else DEFAULT_SIZE[0]
-        ax = Figure(figsize=(width, DEFAULT_SIZE[1]), layout="constrained").add_subplot()
-    plotter.plot(datasets, ax, resolved)
-    return ax.figure, ax
-
-
-def save_figure(figure: Figure, path: str | os.PathLike, *, dpi: float | None = None) -> Path:
-    """Write ``figure`` to ``path`` (.png, .svg or .pdf) atomically: a temporary file, then a rename."""
-    path = Path(path)
-    suffix = path.suffix.lower()
-    if suffix not in FIGURE_FORMATS:
-        raise mf.MasonryError(f"figure file {str(path)!r}: unknown format {suffix or '(none)'!r}; use .png, .svg or .pdf")
-    path.parent.mkdir(parents=True, exist_ok=True)
-    temporary = path.with_name(f".{path.name}.{os.getpid()}.tmp{suffix}")
-    try:
-        figure.savefig(temporary, format=suffix[1:], dpi=dpi or "figure")
-        os.replace(temporary, path)
-    finally:
-        temporary.unlink(missing_ok=True)
-    return path

@@ -3,12 +3,18 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+import xarray as xr
 from PIL import Image
 
 import masonryfw as mf
-from masonryfw_compare import plot, save_figure
 from masonryfw_compare.plotting import default_amplification, thrust_segments
 from masonryfw_compare.shapes import with_geometry
+
+
+def plot(result, kind, **options):
+    """Draw through the core, as the CLI does; returns the figure and its first axes."""
+    figure = mf.render([result] if isinstance(result, xr.Dataset) else result, kind, options)
+    return figure, figure.axes[0]
 
 SUPPORTED = {
     "mechanism": {"la", "fdem"},
@@ -35,7 +41,7 @@ def test_each_kind_renders_what_it_supports_and_refuses_the_rest(results, tmp_pa
         return
     figure, ax = plot(results[result_kind], kind)
     figure.set_size_inches(5, 3)
-    path = save_figure(figure, tmp_path / f"{kind}-{result_kind}.png", dpi=100)
+    path = mf.save_figure(figure, tmp_path / f"{kind}-{result_kind}.png", dpi=100)
     with Image.open(path) as image:
         assert image.size == (500, 300)
         assert len(np.unique(np.asarray(image.convert("L")))) > 2  # something was drawn
@@ -54,7 +60,7 @@ def test_compare_draws_side_by_side_panels_with_scores_in_the_titles(results, tm
         "jmm\nF1 1.00, d 0.08",
     ]
     for suffix in (".svg", ".pdf"):
-        assert save_figure(figure, tmp_path / f"c{suffix}").stat().st_size > 1000
+        assert mf.save_figure(figure, tmp_path / f"c{suffix}").stat().st_size > 1000
     with pytest.raises(mf.MasonryError, match="needs two or more results"):
         plot([results["la"]], "compare")
 
@@ -95,10 +101,10 @@ def test_plot_options_and_file_names_are_checked(results, tmp_path):
     with pytest.raises(mf.PluginError, match="amplification.*cannot read 'big' as float"):
         plot(results["la"], "mechanism", amplification="big")
     figure, _ = plot(results["la"], "mechanism", amplification=50)
-    with pytest.raises(mf.MasonryError, match="unknown format '.jpg'"):
-        save_figure(figure, tmp_path / "m.jpg")
+    with pytest.raises(mf.MasonryError, match="unknown image type '.jpg'"):
+        mf.save_figure(figure, tmp_path / "m.jpg")
 
 
 def test_the_core_renders_these_kinds_through_the_plugin_manager(results):
-    figure = mf.plugins.render([results["jmm"]], "plastic", {"marker_size": "6"})
+    figure = mf.render([results["jmm"]], "plastic", {"marker_size": "6"})
     assert figure.axes[0].get_title() == "Grid wall - jmm"

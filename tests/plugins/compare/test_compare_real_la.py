@@ -4,9 +4,16 @@ from __future__ import annotations
 import meshio
 import numpy as np
 import pytest
+import xarray as xr
 
 import masonryfw as mf
-from masonryfw_compare import compare, export_vtk, plot
+from masonryfw_compare import compare, export_vtk
+
+
+def plot(result, kind, **options):
+    """Draw through the core, as the CLI does; returns the figure and its first axes."""
+    figure = mf.render([result] if isinstance(result, xr.Dataset) else result, kind, options)
+    return figure, figure.axes[0]
 
 
 

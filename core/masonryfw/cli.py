@@ -1,0 +1,356 @@
+"""The ``masonryfw`` command line: a thin click layer over the public API.
+
+Every :class:`masonryfw.MasonryError` (and every ``OSError`` on a user's path)
+becomes ``error: <message>`` on stderr and exit code 1, without a traceback,
+unless ``--debug`` is given; usage errors exit with 2 (click's default).
+"""
+from __future__ import annotations
+
+import json
+import os
+import shlex
+import sys
+import warnings
+from pathlib import Path
+
+import click
+import numpy as np
+
+import masonryfw as mf
+from masonryfw.plugins import command_plugin, installed_plugins, model_part, plugin_commands, render
+
+
+def _error_message(exc: BaseException) -> str:
+    if isinstance(exc, OSError) and exc.filename is not None:
+        return f"{exc.filename}: {exc.strerror or exc}"
+    return str(exc)
+
+
+class _MasonryGroup(click.Group):
+    """Adds the plugins' commands, remembers the command line (for history lines) and
+    turns errors into messages."""
+
+    def _plugin_commands(self, ctx) -> dict[str, click.Command]:
+        """Commands contributed by plugins; one that reuses a built-in name is an error."""
+        extra = plugin_commands()
+        taken = sorted(set(extra) & set(super().list_commands(ctx)))
+        if taken:
+            raise mf.PluginError(
+                f"command {taken[0]!r} of plugin {command_plugin(taken[0])} clashes with the built-in command"
+            )
+        return extra
+
+    def list_commands(self, ctx):
+        try:
+            extra = self._plugin_commands(ctx)
+        except mf.MasonryError as exc:  # --help must still work
+            click.echo(f"warning: {exc}", err=True)
+            extra = {}
+        return sorted([*super().list_commands(ctx), *extra])
+
+    def get_command(self, ctx, name):
+        return super().get_command(ctx, name) or self._plugin_commands(ctx).get(name)
+
+    def make_context(self, info_name, args, parent=None, **extra):
+        extra.setdefault("obj", {})["command_line"] = shlex.join(["masonryfw", *args])
+        return super().make_context(info_name, args, parent, **extra)
+
+    def invoke(self, ctx):
+        try:
+            return super().invoke(ctx)
+        except (mf.MasonryError, OSError) as exc:
+            if ctx.params.get("debug"):
+                raise
+            click.echo(f"error: {_error_message(exc)}", err=True)
+            ctx.exit(1)
+
+
+@click.group(cls=_MasonryGroup)
+@click.option("--debug", is_flag=True, help="Show the full traceback of an error.")
+@click.version_option(mf.__version__, prog_name="masonryfw")
+def cli(debug: bool) -> None:
+    """Failure analysis of dry-joint masonry walls under foundation settlements."""
+
+
+def _command_line() -> str:
+    return click.get_current_context().obj["command_line"]
+
+
+def _is_path(path_or_name: str) -> bool:
+    return Path(path_or_name).exists()
+
+
+def _parse_options(pairs: tuple[str, ...]) -> dict[str, str]:
+    options = {}
+    for pair in pairs:
+        key, sep, value = pair.partition("=")
+        if not sep or not key.strip():
+            raise click.BadParameter(f"{pair!r} is not KEY=VALUE", param_hint="--option")
+        options[key.strip()] = value
+    return options
+
+
+_OPTION = click.option(
+    "--option", "options", multiple=True, metavar="KEY=VALUE", help="A plugin option (repeatable)."
+)
+
+
+# ---------------------------------------------------------------- progress
+
+class _StderrBar:
+    """``progress(fraction, message)`` drawn as one line ``[####......]  40% message`` on a stream."""
+
+    width = 30
+
+    def __init__(self, stream):
+        self.stream = stream
+        self.drawn = False
+
+    def __call__(self, fraction: float, message: str = "") -> None:
+        done = min(max(float(fraction), 0.0), 1.0)
+        filled = round(done * self.width)
+        bar = "#" * filled + "." * (self.width - filled)
+        self.stream.write(f"\r[{bar}] {done:4.0%} {message[:40]:<40}")
+        self.stream.flush()
+        self.drawn = True
+
+    def close(self) -> None:
+        if self.drawn:
+            self.stream.write("\n")
+            self.stream.flush()
+
+
+def _progress_bar(enabled: bool) -> _StderrBar | None:
+    """A bar on stderr when it is a terminal and the user did not pass ``--no-progress``."""
+    return _StderrBar(sys.stderr) if enabled and sys.stderr.isatty() else None
+
+
+# ---------------------------------------------------------------- build, check, info, datasets
+
+@cli.command()
+@click.argument("spec")
+@click.option("-o", "--output", type=click.Path(dir_okay=False), help="Model file to write [default: <spec stem>.nc].")
+def build(spec: str, output: str | None) -> None:
+    """Build a model from SPEC (a TOML file or a bundled case name)."""
+    spec_path = Path(spec) if _is_path(spec) else mf.bundled_spec_path(spec)
+    model = mf.build(mf.load_spec(spec_path))
+    out = Path(output) if output else Path(f"{Path(spec).stem}.nc")
+    mf.save(model, out, command=_command_line(), protect=[spec_path])
+    click.echo(f"wrote {out}: {model.sizes['block']} blocks, {model.sizes.get('interface', 0)} interfaces")
+
+
+@cli.command(name="check")
+@click.argument("file")
+def check_command(file: str) -> None:
+    """Check FILE (model, result or comparison) and print every problem found."""
+    ds = mf.open_dataset(file)
+    problems = mf.check(ds)
+    for problem in problems:
+        click.echo(f"  - {problem}")
+    if problems:
+        click.echo(f"error: {file}: {len(problems)} problem(s)", err=True)
+        click.get_current_context().exit(1)
+    if ds.attrs.get("masonryfw_format") == "comparison":
+        click.echo(f"OK: comparison by {ds.attrs.get('comparator', '?')} of {ds.attrs.get('title', '')}")
+    else:
+        click.echo(f"OK: {ds.sizes.get('block', 0)} blocks, {ds.sizes.get('interface', 0)} interfaces")
+
+
+def _counts(values: np.ndarray, flag_variable: str) -> str:
+    meanings = mf.flags(flag_variable)
+    counts = np.bincount(np.asarray(values, dtype=np.int64), minlength=max(meanings.values()) + 1)
+    return ", ".join(f"{meaning.replace('_', ' ')} {counts[value]}" for meaning, value in meanings.items())
+
+
+def _span(values: np.ndarray) -> str:
+    low, high = float(np.min(values)), float(np.max(values))
+    return f"{low:.6g} m" if np.isclose(low, high) else f"{low:.6g}..{high:.6g} m"
+
+
+def _support_lines(model) -> list[str]:
+    """One line per support block: its x range and how it moves (supports are few)."""
+    roles = mf.flags("block_role")
+    xmin, xmax, _, _ = mf.block_bounds(model.node_x.values, model.node_y.values, model.block_node_count.values)
+    lines = []
+    for block in np.flatnonzero(np.isin(model.block_role.values, [roles["fixed_support"], roles["moving_support"]])):
+        held = model.block_fixed.values[block]
+        direction = model.settlement_direction.values[block]
+        if model.block_role.values[block] == roles["fixed_support"]:
+            motion = f"fixed (held {' '.join(map(str, held))})"
+        else:
+            how = "vertical translation" if held.tolist() == [1, 0, 1] else "rotation about a pivot"
+            motion = f"moving: {how}, settlement direction ({', '.join(f'{d:.4g}' for d in direction)})"
+        lines.append(f"  block {block}: x {xmin[block]:.6g}..{xmax[block]:.6g} m, {motion}")
+    return lines
+
+
+def _load_lines(model) -> list[str]:
+    roles = mf.flags("block_role")
+    on_support = np.isin(model.block_role.values, [roles["fixed_support"], roles["moving_support"]])
+    lines = []
+    for name in ("dead_load", "live_load"):
+        load = model[name].values
+        for label, rows in (("masonry", ~on_support), ("supports", on_support)):
+            fx, fy = load[rows, 0].sum(), load[rows, 1].sum()
+            lines.append(f"  {name.replace('_', ' ')} on {label}: Fx = {fx:.6g} N, Fy = {fy:.6g} N")
+    return lines
+
+
+@cli.command()
+@click.argument("model")
+def info(model: str) -> None:
+    """Describe MODEL (a file or a bundled case name)."""
+    ds = mf.open_model(model)
+    roles = mf.flags("block_role")
+    masonry = np.isin(ds.block_role.values, [roles["unit"], roles["lintel"]])
+    owner = mf.node_block(ds.block_node_count.values)
+    x, y = ds.node_x.values[masonry[owner]], ds.node_y.values[masonry[owner]]
+    click.echo(f"title: {ds.attrs.get('title', '')}")
+    click.echo(f"blocks: {ds.sizes['block']} ({_counts(ds.block_role.values, 'block_role')})")
+    click.echo(f"interfaces: {ds.sizes.get('interface', 0)} ({_counts(ds.interface_kind.values, 'interface_kind')})")
+    if x.size:
+        click.echo(
+            f"wall: {np.ptp(x):.6g} m x {np.ptp(y):.6g} m "
+            f"(x {x.min():.6g}..{x.max():.6g}, y {y.min():.6g}..{y.max():.6g})"
+        )
+        click.echo(f"thickness: {_span(ds.block_thickness.values[masonry])}")
+    click.echo("supports:")
+    for line in _support_lines(ds):
+        click.echo(line)
+    click.echo("loads:")
+    for line in _load_lines(ds):
+        click.echo(line)
+
+
+@cli.command()
+def datasets() -> None:
+    """List the bundled cases with their titles and block counts."""
+    for name in mf.bundled_cases():
+        model = mf.open_model(name, validate=False)
+        click.echo(f"{name:<12} {model.attrs.get('title', ''):<12} {model.sizes['block']:>5} blocks")
+
+
+# ---------------------------------------------------------------- plugins
+
+def _record_lines(kind: str, record) -> list[str]:
+    lines = [f"  {kind} {record.name} {record.version}: {record.summary}"]
+    for option in record.options:
+        choices = f", one of {', '.join(map(str, option.choices))}" if option.choices else ""
+        usage = f"--option {option.name}=<{option.type.__name__}>  (default {option.default!r}{choices})"
+        lines.append(f"      {usage}  {option.help}".rstrip())
+    return lines
+
+
+@cli.command()
+def plugins() -> None:
+    """List the installed plugins and their solvers, comparators and plotters with their options."""
+    for plugin in installed_plugins():
+        origin = f"{plugin.distribution} {plugin.version}" if plugin.distribution else "registered in-process"
+        click.echo(f"{plugin.name} ({origin})")
+        records = [("solver", r) for r in plugin.solvers] + [("comparator", r) for r in plugin.comparators]
+        records += [("plotter", r) for r in plugin.plotters]
+        for kind, record in records:
+            for line in _record_lines(kind, record):
+                click.echo(line)
+        for command in plugin.commands:
+            click.echo(f"  command {command.name}: {command.get_short_help_str(limit=70)}")
+        if not records and not plugin.commands:
+            click.echo("  (contributes nothing)")
+
+
+# ---------------------------------------------------------------- solve, compare, plot
+
+def _scalar_summary(ds, names) -> str:
+    parts = []
+    for name in names:
+        variable = ds[name]
+        if variable.ndim == 0 and np.issubdtype(variable.dtype, np.number):
+            units = variable.attrs.get("units", "")
+            parts.append(f"{name} = {float(variable):.6g}{' ' + units if units not in ('', '1') else ''}")
+    return ", ".join(parts)
+
+
+@cli.command()
+@click.argument("model")
+@click.option("--plugin", "solver", required=True, help="Name of the solver (see `masonryfw plugins`).")
+@click.option("-o", "--output", type=click.Path(dir_okay=False), help="[default: <model>.<plugin>.nc]")
+@_OPTION
+@click.option("--no-progress", is_flag=True, help="Do not draw a progress bar.")
+def solve(model: str, solver: str, output: str | None, options: tuple[str, ...], no_progress: bool) -> None:
+    """Solve MODEL (a file or a bundled case name) with a solver plugin."""
+    parsed = _parse_options(options)
+    inputs = [Path(model)] if _is_path(model) else []
+    out = Path(output) if output else Path(f"{Path(model).stem if inputs else model}.{solver}.nc")
+    _refuse_overwriting(out, inputs)
+    dataset = mf.open_model(model)
+    bar = _progress_bar(not no_progress)
+    try:
+        result = mf.solve(dataset, solver, parsed, progress=bar)
+    finally:
+        if bar is not None:
+            bar.close()
+    mf.save(result, out, command=_command_line(), protect=inputs)
+    added = [name for name in result.data_vars if name not in model_part(dataset).variables]
+    summary = _scalar_summary(result, ["collapse_multiplier"] if "collapse_multiplier" in added else added)
+    click.echo(f"result: {out}")
+    click.echo(f"{solver}: {summary + '; ' if summary else ''}wall time {result.attrs['wall_time_s']:.3g} s")
+
+
+@cli.command()
+@click.argument("a")
+@click.argument("b")
+@click.option("--comparator", help="Name of the comparator [default: the only one installed].")
+@click.option("-o", "--output", type=click.Path(dir_okay=False), help="Write the comparison dataset here.")
+@_OPTION
+@click.option("--json", "as_json", is_flag=True, help="Print the scalar scores as JSON.")
+def compare(
+    a: str, b: str, comparator: str | None, output: str | None, options: tuple[str, ...], as_json: bool
+) -> None:
+    """Compare two results A and B."""
+    parsed = _parse_options(options)
+    comparison = mf.compare(mf.open_dataset(a), mf.open_dataset(b), comparator, parsed)
+    if output:
+        mf.save(comparison, output, command=_command_line(), protect=[a, b])
+    scalars = [n for n in comparison.data_vars if comparison[n].ndim == 0]
+    if as_json:
+        scores = {n: comparison[n].values.item() for n in scalars}
+        click.echo(json.dumps({"comparator": comparison.attrs["comparator"], "scores": scores}, default=str))
+    else:
+        click.echo(f"{comparison.attrs['comparator']}: {_scalar_summary(comparison, scalars) or '(no scalar scores)'}")
+        if output:
+            click.echo(f"comparison: {output}")
+
+
+@cli.command()
+@click.argument("results", nargs=-1, required=True)
+@click.option("--kind", help="Plot kind (see `masonryfw plugins`) [default: the only one installed].")
+@click.option("-o", "--output", type=click.Path(dir_okay=False), required=True, help="Image file (png, svg, pdf).")
+@_OPTION
+def plot(results: tuple[str, ...], kind: str | None, output: str, options: tuple[str, ...]) -> None:
+    """Plot one or more RESULTS (files or bundled case names) with a plotter plugin."""
+    parsed = _parse_options(options)
+    figure = render([mf.open_model(r) for r in results], kind, parsed)
+    if Path(output).suffix.lower() not in mf.io.FIGURE_FORMATS:
+        raise click.BadParameter(
+            f"{output}: unknown image type; use one of {', '.join(mf.io.FIGURE_FORMATS)}", param_hint="-o"
+        )
+    mf.save_figure(figure, output, protect=[r for r in results if _is_path(r)])
+    click.echo(f"plot: {output}")
+
+
+def _refuse_overwriting(output: Path, inputs: list[Path]) -> None:
+    """Stop before any work if ``output`` is one of the ``inputs`` (through links and relative paths)."""
+    for source in inputs:
+        if output.resolve() == source.resolve() or (output.exists() and os.path.samefile(output, source)):
+            raise mf.ModelError(f"{output}: refusing to overwrite the input {source}; write to another path")
+
+
+def _show_warning(message, category, filename, lineno, file=None, line=None) -> None:
+    click.echo(f"warning: {message}", err=True)
+
+
+def main(argv: list[str] | None = None) -> None:
+    """Entry point of the ``masonryfw`` script and of ``python -m masonryfw``."""
+    with warnings.catch_warnings():
+        warnings.showwarning = _show_warning
+        cli.main(args=argv, prog_name="masonryfw")
