@@ -1,0 +1,52 @@
+"""Graph questions on the contact graph (blocks = nodes, interfaces = edges)."""
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse as sp
+from scipy.sparse.csgraph import connected_components
+
+import masonryfw as mf
+
+
+MAX_NAMED = 20
+
+
+def components(n_block: int, edges: np.ndarray) -> np.ndarray:
+    """Connected-component label of every block through the given ``(k, 2)`` block pairs.
+
+    Labels are 0..k-1 in order of the lowest block index of each component.
+    """
+    edges = np.asarray(edges, dtype=np.int64).reshape(-1, 2)
+    graph = sp.coo_matrix(
+        (np.ones(len(edges)), (edges[:, 0], edges[:, 1])), shape=(n_block, n_block)
+    )
+    _, labels = connected_components(graph, directed=False)
+    _, first = np.unique(labels, return_index=True)
+    order = np.argsort(np.argsort(first))  # relabel by first appearance
+    return order[labels]
+
+
+def name_blocks(blocks: np.ndarray) -> str:
+    """``"12, 13"`` (the first few, then how many more)."""
+    shown = ", ".join(str(b) for b in blocks[:MAX_NAMED])
+    more = blocks.size - MAX_NAMED
+    return shown + (f" and {more} more" if more > 0 else "")
+
+
+def check_supported(wall) -> None:
+    """Raise when a connected group of blocks touches no support and holds no component.
+
+    Such a group moves as a rigid body with no joint resisting: the problem has
+    no finite multiplier, and naming the blocks is more useful than "unbounded".
+    """
+    labels = components(wall.n_block, wall.sides)
+    anchored = wall.support | wall.fixed.any(axis=1)
+    supported = np.zeros(labels.max() + 1, dtype=bool)
+    np.logical_or.at(supported, labels, anchored)
+    loose = np.flatnonzero(~supported[labels])
+    if loose.size:
+        what = f"block {loose[0]} is" if loose.size == 1 else f"blocks {name_blocks(loose)} are"
+        raise mf.SolveError(
+            f"{what} not supported: no chain of contacts links them to a support or a held "
+            "block, so they can move as a rigid body with no joint resisting"
+        )
