@@ -12,7 +12,7 @@ from importlib import resources
 from .errors import ModelError
 
 FORMAT_VERSION = 1
-KINDS = ("model", "result", "comparison")
+KINDS = ("model", "result", "comparison", "sweep")
 
 
 @lru_cache(maxsize=None)
