@@ -1,0 +1,28 @@
+"""``fdem``: explicit rigid-block discrete elements under an imposed settlement (paper section 2.2).
+
+Registration only (numba is imported when a solve starts); the method lives in :mod:`.scene` (model -> non-dimensional
+arrays), :mod:`.kernels` (numba: contact detection, contact forces, time
+stepping), :mod:`.simulation` (the gravity and settlement phases),
+:mod:`.postprocess` and :mod:`.solver`. See docs/fdem.md.
+"""
+from __future__ import annotations
+
+import masonryfw as mf
+
+from .options import OPTIONS
+
+__version__ = "0.1.0"
+
+
+@mf.hookimpl
+def masonryfw_solvers():
+    return [
+        mf.Solver(
+            name="fdem",
+            summary="explicit discrete elements: rigid blocks, penalty Coulomb contacts, support "
+            "moved slowly down; reaction history, final mechanism, energy balance",
+            solve=mf.lazy("masonryfw_fdem.solver:solve"),
+            version=__version__,
+            options=OPTIONS,
+        )
+    ]

@@ -1,0 +1,459 @@
+"""Numba kernels of the rigid-block mode: contact detection, contact forces, time stepping.
+
+Everything here works on flat float64/int64 arrays in non-dimensional units
+(lengths over the characteristic length, forces over the total weight, time over
+``sqrt(length / g)``), see :mod:`.scene`.
+
+Contact model ("face pairs"): two blocks touch through a pair of nearly
+anti-parallel edges, one of each block. The pair's common normal ``n`` is the
+bisector of the two outward edge normals (from block A into block B), its
+tangent ``t = (n_y, -n_x)``. The two edges are projected on ``t``; their overlap
+``[s_lo, s_hi]`` carries two contact points, one at each end (end 0 at
+``s_lo``, end 1 at ``s_hi``), each with the tributary length ``(s_hi - s_lo) / 2``
+(the stiffness of an end is the contact stiffness per unit length times that length,
+so the force grows with the overlap as in a potential-based, area-proportional
+contact). An overlap shorter than ``2 min_half`` carries nothing: two blocks that
+meet corner to corner, as the builder's aligned support ends and unit corners do,
+are not in contact until their faces really overlap (the limit analysis, with its
+fixed interface list, makes the same choice).
+The gap at an end is the distance along ``n`` between the two edges' lines there
+(negative = penetration). A block that rocks about a corner keeps a single
+penetrating end at that corner, so this reduces to vertex-to-edge contact; on
+flat faces it gives exactly the two interface ends of the limit analysis.
+Geometry is recomputed from the current positions every step (large displacements);
+the pair list itself is rebuilt only when some block has moved more than half the
+detection buffer since the last detection.
+"""
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+# Indices into the scalar state vector ``acc`` (accumulators carried between chunks).
+TIME, SETTLEMENT, WORK_GRAVITY, WORK_SUPPORT, DISSIPATED_DAMPING, DISSIPATED_FRICTION, RELEASED = range(7)
+N_ACC = 7
+
+# error_model="numpy": float division by zero gives inf/nan instead of a checked branch (3x faster)
+jit = njit(cache=True, error_model="numpy")
+
+
+@jit
+def place_vertices(pos, lx, ly, offs, vx, vy):
+    """Current positions ``vx, vy`` of all nodes (one sine and cosine per block)."""
+    for b in range(offs.size - 1):
+        c = np.cos(pos[b, 2])
+        s = np.sin(pos[b, 2])
+        for k in range(offs[b], offs[b + 1]):
+            vx[k] = pos[b, 0] + c * lx[k] - s * ly[k]
+            vy[k] = pos[b, 1] + s * lx[k] + c * ly[k]
+
+
+@jit
+def next_node(k, b, offs):
+    return k + 1 if k + 1 < offs[b + 1] else offs[b]
+
+
+@jit
+def face_geometry(vx, vy, offs, a, ea, b, eb):
+    """Frame, overlap and end gaps of the face pair (edge ``ea`` of ``a``, edge ``eb`` of ``b``).
+
+    Returns ``nx, ny, ox, oy, s_lo, s_hi, gap_lo, gap_hi, h_lo, h_hi, cos_angle`` where
+    ``h`` is the mid-plane height of each end (contact point ``o + s t + h n``).
+    """
+    ka, kb = next_node(ea, a, offs), next_node(eb, b, offs)
+    ax0, ay0, ax1, ay1 = vx[ea], vy[ea], vx[ka], vy[ka]
+    bx0, by0, bx1, by1 = vx[eb], vy[eb], vx[kb], vy[kb]
+    la = np.hypot(ax1 - ax0, ay1 - ay0)
+    lb = np.hypot(bx1 - bx0, by1 - by0)
+    nax, nay = (ay1 - ay0) / la, -(ax1 - ax0) / la
+    nbx, nby = (by1 - by0) / lb, -(bx1 - bx0) / lb
+    cos_angle = nax * nbx + nay * nby
+    nx, ny = nax - nbx, nay - nby
+    nn = np.hypot(nx, ny)
+    if cos_angle > -0.1:  # faces at more than ~84 degrees: never a face pair
+        return 0.0, 0.0, 0.0, 0.0, 0.0, -1.0, 1e300, 1e300, 0.0, 0.0, cos_angle
+    nx, ny = nx / nn, ny / nn
+    tx, ty = ny, -nx
+    ox = 0.25 * (ax0 + ax1 + bx0 + bx1)
+    oy = 0.25 * (ay0 + ay1 + by0 + by1)
+    sa0 = (ax0 - ox) * tx + (ay0 - oy) * ty
+    sa1 = (ax1 - ox) * tx + (ay1 - oy) * ty
+    sb0 = (bx0 - ox) * tx + (by0 - oy) * ty
+    sb1 = (bx1 - ox) * tx + (by1 - oy) * ty
+    ha0 = (ax0 - ox) * nx + (ay0 - oy) * ny
+    ha1 = (ax1 - ox) * nx + (ay1 - oy) * ny
+    hb0 = (bx0 - ox) * nx + (by0 - oy) * ny
+    hb1 = (bx1 - ox) * nx + (by1 - oy) * ny
+    s_lo = max(min(sa0, sa1), min(sb0, sb1))
+    s_hi = min(max(sa0, sa1), max(sb0, sb1))
+    if s_hi < s_lo:  # no overlap: evaluate both ends at the middle of the gap between the edges
+        mid = 0.5 * (s_lo + s_hi)
+        e_lo, e_hi = mid, mid
+    else:
+        e_lo, e_hi = s_lo, s_hi
+    ka_lo = ha0 + (ha1 - ha0) * (e_lo - sa0) / (sa1 - sa0)
+    ka_hi = ha0 + (ha1 - ha0) * (e_hi - sa0) / (sa1 - sa0)
+    kb_lo = hb0 + (hb1 - hb0) * (e_lo - sb0) / (sb1 - sb0)
+    kb_hi = hb0 + (hb1 - hb0) * (e_hi - sb0) / (sb1 - sb0)
+    return (nx, ny, ox, oy, s_lo, s_hi, kb_lo - ka_lo, kb_hi - ka_hi,
+            0.5 * (ka_lo + kb_lo), 0.5 * (ka_hi + kb_hi), cos_angle)
+
+
+@jit
+def block_boxes(vx, vy, offs, margin):
+    n = offs.size - 1
+    box = np.empty((n, 4))
+    for b in range(n):
+        x0 = y0 = 1e300
+        x1 = y1 = -1e300
+        for k in range(offs[b], offs[b + 1]):
+            x, y = vx[k], vy[k]
+            x0, x1, y0, y1 = min(x0, x), max(x1, x), min(y0, y), max(y1, y)
+        box[b, 0], box[b, 1], box[b, 2], box[b, 3] = x0 - margin, x1 + margin, y0 - margin, y1 + margin
+    return box
+
+
+@jit
+def candidate_block_pairs(box, driven):
+    """Block pairs whose boxes overlap: sort by left edge, sweep (no all-pairs loop).
+
+    Pairs of two driven blocks (supports) are left out: nothing acts between them.
+    """
+    order = np.argsort(box[:, 0])
+    n = order.size
+    out = []
+    for i in range(n):
+        p = order[i]
+        for j in range(i + 1, n):
+            q = order[j]
+            if box[q, 0] > box[p, 1]:
+                break
+            if box[q, 2] > box[p, 3] or box[p, 2] > box[q, 3]:
+                continue
+            if driven[p] and driven[q]:
+                continue
+            out.append((min(p, q), max(p, q)))
+    pairs = np.empty((len(out), 2), dtype=np.int64)
+    for i in range(len(out)):
+        pairs[i, 0], pairs[i, 1] = out[i]
+    return pairs
+
+
+@jit
+def detect_face_pairs(pos, lx, ly, offs, driven, buffer, max_penetration, min_cos):
+    """Face pairs of every candidate block pair: edges anti-parallel within the angle
+    ``acos(min_cos)``, overlapping (or within ``buffer`` of it) along the tangent, with
+    end gaps between ``-max_penetration`` and ``buffer``. Returns (k, 4) ``a, ea, b, eb``."""
+    vx = np.empty(lx.size)
+    vy = np.empty(lx.size)
+    place_vertices(pos, lx, ly, offs, vx, vy)
+    pairs = candidate_block_pairs(block_boxes(vx, vy, offs, buffer), driven)
+    out = []
+    for i in range(pairs.shape[0]):
+        a, b = pairs[i, 0], pairs[i, 1]
+        for ea in range(offs[a], offs[a + 1]):
+            for eb in range(offs[b], offs[b + 1]):
+                g = face_geometry(vx, vy, offs, a, ea, b, eb)
+                if g[10] > -min_cos:
+                    continue
+                if g[5] - g[4] < -buffer:
+                    continue
+                gap_min = min(g[6], g[7])
+                if gap_min < -max_penetration or gap_min > buffer:
+                    continue
+                out.append((a, ea, b, eb))
+    faces = np.empty((len(out), 4), dtype=np.int64)
+    for i in range(len(out)):
+        faces[i, 0], faces[i, 1], faces[i, 2], faces[i, 3] = out[i]
+    return faces
+
+
+@jit
+def face_keys(faces, n_node):
+    """One int64 per face pair (its two edges), to carry contact history across rebuilds."""
+    return faces[:, 1] * n_node + faces[:, 3]
+
+
+@jit
+def carry_history(old_keys, old_shear, old_bonded, old_energy, new_keys, new_shear, new_bonded, new_energy):
+    """Copy shear forces, bond states and spring energies of face pairs present before and after
+    a rebuild; returns the spring energy of the pairs the rebuild dropped."""
+    order = np.argsort(new_keys)
+    sorted_keys = new_keys[order]
+    dropped = 0.0
+    for o in range(old_keys.size):
+        j = np.searchsorted(sorted_keys, old_keys[o])
+        if j < sorted_keys.size and sorted_keys[j] == old_keys[o]:
+            i = order[j]
+            for e in range(2):
+                new_shear[i, e] = old_shear[o, e]
+                new_bonded[i, e] = old_bonded[o, e]
+                new_energy[i, e] = old_energy[o, e]
+        else:
+            dropped += old_energy[o, 0] + old_energy[o, 1]
+    return dropped
+
+
+@jit
+def contact_forces(pos, vel, vx, vy, offs, faces, props, kn, kt, min_half, contact_damping, inv_mass,
+                   dt, shear, bonded, normal, energy, force, acc, update_history, active, driven, calm,
+                   wake_speed):
+    """Add the contact forces of every face pair to ``force`` (block, 3).
+
+    ``props`` (face, 4): friction, cohesion and tensile strength per unit length
+    (already times the thickness), and the model interface (post-processing only). ``shear`` (face, 2) is the
+    tangential spring force on block B along ``t``, ``normal`` (face, 2) the
+    normal force (compression positive), ``bonded`` (face, 2) 1 while the end
+    still has its cohesion/tension. Friction (and bond-breaking) dissipation goes
+    to ``acc[DISSIPATED_FRICTION]``; the spring energy a face pair still holds
+    when its two faces slide apart (a corner sliding off an edge) to ``acc[RELEASED]``.
+    ``energy`` (face, 2) keeps the spring energy of every end (for what a rebuild drops). Returns the elastic energy stored in the springs.
+    With ``update_history`` False only the forces and energy are evaluated.
+
+    Normal contact damping: a dashpot ``contact_damping`` times critical for the
+    reduced mass of the two blocks (``inv_mass``: 0 for driven blocks) acts on
+    the normal relative velocity; the total normal force stays compressive on
+    dry ends. It damps the contact chatter (a block landing on a plane) without
+    touching sliding, which has no normal relative velocity.
+
+    Sleeping: a pair of two inactive blocks (asleep, or supports standing still) is
+    skipped, its forces and spring energy frozen. A sleeping block is woken when
+    a contact point it shares with an active block moves faster than ``wake_speed``.
+    """
+    stored = 0.0
+    for f in range(faces.shape[0]):
+        a, ea, b, eb = faces[f, 0], faces[f, 1], faces[f, 2], faces[f, 3]
+        if not active[a] and not active[b]:
+            stored += energy[f, 0] + energy[f, 1]
+            continue
+        g = face_geometry(vx, vy, offs, a, ea, b, eb)
+        nx, ny, ox, oy, s_lo, s_hi = g[0], g[1], g[2], g[3], g[4], g[5]
+        tx, ty = ny, -nx
+        half = 0.5 * (s_hi - s_lo)
+        if half <= min_half:
+            if update_history:  # the faces slid apart: the contact (and any bond) is gone
+                for e in range(2):
+                    acc[RELEASED] += energy[f, e]
+                    energy[f, e] = 0.0
+                    shear[f, e] = 0.0
+                    bonded[f, e] = 0
+            normal[f, 0] = normal[f, 1] = 0.0
+            continue
+        knp = kn * half
+        ktp = kt * half
+        m_inv = inv_mass[a] + inv_mass[b]
+        dashpot = 2.0 * contact_damping * np.sqrt(knp / m_inv) if m_inv > 0.0 else 0.0
+        mu, coh, ten = props[f, 0], props[f, 1] * half, props[f, 2] * half
+        for e in range(2):
+            s = s_lo if e == 0 else s_hi
+            gap = g[6] if e == 0 else g[7]
+            h = g[8] if e == 0 else g[9]
+            px = ox + s * tx + h * nx
+            py = oy + s * ty + h * ny
+            fn_elastic = -knp * gap
+            dvx = (vel[b, 0] - vel[b, 2] * (py - pos[b, 1])) - (vel[a, 0] - vel[a, 2] * (py - pos[a, 1]))
+            dvy = (vel[b, 1] + vel[b, 2] * (px - pos[b, 0])) - (vel[a, 1] + vel[a, 2] * (px - pos[a, 0]))
+            opening_rate = dvx * nx + dvy * ny
+            if wake_speed > 0.0 and (not active[a] or not active[b]):
+                # wake on a fast partner, or on a loaded end losing compression (the sleeper's support goes)
+                losing = normal[f, e] > 0.0 and fn_elastic < 0.5 * normal[f, e]
+                sleeper = a if not active[a] else b
+                if not driven[sleeper] and (losing or np.hypot(dvx, dvy) > wake_speed):
+                    active[sleeper] = 1
+                    calm[sleeper] = 0
+            ft = shear[f, e]
+            if bonded[f, e] and fn_elastic < -ten and update_history:
+                bonded[f, e] = 0
+                acc[DISSIPATED_FRICTION] += 0.5 * fn_elastic * fn_elastic / knp
+            if not bonded[f, e] and fn_elastic <= 0.0:  # open dry end: no force at all
+                if update_history:
+                    acc[DISSIPATED_FRICTION] += 0.5 * ft * ft / ktp
+                    shear[f, e] = 0.0
+                normal[f, e] = 0.0
+                energy[f, e] = 0.0
+                continue
+            fn = fn_elastic - dashpot * opening_rate
+            if not bonded[f, e] and fn < 0.0:
+                fn = 0.0
+            if update_history:
+                acc[DISSIPATED_DAMPING] -= (fn - fn_elastic) * opening_rate * dt
+                slip = (dvx * tx + dvy * ty) * dt
+                trial = ft - ktp * slip
+                cap = mu * max(fn, 0.0) + (coh if bonded[f, e] else 0.0)
+                if abs(trial) > cap:
+                    if bonded[f, e]:  # brittle: the bond is lost at the first violation
+                        bonded[f, e] = 0
+                        if fn < 0.0:
+                            acc[DISSIPATED_FRICTION] += 0.5 * fn_elastic * fn_elastic / knp
+                            fn = 0.0
+                            fn_elastic = 0.0
+                        cap = mu * fn
+                    limited = cap if trial > 0.0 else -cap
+                    # friction work on the plastic part of the slip increment
+                    acc[DISSIPATED_FRICTION] += cap * (abs(trial) - cap) / ktp
+                    ft = limited
+                else:
+                    ft = trial
+                shear[f, e] = ft
+            spring = 0.5 * fn_elastic * fn_elastic / knp + 0.5 * ft * ft / ktp
+            stored += spring
+            if update_history:
+                energy[f, e] = spring
+            normal[f, e] = fn
+            fx = fn * nx + ft * tx
+            fy = fn * ny + ft * ty
+            force[b, 0] += fx
+            force[b, 1] += fy
+            force[b, 2] += (px - pos[b, 0]) * fy - (py - pos[b, 1]) * fx
+            force[a, 0] -= fx
+            force[a, 1] -= fy
+            force[a, 2] -= (px - pos[a, 0]) * fy - (py - pos[a, 1]) * fx
+    return stored
+
+
+@jit
+def settlement_rate(time, rate, ramp_time, start_time):
+    """Smooth velocity ramp (half cosine over ``ramp_time``) from ``start_time`` on."""
+    if rate == 0.0 or time <= start_time:
+        return 0.0
+    tau = time - start_time
+    if tau >= ramp_time:
+        return rate
+    return rate * 0.5 * (1.0 - np.cos(np.pi * tau / ramp_time))
+
+
+@jit
+def advance(n_steps, dt, pos, vel, pos0, pos_detect, radius, lx, ly, offs, faces, props, kn, kt,
+            min_half, contact_damping, inv_mass, shear, bonded, normal, energy, mass, free, driven, moving,
+            direction, load, load_ramp, damping, rate, ramp_time, start_time, target, half_buffer,
+            active, calm, sleep_speed, sleep_steps, acc, out):
+    """Up to ``n_steps`` explicit central-difference steps.
+
+    Local non-viscous damping (Cundall): each free component of the unbalanced
+    force is reduced by ``damping * |F|`` against its velocity. Driven blocks
+    (supports) follow ``pos0 + settlement * direction``. The loads grow with a smooth
+    ramp over ``load_ramp`` from time 0 (applied at once if 0). Stops early when some
+    block has moved more than ``half_buffer`` since the last detection (the pair
+    list must be rebuilt) or the settlement reached ``target``.
+
+    Sleeping (``sleep_speed`` > 0, settlement phase only), as rigid-body engines do: a
+    free block slower than ``sleep_speed`` (centroid speed plus spin times radius) for
+    ``sleep_steps`` steps in a row stops being integrated until a contact wakes it
+    (see :func:`contact_forces`); moving supports are active while they move.
+
+    ``out`` receives: steps done, rebuild needed (0/1), reaction on the moving
+    supports (upward force on the wall), kinetic energy, stored energy,
+    unbalanced-force ratio. Returns nothing; ``acc`` carries the accumulators.
+    """
+    n_block = pos.shape[0]
+    force = np.zeros((n_block, 3))
+    vx = np.empty(lx.size)
+    vy = np.empty(lx.size)
+    steps = 0
+    rebuild = 0
+    load_norm = 0.0
+    for i in range(n_block):
+        load_norm += abs(load[i, 0]) + abs(load[i, 1])
+    for step in range(n_steps):
+        force[:, :] = 0.0
+        place_vertices(pos, lx, ly, offs, vx, vy)
+        time = acc[TIME]
+        rate_now = settlement_rate(time + 0.5 * dt, rate, ramp_time, start_time)
+        sleeping = sleep_speed > 0.0 and rate_now > 0.0
+        for i in range(n_block):
+            if driven[i]:
+                active[i] = 1 if (moving[i] and rate_now != 0.0) else 0
+        stored = contact_forces(pos, vel, vx, vy, offs, faces, props, kn, kt, min_half, contact_damping,
+                                inv_mass, dt, shear, bonded, normal, energy, force, acc, True, active,
+                                driven, calm, sleep_speed if sleeping else 0.0)
+        load_share = 1.0
+        if time < load_ramp:
+            load_share = 0.5 * (1.0 - np.cos(np.pi * time / load_ramp))
+        for i in range(n_block):
+            if driven[i]:
+                for d in range(3):
+                    v = rate_now * direction[i, d]
+                    acc[WORK_SUPPORT] -= force[i, d] * v * dt
+                    vel[i, d] = v
+                continue
+            if not active[i]:
+                continue
+            for d in range(3):
+                if not free[i, d]:
+                    vel[i, d] = 0.0
+                    continue
+                f = force[i, d] + load_share * load[i, d]
+                v_old = vel[i, d]
+                damp = 0.0
+                if v_old > 0.0:
+                    damp = -damping * abs(f)
+                elif v_old < 0.0:
+                    damp = damping * abs(f)
+                v_new = v_old + dt * (f + damp) / mass[i, d]
+                vel[i, d] = v_new
+                acc[WORK_GRAVITY] += load_share * load[i, d] * v_new * dt
+                acc[DISSIPATED_DAMPING] -= damp * v_new * dt
+        acc[SETTLEMENT] += rate_now * dt
+        for i in range(n_block):
+            if driven[i]:
+                for d in range(3):
+                    pos[i, d] = pos0[i, d] + acc[SETTLEMENT] * direction[i, d]
+            elif active[i]:
+                for d in range(3):
+                    pos[i, d] += dt * vel[i, d]
+                if sleeping:
+                    speed = np.hypot(vel[i, 0], vel[i, 1]) + abs(vel[i, 2]) * radius[i]
+                    calm[i] = calm[i] + 1 if speed < sleep_speed else 0
+                    if calm[i] >= sleep_steps:
+                        active[i] = 0
+                        vel[i, 0] = vel[i, 1] = vel[i, 2] = 0.0
+        acc[TIME] = time + dt
+        steps += 1
+        moved = 0.0
+        for i in range(n_block):
+            m = np.hypot(pos[i, 0] - pos_detect[i, 0], pos[i, 1] - pos_detect[i, 1]) \
+                + abs(pos[i, 2] - pos_detect[i, 2]) * radius[i]
+            moved = max(moved, m)
+        if moved > half_buffer:
+            rebuild = 1
+            break
+        if target > 0.0 and acc[SETTLEMENT] >= target:
+            break
+    # state at the end of the chunk (forces at the current positions, history untouched)
+    force[:, :] = 0.0
+    place_vertices(pos, lx, ly, offs, vx, vy)
+    stored = contact_forces(pos, vel, vx, vy, offs, faces, props, kn, kt, min_half, contact_damping,
+                            inv_mass, dt, shear, bonded, normal, energy, force, acc, False, active,
+                            driven, calm, 0.0)
+    reaction = 0.0
+    kinetic = 0.0
+    unbalanced = 0.0
+    for i in range(n_block):
+        if moving[i]:
+            reaction -= force[i, 1]
+        if not driven[i]:
+            for d in range(3):
+                if free[i, d]:
+                    kinetic += 0.5 * mass[i, d] * vel[i, d] * vel[i, d]
+                    if d < 2:
+                        unbalanced += abs(force[i, d] + load[i, d])
+    out[0] = steps
+    out[1] = rebuild
+    out[2] = reaction
+    out[3] = kinetic
+    out[4] = stored
+    out[5] = unbalanced / load_norm if load_norm > 0.0 else 0.0
+
+
+@jit
+def face_frames(pos, lx, ly, offs, faces):
+    """(face, 11) :func:`face_geometry` of every face pair (for post-processing)."""
+    vx = np.empty(lx.size)
+    vy = np.empty(lx.size)
+    place_vertices(pos, lx, ly, offs, vx, vy)
+    out = np.empty((faces.shape[0], 11))
+    for f in range(faces.shape[0]):
+        g = face_geometry(vx, vy, offs, faces[f, 0], faces[f, 1], faces[f, 2], faces[f, 3])
+        for j in range(11):
+            out[f, j] = g[j]
+    return out

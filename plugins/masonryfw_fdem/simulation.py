@@ -1,0 +1,257 @@
+"""The time loop: gravity until rest, then the settlement ramp, in numba chunks.
+
+Python only decides between chunks: rebuilds the face-pair list when the
+kernel asks for it, records the history, checks the rest and plateau criteria,
+reports progress. A KeyboardInterrupt between or inside chunks ends the run
+with the state reached so far (``interrupted``).
+"""
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass, field
+
+import numpy as np
+
+import masonryfw as mf
+
+from . import kernels
+from .scene import Scene, face_properties
+
+LOG = logging.getLogger("masonryfw.fdem")
+GRAVITY_PHASE, SETTLEMENT_PHASE = 0, 1
+# Kinetic energy (in units of the wall's weight times the model size) no run can reach by falling:
+# the whole wall falling a thousand times its own size. Beyond it the integration has blown up.
+UNSTABLE_KINETIC_ENERGY = 1e3
+GRAVITY_TIME_LIMIT = 20.0  # scaled time units (sqrt(length / g)) for the gravity phase to come to rest
+
+
+@dataclass(frozen=True)
+class Controls:
+    """Non-dimensional run parameters (resolved from the options by the solver)."""
+
+    kn: float  # normal stiffness per unit contact length
+    kt: float
+    min_half: float  # half the shortest overlap that is a contact
+    contact_damping: float
+    dt: float
+    dt_critical: float
+    damping: float
+    target: float  # settlement to reach (0: no settlement phase)
+    rate: float  # settlement velocity
+    ramp_time: float
+    load_ramp: float  # duration of the smooth load ramp at the start
+    gravity_time: float  # fixed duration of the gravity phase, 0: until at rest
+    rest_tolerance: float
+    max_steps: int
+    record_steps: int
+    buffer: float
+    max_penetration: float
+    min_cos: float
+    sleep_speed: float  # 0: no sleeping
+    sleep_steps: int
+    plateau_tolerance: float
+    plateau_window: float
+    snapshots: tuple[float, ...]
+
+
+@dataclass
+class History:
+    """One row per recorded chunk."""
+
+    rows: list = field(default_factory=list)
+    snapshots: list = field(default_factory=list)  # (settlement, positions)
+
+    COLUMNS = ("phase", "time", "settlement", "reaction", "kinetic", "stored", "work_gravity",
+               "work_support", "dissipated_damping", "dissipated_friction", "released", "unbalanced")
+
+    def add(self, phase: int, acc: np.ndarray, out: np.ndarray) -> None:
+        self.rows.append((
+            phase, acc[kernels.TIME], acc[kernels.SETTLEMENT], out[2], out[3], out[4],
+            acc[kernels.WORK_GRAVITY], acc[kernels.WORK_SUPPORT],
+            acc[kernels.DISSIPATED_DAMPING], acc[kernels.DISSIPATED_FRICTION], acc[kernels.RELEASED], out[5],
+        ))
+
+    def table(self) -> dict[str, np.ndarray]:
+        data = np.asarray(self.rows, dtype=float).reshape(-1, len(self.COLUMNS))
+        return {name: data[:, i] for i, name in enumerate(self.COLUMNS)}
+
+
+@dataclass
+class State:
+    pos: np.ndarray
+    vel: np.ndarray
+    pos_detect: np.ndarray
+    faces: np.ndarray
+    props: np.ndarray
+    shear: np.ndarray
+    bonded: np.ndarray
+    normal: np.ndarray
+    energy: np.ndarray
+    acc: np.ndarray
+    active: np.ndarray  # (block,) 1 while integrated (free blocks not asleep)
+    calm: np.ndarray  # (block,) consecutive slow steps
+    steps: int = 0
+    rebuilds: int = 0
+    gravity_steps: int = 0
+    settlement_start: float = 0.0
+    stop_reason: str = ""
+    interrupted: bool = False
+
+
+def detect(scene: Scene, controls: Controls, state: State | None, pos: np.ndarray):
+    """Face pairs at ``pos`` with their properties; contact history carried from ``state``
+    (the spring energy of pairs the rebuild drops is added to the released energy)."""
+    faces = kernels.detect_face_pairs(pos, scene.lx, scene.ly, scene.offs, scene.driven,
+                                      controls.buffer, controls.max_penetration, controls.min_cos)
+    props, bonded_start = face_properties(scene, faces)
+    shear = np.zeros((faces.shape[0], 2))
+    energy = np.zeros((faces.shape[0], 2))
+    if state is None:
+        bonded = np.repeat(bonded_start[:, None], 2, axis=1).astype(np.int64)
+    else:
+        bonded = np.zeros((faces.shape[0], 2), dtype=np.int64)
+        n_node = scene.lx.size
+        state.acc[kernels.RELEASED] += kernels.carry_history(
+            kernels.face_keys(state.faces, n_node), state.shear, state.bonded, state.energy,
+            kernels.face_keys(faces, n_node), shear, bonded, energy)
+    return faces, props, shear, bonded, energy
+
+
+def initial_state(scene: Scene, controls: Controls) -> State:
+    pos = scene.pos0.copy()
+    faces, props, shear, bonded, energy = detect(scene, controls, None, pos)
+    return State(pos=pos, vel=np.zeros_like(pos), pos_detect=pos.copy(), faces=faces, props=props,
+                 shear=shear, bonded=bonded, normal=np.zeros((faces.shape[0], 2)), energy=energy,
+                 acc=np.zeros(kernels.N_ACC), active=(~scene.driven).astype(np.int64),
+                 calm=np.zeros(scene.driven.size, dtype=np.int64))
+
+
+def rebuild(scene: Scene, controls: Controls, state: State) -> None:
+    state.faces, state.props, state.shear, state.bonded, state.energy = detect(scene, controls, state, state.pos)
+    state.normal = np.zeros((state.faces.shape[0], 2))
+    state.pos_detect = state.pos.copy()
+    state.rebuilds += 1
+
+
+def advance(scene: Scene, controls: Controls, state: State, load: np.ndarray, n_steps: int, rate: float,
+            target: float, out: np.ndarray) -> None:
+    """One call of the numba stepping kernel (see :func:`.kernels.advance`)."""
+    kernels.advance(n_steps, controls.dt, state.pos, state.vel, scene.pos0, state.pos_detect, scene.radius,
+                    scene.lx, scene.ly, scene.offs, state.faces, state.props, controls.kn, controls.kt,
+                    controls.min_half, controls.contact_damping, scene.inv_mass, state.shear, state.bonded, state.normal,
+                    state.energy, scene.mass, scene.free, scene.driven, scene.moving, scene.direction, load,
+                    controls.load_ramp, controls.damping, rate, controls.ramp_time, state.settlement_start,
+                    target, 0.5 * controls.buffer, state.active, state.calm, controls.sleep_speed,
+                    controls.sleep_steps, state.acc, out)
+
+
+def chunk(scene: Scene, controls: Controls, state: State, load: np.ndarray, n_steps: int,
+          rate: float, target: float) -> np.ndarray:
+    """Run up to ``n_steps`` steps (rebuilding the pair list as needed); returns the kernel's ``out``."""
+    out = np.zeros(6)
+    left = n_steps
+    while True:
+        advance(scene, controls, state, load, left, rate, target, out)
+        if not out[3] < UNSTABLE_KINETIC_ENERGY:  # also catches nan
+            raise mf.SolveError(
+                f"fdem: the time integration blew up (kinetic energy {out[3]:.3g} W x length after "
+                f"{state.steps} steps, dt = {controls.dt:.3g} = {controls.dt / controls.dt_critical:.2f} dt_crit "
+                "in scaled units); lower the option dt_safety"
+            )
+        done = int(out[0])
+        state.steps += done
+        left -= done
+        if out[1]:
+            rebuild(scene, controls, state)
+        if not out[1] or left <= 0 or (target > 0 and state.acc[kernels.SETTLEMENT] >= target):
+            return out
+
+
+def gravity_phase(scene, controls, state, load, history, progress) -> None:
+    """Apply the loads with the supports still until the unbalanced-force ratio drops below
+    the rest tolerance (or for exactly ``gravity_time``)."""
+    if controls.gravity_time > 0:
+        total = int(np.ceil(controls.gravity_time / controls.dt))
+    else:  # a wall settles in a few sqrt(length / g); one that has not after 20 never will
+        total = min(controls.max_steps, int(np.ceil(GRAVITY_TIME_LIMIT / controls.dt)))
+    while state.gravity_steps < total:
+        n = min(controls.record_steps, total - state.gravity_steps)
+        before = state.steps
+        out = chunk(scene, controls, state, load, n, 0.0, 0.0)
+        state.gravity_steps += state.steps - before
+        history.add(GRAVITY_PHASE, state.acc, out)
+        ramped = state.acc[kernels.TIME] >= controls.load_ramp
+        if controls.gravity_time <= 0 and ramped and out[5] < controls.rest_tolerance:
+            state.stop_reason = "at rest"
+            break
+        progress(0.05 * min(1.0, state.gravity_steps / max(total, 1)),
+                 f"fdem: gravity, unbalanced force ratio {out[5]:.2e}")
+    else:
+        if controls.gravity_time <= 0:
+            raise mf.SolveError(
+                f"fdem: the wall did not come to rest under its loads within {state.gravity_steps} steps "
+                f"(unbalanced force ratio {history.rows[-1][-1]:.2e} > rest_tolerance "
+                f"{controls.rest_tolerance:g}): it is not stable as built, or the integration is "
+                "(lower dt_safety); set gravity_time to run a fixed time instead"
+            )
+        state.stop_reason = "gravity time reached"
+
+
+def plateau_reached(history: History, controls: Controls, reference: float) -> bool:
+    """The reaction varied less than ``plateau_tolerance * reference`` over the last
+    ``plateau_window * target`` of settlement (and that much settlement came after the ramp)."""
+    if controls.plateau_tolerance <= 0 or reference <= 0:
+        return False
+    rows = history.table()
+    in_settlement = rows["phase"] == SETTLEMENT_PHASE
+    settlement = rows["settlement"][in_settlement]
+    reaction = rows["reaction"][in_settlement]
+    if settlement.size < 3:
+        return False
+    window = controls.plateau_window * controls.target
+    ramp_settlement = 0.5 * controls.rate * controls.ramp_time
+    if settlement[-1] < window + ramp_settlement:
+        return False
+    recent = reaction[settlement >= settlement[-1] - window]
+    return float(np.ptp(recent)) <= controls.plateau_tolerance * reference
+
+
+def settlement_phase(scene, controls, state, load, history, progress) -> None:
+    state.settlement_start = float(state.acc[kernels.TIME])
+    reference = history.rows[-1][3] if history.rows else 0.0
+    pending = sorted(controls.snapshots)
+    while state.acc[kernels.SETTLEMENT] < controls.target:
+        if state.steps >= controls.max_steps:
+            state.stop_reason = "step limit"
+            LOG.warning("fdem: settlement phase hit the step limit (%d)", controls.max_steps)
+            return
+        out = chunk(scene, controls, state, load, controls.record_steps, controls.rate, controls.target)
+        history.add(SETTLEMENT_PHASE, state.acc, out)
+        settled = state.acc[kernels.SETTLEMENT]
+        while pending and settled >= pending[0]:
+            pending.pop(0)
+            history.snapshots.append((settled, state.pos.copy()))  # the first record past the request
+        progress(0.05 + 0.95 * min(1.0, settled / controls.target),
+                 f"fdem: settlement {settled / controls.target:.0%} of target, reaction {out[2]:.3g} W")
+        if plateau_reached(history, controls, reference):
+            state.stop_reason = "reaction plateau"
+            return
+    state.stop_reason = "target settlement"
+
+
+def run(scene: Scene, controls: Controls, load: np.ndarray, progress) -> tuple[State, History]:
+    """Gravity, then settlement; a KeyboardInterrupt returns what was computed (``interrupted``)."""
+    state = initial_state(scene, controls)
+    history = History()
+    try:
+        gravity_phase(scene, controls, state, load, history, progress)
+        if controls.target > 0 and scene.moving.any():
+            settlement_phase(scene, controls, state, load, history, progress)
+    except KeyboardInterrupt:
+        state.interrupted = True
+        state.stop_reason = "interrupted"
+        out = np.zeros(6)
+        advance(scene, controls, state, load, 0, 0.0, 0.0, out)  # evaluate the state reached
+        phase = SETTLEMENT_PHASE if state.settlement_start > 0 else GRAVITY_PHASE
+        history.add(phase, state.acc, out)
+    return state, history

@@ -1,0 +1,119 @@
+"""fdem as a plugin: result contents, equilibrium of the contact forces, interruption,
+snapshots, and bad input naming what is wrong."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import masonryfw as mf
+from masonryfw_fdem.scene import build_scene
+
+ROLE = mf.flags("block_role")
+RESULT_VARIABLES = (
+    "block_displacement", "interface_opening", "interface_slip", "interface_normal_force",
+    "interface_shear_force", "interface_state", "crack_indicator", "macro_block", "step_settlement",
+    "step_reaction", "step_kinetic_energy", "step_work_gravity", "step_work_support", "step_dissipated",
+    "step_stored",
+)
+
+
+def test_fdem_is_registered_with_its_options():
+    solver = mf.get_solver("fdem")
+    names = {o.name for o in solver.options}
+    assert {"mode", "settlement", "damping", "dt_safety", "loading_rate", "snapshots"} <= names
+
+
+def test_gravity_state_contact_forces_carry_the_weight(small_wall):
+    """At rest under gravity the support interfaces carry the whole weight (vertical equilibrium)."""
+    result = mf.solve(small_wall, "fdem", {"settlement_ratio": 0.0})
+    assert result.attrs["fdem_stop_reason"] == "at rest"
+    weight = -small_wall.dead_load.values[small_wall.block_role.values < 2, 1].sum()
+    sides = small_wall.interface_blocks.values
+    on_support = (small_wall.block_role.values[sides] >= ROLE["fixed_support"]).any(axis=1)
+    # the normal of a support interface points up or down; its normal force is vertical
+    vertical = np.abs(small_wall.interface_normal_y.values[on_support])
+    carried = (result.interface_normal_force.values[on_support].sum(axis=1) * vertical).sum()
+    assert carried == pytest.approx(weight, rel=1e-3)
+    assert np.all(result.interface_normal_force.values >= -1e-9 * weight)  # dry joints: no tension
+
+
+def test_result_holds_format_variables_and_run_attributes(small_wall):
+    result = mf.solve(small_wall, "fdem", {"snapshots": "0.001, 0.002"})
+    for name in RESULT_VARIABLES:
+        assert name in result, name
+    assert result.attrs["solver"] == "fdem"
+    assert result.attrs["fdem_dt_s"] < result.attrs["fdem_dt_critical_s"]
+    assert result.attrs["fdem_steps"] > result.attrs["fdem_gravity_steps"] > 0
+    assert result.attrs["fdem_interrupted"] == 0
+    np.testing.assert_allclose(result.snapshot_settlement.values, [0.001, 0.002], atol=5e-5)
+    moving = small_wall.block_role.values == ROLE["moving_support"]
+    np.testing.assert_allclose(result.snapshot_block_displacement.values[:, moving, 1].ravel(),
+                               -result.snapshot_settlement.values, rtol=1e-12)
+    # the moving support went down by the last recorded settlement
+    assert result.block_displacement.values[moving, 1] == pytest.approx(-result.step_settlement.values[-1])
+
+
+def test_keyboard_interrupt_returns_the_state_reached(small_wall):
+    calls = []
+
+    def impatient(fraction, message):
+        calls.append(fraction)
+        if "settlement" in message and fraction > 0.3:
+            raise KeyboardInterrupt
+
+    result = mf.solve(small_wall, "fdem", {"plateau_tolerance": 0.0}, impatient)
+    assert result.attrs["fdem_interrupted"] == 1
+    assert result.attrs["fdem_stop_reason"] == "interrupted"
+    settled = result.step_settlement.values[-1]
+    assert 0 < settled < result.attrs["fdem_target_settlement"]
+    moving = small_wall.block_role.values == ROLE["moving_support"]
+    assert result.block_displacement.values[moving, 1] == pytest.approx(-settled)
+    assert mf.check(result) == []
+
+
+@pytest.mark.parametrize("options, named", [
+    ({"damping": 1.5}, "damping"),
+    ({"dt_safety": 0.0}, "dt_safety"),
+    ({"mode": "deformable"}, "mode"),
+    ({"snapshots": "1mm"}, "snapshots"),
+])
+def test_bad_options_name_the_option(small_wall, options, named):
+    with pytest.raises(mf.PluginError, match=named):
+        mf.solve(small_wall, "fdem", options)
+
+
+def test_non_convex_block_is_named(small_wall):
+    model = small_wall.copy()
+    x = model.node_x.values.copy()
+    y = model.node_y.values.copy()
+    # block 0 is the rectangle of nodes 0..3; pull its top-right corner inside: a dart (concave)
+    x[2], y[2] = 0.05, 0.01
+    model["node_x"], model["node_y"] = ("node", x, model.node_x.attrs), ("node", y, model.node_y.attrs)
+    model = mf.derive_geometry(model.drop_vars(list(mf.DERIVED_GEOMETRY_VARIABLES), errors="ignore"))
+    with pytest.raises(mf.ModelError, match=r"block\(s\) 0: not convex"):
+        build_scene(model)
+
+
+def test_weightless_masonry_block_is_named(small_wall):
+    weight = small_wall.block_unit_weight.values.copy()
+    weight[3] = 0.0
+    model = small_wall.assign(block_unit_weight=("block", weight, small_wall.block_unit_weight.attrs))
+    with pytest.raises(mf.ModelError, match=r"block\(s\) 3:"):
+        build_scene(model)
+
+
+def test_sleeping_blocks_keep_the_crack_pattern(small_wall):
+    """Sleeping (off by default) freezes the blocks at rest on the fixed side; the mechanism must not change."""
+    awake = mf.solve(small_wall, "fdem", {})
+    sleeping = mf.solve(small_wall, "fdem", {"sleep": 0.05})
+    assert sleeping.attrs["fdem_asleep_blocks"] >= 1
+    scores = mf.compare(awake, sleeping)
+    assert scores.crack_f1.item() >= 0.9
+    assert sleeping.step_reaction.values[-1] == pytest.approx(awake.step_reaction.values[-1], rel=0.1)
+
+
+def test_wall_that_never_comes_to_rest_is_an_error(walls):
+    """A block on a 40 deg incline steeper than its 30 deg friction angle keeps sliding: no rest state."""
+    model = walls.gravity_rotated(mf.build(walls.single_block_spec(0.4, 0.2, 30.0)), 40.0)
+    with pytest.raises(mf.SolveError, match="did not come to rest"):
+        mf.solve(model, "fdem", {})
