@@ -10,7 +10,10 @@
    lowest and final reaction over R0, and the crack pattern against the default run
    (crack F1, macro-block ARI of the ``compare`` plugin).
 
-Run: ``python benchmarks/bench_fdem.py`` (a few minutes).
+4. The deformable mode: element-steps per second of the CST update (the kernel alone and the
+   whole explicit step), and Test 12C in both modes.
+
+Run: ``python benchmarks/bench_fdem.py`` (a few minutes); ``--deformable`` for part 4 only.
 """
 from __future__ import annotations
 
@@ -122,11 +125,128 @@ def main() -> None:
         "### Sleeping blocks at rest\n\n" + "\n".join(sleeping) + "\n\n"
         "### Run time against error (Test 12C, 12 mm, no plateau stop; one option changed at a time)\n\n"
         + "\n".join(sweep) + "\n\n"
-        "Not measured: the deformable (CST) mode is not implemented (see docs/fdem.md).\n"
+        "The deformable (CST) mode: see the next section.\n"
     )
     write_section("fdem", "fdem: rigid-block explicit DEM", body)
+    print(body)
+    deformable_main()
+
+
+def grid_mesh(columns: int, rows: int):
+    """A structured mesh of the unit square, every cell split into two triangles (a plain CST mesh
+    of ``2 columns rows`` elements, node order row-major)."""
+    import numpy as np
+
+    from masonryfw_fdem.deformable import shape_gradients
+
+    x, y = np.meshgrid(np.linspace(0, 1, columns + 1), np.linspace(0, 1, rows + 1))
+    node = np.arange(x.size).reshape(rows + 1, columns + 1)
+    a, b, c, d = node[:-1, :-1].ravel(), node[:-1, 1:].ravel(), node[1:, 1:].ravel(), node[1:, :-1].ravel()
+    triangles = np.concatenate((np.stack((a, b, c), 1), np.stack((a, c, d), 1))).astype(np.int64)
+    order = np.argsort(triangles[:, 0], kind="stable")  # neighbouring elements share cached nodes
+    triangles = triangles[order]
+    grad_x, grad_y, area = shape_gradients(x.ravel(), y.ravel(), triangles)
+    return x.ravel(), y.ravel(), triangles, grad_x, grad_y, area
+
+
+def cst_rows(repeats: int = 5) -> list[str]:
+    """Element-steps per second of the CST internal-force kernel alone, and of the whole
+    deformable step (forces + central-difference update of the nodes, no contacts)."""
+    import numpy as np
+
+    from masonryfw_fdem import deformable
+
+    rows = []
+    for columns in (16, 300):
+        x0, y0, triangles, grad_x, grad_y, area = grid_mesh(columns, columns)
+        n_tri, n_node = triangles.shape[0], x0.size
+        young, nu, on = np.full(n_tri, 100.0), np.full(n_tri, 0.2), np.ones(n_tri, np.bool_)
+        rng = np.random.default_rng(0)
+        x, y = x0 + 1e-4 * rng.normal(size=n_node), y0 + 1e-4 * rng.normal(size=n_node)
+        force = np.zeros((n_node, 2))
+        steps = max(1, int(2e7 // n_tri))
+        deformable.cst_forces(x, y, triangles, grad_x, grad_y, area, young, nu, on, force)  # compile
+        kernel = []
+        for _ in range(repeats):
+            clock = time.perf_counter()
+            for _ in range(steps):
+                deformable.cst_forces(x, y, triangles, grad_x, grad_y, area, young, nu, on, force)
+            kernel.append(time.perf_counter() - clock)
+        kernel_rate = n_tri * steps / float(np.median(kernel))
+        # the full step: mesh only (no contacts, no supports), damping on, gravity
+        mass = np.bincount(triangles.ravel(), weights=np.repeat(area / 3, 3), minlength=n_node)
+        node_block = np.zeros(n_node, np.int64)
+        no_faces, face_rows = np.zeros((0, 4), np.int64), np.zeros((0, 2))
+        load = np.zeros((n_node, 2))
+        load[:, 1] = -mass
+        full = []
+        for _ in range(repeats):
+            vel = np.zeros((n_node, 2))
+            xs, ys = x.copy(), y.copy()
+            acc, out = np.zeros(7), np.zeros(6)
+            args = (1e-4, xs, ys, vel, x0, y0, x0.copy(), y0.copy(), np.array([0, 0]), node_block, triangles,
+                    grad_x, grad_y, area, young, nu, on, mass, 1 / mass, np.zeros(n_node, np.bool_),
+                    np.zeros(1, np.bool_), np.zeros((1, 3)), np.zeros((1, 3)), no_faces, np.zeros((0, 4)),
+                    1.0, 0.5, 0.0, 0.2, face_rows, face_rows.astype(np.int64), face_rows.copy(),
+                    face_rows.copy(), load, 0.0, 0.7, 0.0, 1.0, 0.0, 0.0, 1e300, acc, out)
+            deformable.advance(1, *args)  # compile
+            clock = time.perf_counter()
+            deformable.advance(steps, *args)
+            full.append(time.perf_counter() - clock)
+        full_rate = n_tri * steps / float(np.median(full))
+        rows.append(f"| {n_tri} | {n_node} | {steps} | {kernel_rate / 1e6:.0f} | {full_rate / 1e6:.0f} |")
+        print(rows[-1], flush=True)
+    return rows
+
+
+def mode_rows(case: str) -> list[str]:
+    """The same wall in both modes (paper E and nu), defaults otherwise."""
+    model = mf.open_model(case)
+    r0 = dead_reaction(model)
+    rigid, rigid_time = timed(model, {})
+    rows = []
+    for mode in ("rigid", "deformable"):
+        result, seconds = (rigid, rigid_time) if mode == "rigid" else timed(model, {"mode": mode})
+        phase = result.step_phase.values == 1
+        scores = mf.compare(rigid, result)
+        rows.append(
+            f"| {case} | {mode} | {result.attrs['fdem_steps']} | {result.attrs['fdem_dt_s']:.2e} | {seconds:.1f} | "
+            f"{result.attrs['fdem_stop_reason']} | {result.step_reaction.values[phase].min() / r0:.3f} | "
+            f"{result.step_reaction.values[-1] / r0:.3f} | {scores.crack_f1.item():.2f} | "
+            f"{scores.macro_block_ari.item():.2f} | {abs(result.step_energy_error.values).max():.1e} |")
+        print(rows[-1], flush=True)
+    return rows
+
+
+def deformable_main() -> None:
+    mf.solve(mf.open_model("test-8c"), "fdem", {"settlement": 1e-4, "mode": "deformable"})  # compile / cache
+    kernel = [
+        "| elements | nodes | steps | M element-steps / s, CST forces only | M element-steps / s, whole step |",
+        "|---|---|---|---|---|",
+        *cst_rows(),
+    ]
+    modes = [
+        "| case | mode | steps | dt [s] | wall time [s] | stop | R min / R0 | R end / R0 | crack F1 vs rigid | "
+        "ARI vs rigid | max energy error |",
+        "|---|---|---|---|---|---|---|---|---|---|---|",
+        *mode_rows("test-12c"),
+    ]
+    body = (
+        "`mode=deformable`: every block a fan of constant-strain triangles (Green-Lagrange strain, "
+        "plane stress), the rigid mode's joints on the boundary nodes. Serial numba, one core, "
+        "compile time excluded.\n\n"
+        "### CST update throughput (structured mesh of the unit square, no contacts)\n\n"
+        + "\n".join(kernel) + "\n\n"
+        "The issue's target is >= 60 M element-steps / s per core.\n\n"
+        "### Rigid against deformable on a paper wall (E = 1.14 GPa, nu = 0.2 from the model)\n\n"
+        + "\n".join(modes) + "\n"
+    )
+    write_section("fdem-deformable", "fdem: deformable (CST) mode", body)
     print(body)
 
 
 if __name__ == "__main__":
-    main()
+    if "--deformable" in sys.argv:
+        deformable_main()
+    else:
+        main()

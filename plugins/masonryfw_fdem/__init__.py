@@ -1,8 +1,9 @@
-"""``fdem``: explicit rigid-block discrete elements under an imposed settlement (paper section 2.2).
+"""``fdem``: explicit discrete elements (rigid or CST-meshed blocks) under an imposed settlement (paper section 2.2).
 
 Registration only (numba is imported when a solve starts); the method lives in :mod:`.scene` (model -> non-dimensional
 arrays), :mod:`.kernels` (numba: contact detection, contact forces, time
 stepping), :mod:`.simulation` (the gravity and settlement phases),
+:mod:`.deformable` and :mod:`.deformable_simulation` (the CST mode),
 :mod:`.postprocess` and :mod:`.solver`. See docs/fdem.md.
 """
 from __future__ import annotations
@@ -19,7 +20,7 @@ def masonryfw_solvers():
     return [
         mf.Solver(
             name="fdem",
-            summary="explicit discrete elements: rigid blocks, penalty Coulomb contacts, support "
+            summary="explicit discrete elements: rigid or CST-meshed blocks, penalty Coulomb contacts, support "
             "moved slowly down; reaction history, final mechanism, energy balance",
             solve=mf.lazy("masonryfw_fdem.solver:solve"),
             version=__version__,

@@ -6,8 +6,9 @@ import masonryfw as mf
 OPTIONS = (
     mf.Option("mode", str, "rigid",
               "rigid: every block a rigid body with 3 DOF (the paper's units have a very high E, "
-              "so only the joints deform). The deformable (CST) mode is not implemented yet.",
-              ("rigid",)),
+              "so only the joints deform); deformable: every block a fan of constant-strain triangles "
+              "(plane stress, block_young_modulus / block_poisson_ratio), the same joints",
+              ("rigid", "deformable")),
     mf.Option("settlement", float, 0.0,
               "target settlement of the moving support [m] along settlement_direction; "
               "0 = settlement_ratio x masonry height"),

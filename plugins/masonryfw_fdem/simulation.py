@@ -151,7 +151,11 @@ def chunk(scene: Scene, controls: Controls, state: State, load: np.ndarray, n_st
     out = np.zeros(6)
     left = n_steps
     while True:
-        advance(scene, controls, state, load, left, rate, target, out)
+        nodal = hasattr(state, "advance_chunk")  # deformable mode: the state steps its own nodes
+        if nodal:
+            state.advance_chunk(scene, controls, left, rate, target, out)
+        else:
+            advance(scene, controls, state, load, left, rate, target, out)
         if not out[3] < UNSTABLE_KINETIC_ENERGY:  # also catches nan
             raise mf.SolveError(
                 f"fdem: the time integration blew up (kinetic energy {out[3]:.3g} W x length after "
@@ -162,7 +166,10 @@ def chunk(scene: Scene, controls: Controls, state: State, load: np.ndarray, n_st
         state.steps += done
         left -= done
         if out[1]:
-            rebuild(scene, controls, state)
+            if nodal:
+                state.rebuild_pairs(scene, controls)
+            else:
+                rebuild(scene, controls, state)
         if not out[1] or left <= 0 or (target > 0 and state.acc[kernels.SETTLEMENT] >= target):
             return out
 

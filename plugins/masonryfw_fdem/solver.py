@@ -107,13 +107,23 @@ def solve(model: xr.Dataset, options: Mapping[str, Any], progress=mf.no_progress
     clock = time.perf_counter()
     scene = build_scene(model)
     controls = make_controls(scene, options)
+    load = scene.dead + options["load_factor"] * scene.live
+    deformable_mode = options["mode"] == "deformable"
+    if deformable_mode:
+        from . import deformable, deformable_simulation
+
+        deformable.check_supported(scene)
+        mesh = deformable.build_mesh(model, scene)
+        controls = deformable_simulation.deformable_controls(mesh, scene, controls, options["dt_safety"])
     LOG.info("fdem: dt = %.4g s (dt_crit = %.4g s, safety %.2g), kn = %.4g N/m2",
              controls.dt * scene.scales.time, controls.dt_critical * scene.scales.time,
              options["dt_safety"], controls.kn * scene.scales.force / scene.scales.length**2)
-    load = scene.dead + options["load_factor"] * scene.live
     progress(0.0, f"fdem: dt = {controls.dt * scene.scales.time:.3g} s "
                   f"(dt_crit = {controls.dt_critical * scene.scales.time:.3g} s)")
-    state, history = run(scene, controls, load, progress)
+    if deformable_mode:
+        state, history = deformable_simulation.run(scene, controls, mesh, load, progress)
+    else:
+        state, history = run(scene, controls, load, progress)
     result = result_dataset(model, scene, controls, state, history, options)
     result.attrs.update(
         fdem_mode=options["mode"],
@@ -166,7 +176,7 @@ def history_variables(scene: Scene, history: History) -> dict:
                                         "energy dissipated by friction and broken bonds"),
         "step_released": var(rows["released"] * energy, "J",
                              "spring energy lost when two faces slid apart while in contact (numerical)"),
-        "step_stored": var(stored, "J", "elastic energy stored in the contact springs"),
+        "step_stored": var(stored, "J", "elastic energy stored in the contact springs (and the blocks' strain in mode=deformable)"),
         "step_energy_error": var(error, "1", "(work in - kinetic - dissipated - stored) / largest work so far"),
         "step_unbalanced_ratio": var(rows["unbalanced"], "1", "unbalanced force / applied load"),
     }

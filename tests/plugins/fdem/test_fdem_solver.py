@@ -74,7 +74,7 @@ def test_keyboard_interrupt_returns_the_state_reached(small_wall):
 @pytest.mark.parametrize("options, named", [
     ({"damping": 1.5}, "damping"),
     ({"dt_safety": 0.0}, "dt_safety"),
-    ({"mode": "deformable"}, "mode"),
+    ({"mode": "elastic"}, "mode"),
     ({"snapshots": "1mm"}, "snapshots"),
 ])
 def test_bad_options_name_the_option(small_wall, options, named):

@@ -1,0 +1,423 @@
+"""The ``deformable`` mode: every block a fan of constant-strain triangles (CST), joints as in
+the rigid mode.
+
+Mesh: each convex block is split into a fan of triangles from an extra node at its centroid,
+so its boundary nodes are exactly the model's polygon nodes (same indices as
+``Scene.lx``), and the rigid mode's face-pair detection and contact law apply unchanged to
+the current boundary. Nodes ``0 .. n_polygon_node - 1`` are the polygon nodes, followed by one
+centroid node per block.
+
+Elements: plane stress, total Lagrangian with the Green-Lagrange strain and a Saint
+Venant-Kirchhoff law (``S = D E``), so that rigid rotations of a block (rocking) carry no
+spurious strain; for small displacements this is the linear CST, ``f = -t A B^T D B u``.
+Masses are lumped (a third of each triangle's mass at each of its nodes; the mass-weighted
+mean of the nodes is then the polygon's centroid exactly).
+
+Non-dimensional units as in :mod:`.scene`; the elastic constant of a block becomes
+``E t length / W`` (force per unit non-dimensional strain and length).
+Contact forces act at points of the current boundary edges and are shared between an edge's
+two nodes by linear interpolation (velocities are interpolated the same way).
+Support blocks stay rigid: their nodes follow ``pos0 + settlement * direction`` (finite rotation).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numba import njit
+
+import masonryfw as mf
+
+from .kernels import DISSIPATED_DAMPING, DISSIPATED_FRICTION, RELEASED, SETTLEMENT, TIME, WORK_GRAVITY, \
+    WORK_SUPPORT, face_geometry, settlement_rate
+from .scene import Scene, name_list
+
+jit = njit(cache=True, error_model="numpy")
+# the element loop has no nan/inf logic: fastmath (fused multiply-adds) makes it ~25 % faster
+fast_jit = njit(cache=True, error_model="numpy", fastmath=True)
+
+
+@dataclass
+class Mesh:
+    """Flat non-dimensional arrays of the triangulated blocks."""
+
+    x0: np.ndarray  # (node,) reference coordinates
+    y0: np.ndarray
+    node_block: np.ndarray  # (node,) owning block
+    triangles: np.ndarray  # (tri, 3) node indices, counter-clockwise
+    grad_x: np.ndarray  # (tri, 3) dN_i/dX in the reference configuration
+    grad_y: np.ndarray  # (tri, 3) dN_i/dY
+    area0: np.ndarray  # (tri,) reference area
+    young: np.ndarray  # (tri,) E t length / W
+    poisson: np.ndarray  # (tri,)
+    mass: np.ndarray  # (node,) lumped
+    inv_mass: np.ndarray  # (node,) 0 on driven nodes
+    driven: np.ndarray  # (node,) bool: node of a support block
+    active_tri: np.ndarray  # (tri,) bool: element of a free block (support blocks are rigid)
+
+
+def fan_triangles(offs: np.ndarray) -> np.ndarray:
+    """(tri, 3): centroid node, polygon node k, next polygon node, for every edge of every block."""
+    n_poly = int(offs[-1])
+    counts = np.diff(offs)
+    block = np.repeat(np.arange(counts.size), counts)
+    k = np.arange(n_poly)
+    nxt = k + 1
+    nxt[offs[1:] - 1] = offs[:-1]
+    return np.stack((n_poly + block, k, nxt), axis=1).astype(np.int64)
+
+
+def shape_gradients(x: np.ndarray, y: np.ndarray, triangles: np.ndarray):
+    """Constant shape-function gradients (tri, 3) and signed areas (tri,) of linear triangles."""
+    px, py = x[triangles], y[triangles]
+    j, k = [1, 2, 0], [2, 0, 1]
+    area = 0.5 * ((px[:, 1] - px[:, 0]) * (py[:, 2] - py[:, 0]) - (px[:, 2] - px[:, 0]) * (py[:, 1] - py[:, 0]))
+    grad_x = (py[:, j] - py[:, k]) / (2.0 * area[:, None])
+    grad_y = (px[:, k] - px[:, j]) / (2.0 * area[:, None])
+    return grad_x, grad_y, area
+
+
+def elastic_constants(model, n_block: int) -> tuple[np.ndarray, np.ndarray]:
+    """``block_young_modulus`` and ``block_poisson_ratio`` [Pa, 1], checked."""
+    for name in ("block_young_modulus", "block_poisson_ratio"):
+        if name not in model:
+            raise mf.ModelError(f"{name}: missing; the fdem deformable mode needs the blocks' elastic constants "
+                                "(material young_modulus / poisson_ratio in the wall spec)")
+    young = model.block_young_modulus.values.astype(float)
+    nu = model.block_poisson_ratio.values.astype(float)
+    bad = np.flatnonzero(~(young > 0))
+    if bad.size:
+        raise mf.ModelError(f"block(s) {name_list(bad)}: block_young_modulus must be positive")
+    bad = np.flatnonzero(~((nu > -1.0) & (nu < 0.5)))
+    if bad.size:
+        raise mf.ModelError(f"block(s) {name_list(bad)}: block_poisson_ratio must be in (-1, 0.5)")
+    return np.broadcast_to(young, (n_block,)), np.broadcast_to(nu, (n_block,))
+
+
+def build_mesh(model, scene: Scene) -> Mesh:
+    """The fan mesh of every block of ``model`` (see the module docstring)."""
+    n_block = scene.driven.size
+    counts = np.diff(scene.offs)
+    owner = np.repeat(np.arange(n_block), counts)
+    x0 = np.concatenate((scene.pos0[owner, 0] + scene.lx, scene.pos0[:, 0]))
+    y0 = np.concatenate((scene.pos0[owner, 1] + scene.ly, scene.pos0[:, 1]))
+    node_block = np.concatenate((owner, np.arange(n_block)))
+    triangles = fan_triangles(scene.offs)
+    tri_block = node_block[triangles[:, 0]]
+    grad_x, grad_y, area0 = shape_gradients(x0, y0, triangles)
+    block_area = np.bincount(tri_block, weights=area0, minlength=n_block)
+    young, nu = elastic_constants(model, n_block)
+    thickness = model.block_thickness.values
+    young_scaled = young * thickness * scene.scales.length / scene.scales.force
+    mass_share = scene.mass[:, 0]
+    tri_mass = mass_share[tri_block] * area0 / block_area[tri_block]
+    mass = np.bincount(triangles.ravel(), weights=np.repeat(tri_mass / 3.0, 3), minlength=x0.size)
+    driven = scene.driven[node_block]
+    return Mesh(x0=x0, y0=y0, node_block=node_block, triangles=triangles, grad_x=grad_x, grad_y=grad_y,
+                area0=area0, young=young_scaled[tri_block], poisson=nu[tri_block], mass=mass,
+                inv_mass=np.where(driven, 0.0, 1.0 / mass), driven=driven,
+                active_tri=~scene.driven[tri_block])
+
+
+def check_supported(scene: Scene) -> None:
+    """The deformable mode moves nodes, not blocks: a held component of a free block, or a moment
+    load, has no nodal meaning here."""
+    held = np.flatnonzero(~scene.driven & ~scene.free.all(axis=1))
+    if held.size:
+        raise mf.ModelError(f"block(s) {name_list(held)}: block_fixed holds a component of a free block; "
+                            "the fdem deformable mode does not support it (make the block a support)")
+    moment = np.flatnonzero((scene.dead[:, 2] != 0) | (scene.live[:, 2] != 0))
+    if moment.size:
+        raise mf.ModelError(f"block(s) {name_list(moment)}: dead_load / live_load has a moment component; "
+                            "the fdem deformable mode takes only forces (applied in proportion to the nodal masses)")
+
+
+def nodal_load(mesh: Mesh, scene: Scene, load: np.ndarray) -> np.ndarray:
+    """(node, 2): each free block's force load shared among its nodes in proportion to their masses."""
+    block_mass = np.bincount(mesh.node_block, weights=mesh.mass, minlength=scene.driven.size)
+    share = mesh.mass / block_mass[mesh.node_block]
+    return np.where(mesh.driven[:, None], 0.0, load[mesh.node_block, :2] * share[:, None])
+
+
+def critical_time_step(mesh: Mesh, scene: Scene, kn: float) -> float:
+    """2 / omega_max with omega^2 bounded by the stiffest element (Courant: omega = 2 c_p / h_min,
+    c_p^2 = E / (rho (1 - nu^2)), h the triangle's smallest altitude) plus the contact springs
+    all round a boundary node (kn times the length of its two edges over 2, on its lumped mass)."""
+    free_tri = mesh.active_tri
+    px, py = mesh.x0[mesh.triangles], mesh.y0[mesh.triangles]
+    sides = np.hypot(px - np.roll(px, -1, axis=1), py - np.roll(py, -1, axis=1))
+    altitude = 2.0 * np.abs(mesh.area0) / sides.max(axis=1)
+    tri_block = mesh.node_block[mesh.triangles[:, 0]]
+    block_area = np.bincount(tri_block, weights=mesh.area0, minlength=scene.driven.size)
+    density = scene.mass[tri_block, 0] / block_area[tri_block]
+    wave = mesh.young / (density * (1.0 - mesh.poisson**2))
+    omega_element = (4.0 * wave / altitude**2)[free_tri].max(initial=0.0)
+    n_poly = scene.lx.size
+    edge = np.hypot(np.diff(px[:, 1:], axis=1)[:, 0], np.diff(py[:, 1:], axis=1)[:, 0])  # polygon edges
+    tributary = 0.5 * (edge + edge[prev_edge(scene.offs)])
+    free_poly = ~mesh.driven[:n_poly]
+    omega_contact = (kn * tributary / mesh.mass[:n_poly])[free_poly].max(initial=0.0)
+    omega = np.sqrt(omega_element + omega_contact)
+    return 2.0 / omega if omega > 0 else np.inf
+
+
+def prev_edge(offs: np.ndarray) -> np.ndarray:
+    """Index of the edge ending at each polygon node (edge k runs from node k to the next)."""
+    idx = np.arange(int(offs[-1])) - 1
+    idx[offs[:-1]] = offs[1:] - 1
+    return idx
+
+
+@fast_jit
+def cst_forces(x, y, triangles, grad_x, grad_y, area0, young, poisson, active_tri, force):
+    """Add the internal forces of every active CST to ``force`` (node, 2); returns the strain energy.
+
+    Deformation gradient ``F = sum_i x_i grad N_i``, Green strain ``E = (F^T F - I) / 2``,
+    plane-stress ``S = D E``, first Piola ``P = F S``, nodal force ``-A0 P grad N_i``.
+    """
+    energy = 0.0
+    for e in range(triangles.shape[0]):
+        if not active_tri[e]:
+            continue
+        n0, n1, n2 = triangles[e, 0], triangles[e, 1], triangles[e, 2]
+        bx0, bx1, bx2 = grad_x[e, 0], grad_x[e, 1], grad_x[e, 2]
+        by0, by1, by2 = grad_y[e, 0], grad_y[e, 1], grad_y[e, 2]
+        f11 = x[n0] * bx0 + x[n1] * bx1 + x[n2] * bx2
+        f12 = x[n0] * by0 + x[n1] * by1 + x[n2] * by2
+        f21 = y[n0] * bx0 + y[n1] * bx1 + y[n2] * bx2
+        f22 = y[n0] * by0 + y[n1] * by1 + y[n2] * by2
+        e11 = 0.5 * (f11 * f11 + f21 * f21 - 1.0)
+        e22 = 0.5 * (f12 * f12 + f22 * f22 - 1.0)
+        e12 = 0.5 * (f11 * f12 + f21 * f22)
+        nu = poisson[e]
+        c = young[e] / (1.0 - nu * nu)
+        s11 = c * (e11 + nu * e22)
+        s22 = c * (e22 + nu * e11)
+        s12 = c * (1.0 - nu) * e12
+        a = area0[e]
+        energy += 0.5 * a * (s11 * e11 + s22 * e22 + 2.0 * s12 * e12)
+        p11 = a * (f11 * s11 + f12 * s12)
+        p12 = a * (f11 * s12 + f12 * s22)
+        p21 = a * (f21 * s11 + f22 * s12)
+        p22 = a * (f21 * s12 + f22 * s22)
+        force[n0, 0] -= p11 * bx0 + p12 * by0
+        force[n0, 1] -= p21 * bx0 + p22 * by0
+        force[n1, 0] -= p11 * bx1 + p12 * by1
+        force[n1, 1] -= p21 * bx1 + p22 * by1
+        force[n2, 0] -= p11 * bx2 + p12 * by2
+        force[n2, 1] -= p21 * bx2 + p22 * by2
+    return energy
+
+
+@jit
+def edge_weight(x, y, k0, k1, px, py):
+    """Share of node ``k1`` in the point of edge k0-k1 nearest to (px, py), clipped to the edge."""
+    ex, ey = x[k1] - x[k0], y[k1] - y[k0]
+    w = ((px - x[k0]) * ex + (py - y[k0]) * ey) / (ex * ex + ey * ey)
+    return min(max(w, 0.0), 1.0)
+
+
+@jit
+def next_node(k, b, offs):
+    return k + 1 if k + 1 < offs[b + 1] else offs[b]
+
+
+@jit
+def node_contact_forces(x, y, vel, offs, faces, props, kn, kt, min_half, contact_damping, inv_mass, dt,
+                        shear, bonded, normal, energy, force, acc, update_history):
+    """The rigid mode's face-pair contact law (see :func:`.kernels.contact_forces`) on the current
+    boundary nodes: the force at each contact end goes to the two nodes of each edge by linear
+    interpolation, and the relative velocity is interpolated from them. Returns the spring energy."""
+    stored = 0.0
+    for f in range(faces.shape[0]):
+        a, ea, b, eb = faces[f, 0], faces[f, 1], faces[f, 2], faces[f, 3]
+        ka, kb = next_node(ea, a, offs), next_node(eb, b, offs)
+        g = face_geometry(x, y, offs, a, ea, b, eb)
+        nx, ny, ox, oy, s_lo, s_hi = g[0], g[1], g[2], g[3], g[4], g[5]
+        tx, ty = ny, -nx
+        half = 0.5 * (s_hi - s_lo)
+        if half <= min_half:
+            if update_history:
+                for e in range(2):
+                    acc[RELEASED] += energy[f, e]
+                    energy[f, e] = 0.0
+                    shear[f, e] = 0.0
+                    bonded[f, e] = 0
+            normal[f, 0] = normal[f, 1] = 0.0
+            continue
+        knp = kn * half
+        ktp = kt * half
+        m_inv = 0.5 * (inv_mass[ea] + inv_mass[ka] + inv_mass[eb] + inv_mass[kb])
+        dashpot = 2.0 * contact_damping * np.sqrt(knp / m_inv) if m_inv > 0.0 else 0.0
+        mu, coh, ten = props[f, 0], props[f, 1] * half, props[f, 2] * half
+        for e in range(2):
+            s = s_lo if e == 0 else s_hi
+            gap = g[6] if e == 0 else g[7]
+            h = g[8] if e == 0 else g[9]
+            px = ox + s * tx + h * nx
+            py = oy + s * ty + h * ny
+            wa = edge_weight(x, y, ea, ka, px, py)
+            wb = edge_weight(x, y, eb, kb, px, py)
+            dvx = ((1.0 - wb) * vel[eb, 0] + wb * vel[kb, 0]) - ((1.0 - wa) * vel[ea, 0] + wa * vel[ka, 0])
+            dvy = ((1.0 - wb) * vel[eb, 1] + wb * vel[kb, 1]) - ((1.0 - wa) * vel[ea, 1] + wa * vel[ka, 1])
+            opening_rate = dvx * nx + dvy * ny
+            fn_elastic = -knp * gap
+            ft = shear[f, e]
+            if bonded[f, e] and fn_elastic < -ten and update_history:
+                bonded[f, e] = 0
+                acc[DISSIPATED_FRICTION] += 0.5 * fn_elastic * fn_elastic / knp
+            if not bonded[f, e] and fn_elastic <= 0.0:
+                if update_history:
+                    acc[DISSIPATED_FRICTION] += 0.5 * ft * ft / ktp
+                    shear[f, e] = 0.0
+                normal[f, e] = 0.0
+                energy[f, e] = 0.0
+                continue
+            fn = fn_elastic - dashpot * opening_rate
+            if not bonded[f, e] and fn < 0.0:
+                fn = 0.0
+            if update_history:
+                acc[DISSIPATED_DAMPING] -= (fn - fn_elastic) * opening_rate * dt
+                slip = (dvx * tx + dvy * ty) * dt
+                trial = ft - ktp * slip
+                cap = mu * max(fn, 0.0) + (coh if bonded[f, e] else 0.0)
+                if abs(trial) > cap:
+                    if bonded[f, e]:
+                        bonded[f, e] = 0
+                        if fn < 0.0:
+                            acc[DISSIPATED_FRICTION] += 0.5 * fn_elastic * fn_elastic / knp
+                            fn = 0.0
+                            fn_elastic = 0.0
+                        cap = mu * fn
+                    acc[DISSIPATED_FRICTION] += cap * (abs(trial) - cap) / ktp
+                    ft = cap if trial > 0.0 else -cap
+                else:
+                    ft = trial
+                shear[f, e] = ft
+            spring = 0.5 * fn_elastic * fn_elastic / knp + 0.5 * ft * ft / ktp
+            stored += spring
+            if update_history:
+                energy[f, e] = spring
+            normal[f, e] = fn
+            fx = fn * nx + ft * tx
+            fy = fn * ny + ft * ty
+            force[eb, 0] += (1.0 - wb) * fx
+            force[eb, 1] += (1.0 - wb) * fy
+            force[kb, 0] += wb * fx
+            force[kb, 1] += wb * fy
+            force[ea, 0] -= (1.0 - wa) * fx
+            force[ea, 1] -= (1.0 - wa) * fy
+            force[ka, 0] -= wa * fx
+            force[ka, 1] -= wa * fy
+    return stored
+
+
+@jit
+def driven_motion(settlement, rate, x0, y0, node_block, driven, pos0, direction, x, y, vel):
+    """Positions and velocities of the support nodes: rigid motion ``pos0 + settlement * direction``."""
+    for k in range(x0.size):
+        if not driven[k]:
+            continue
+        b = node_block[k]
+        theta = settlement * direction[b, 2]
+        c, s = np.cos(theta), np.sin(theta)
+        rx, ry = x0[k] - pos0[b, 0], y0[k] - pos0[b, 1]
+        qx, qy = c * rx - s * ry, s * rx + c * ry
+        x[k] = pos0[b, 0] + settlement * direction[b, 0] + qx
+        y[k] = pos0[b, 1] + settlement * direction[b, 1] + qy
+        vel[k, 0] = rate * (direction[b, 0] - direction[b, 2] * qy)
+        vel[k, 1] = rate * (direction[b, 1] + direction[b, 2] * qx)
+
+
+@jit
+def advance(n_steps, dt, x, y, vel, x0, y0, x_detect, y_detect, offs, node_block, triangles, grad_x, grad_y,
+            area0, young, poisson, active_tri, mass, inv_mass, driven, moving, pos0, direction, faces, props,
+            kn, kt, min_half, contact_damping, shear, bonded, normal, energy, load, load_ramp, damping, rate,
+            ramp_time, start_time, target, half_buffer, acc, out):
+    """Up to ``n_steps`` central-difference steps of the nodes (see :func:`.kernels.advance` for the
+    damping, the loads, the supports, the stop conditions and ``out``; stored energy = strain + springs)."""
+    n_node = x.size
+    force = np.zeros((n_node, 2))
+    steps = 0
+    rebuild = 0
+    load_norm = 0.0
+    for k in range(n_node):
+        load_norm += abs(load[k, 0]) + abs(load[k, 1])
+    for step in range(n_steps):
+        force[:, :] = 0.0
+        time = acc[TIME]
+        rate_now = settlement_rate(time + 0.5 * dt, rate, ramp_time, start_time)
+        driven_motion(acc[SETTLEMENT], rate_now, x0, y0, node_block, driven, pos0, direction, x, y, vel)
+        cst_forces(x, y, triangles, grad_x, grad_y, area0, young, poisson, active_tri, force)
+        node_contact_forces(x, y, vel, offs, faces, props, kn, kt, min_half, contact_damping, inv_mass, dt,
+                            shear, bonded, normal, energy, force, acc, True)
+        load_share = 1.0
+        if time < load_ramp:
+            load_share = 0.5 * (1.0 - np.cos(np.pi * time / load_ramp))
+        for k in range(n_node):
+            if driven[k]:
+                acc[WORK_SUPPORT] -= (force[k, 0] * vel[k, 0] + force[k, 1] * vel[k, 1]) * dt
+                continue
+            for d in range(2):
+                f = force[k, d] + load_share * load[k, d]
+                v_old = vel[k, d]
+                damp = 0.0
+                if v_old > 0.0:
+                    damp = -damping * abs(f)
+                elif v_old < 0.0:
+                    damp = damping * abs(f)
+                v_new = v_old + dt * (f + damp) / mass[k]
+                vel[k, d] = v_new
+                acc[WORK_GRAVITY] += load_share * load[k, d] * v_new * dt
+                acc[DISSIPATED_DAMPING] -= damp * v_new * dt
+        acc[SETTLEMENT] += rate_now * dt
+        moved = 0.0
+        for k in range(n_node):
+            if not driven[k]:
+                x[k] += dt * vel[k, 0]
+                y[k] += dt * vel[k, 1]
+        driven_motion(acc[SETTLEMENT], rate_now, x0, y0, node_block, driven, pos0, direction, x, y, vel)
+        for k in range(n_node):
+            moved = max(moved, np.hypot(x[k] - x_detect[k], y[k] - y_detect[k]))
+        acc[TIME] = time + dt
+        steps += 1
+        if moved > half_buffer:
+            rebuild = 1
+            break
+        if target > 0.0 and acc[SETTLEMENT] >= target:
+            break
+    force[:, :] = 0.0
+    strain = cst_forces(x, y, triangles, grad_x, grad_y, area0, young, poisson, active_tri, force)
+    springs = node_contact_forces(x, y, vel, offs, faces, props, kn, kt, min_half, contact_damping, inv_mass,
+                                  dt, shear, bonded, normal, energy, force, acc, False)
+    reaction = 0.0
+    kinetic = 0.0
+    unbalanced = 0.0
+    for k in range(n_node):
+        if moving[node_block[k]]:
+            reaction -= force[k, 1]
+        if not driven[k]:
+            kinetic += 0.5 * mass[k] * (vel[k, 0] * vel[k, 0] + vel[k, 1] * vel[k, 1])
+            unbalanced += abs(force[k, 0] + load[k, 0]) + abs(force[k, 1] + load[k, 1])
+    out[0] = steps
+    out[1] = rebuild
+    out[2] = reaction
+    out[3] = kinetic
+    out[4] = strain + springs
+    out[5] = unbalanced / load_norm if load_norm > 0.0 else 0.0
+
+
+def rigid_fit(mesh: Mesh, x: np.ndarray, y: np.ndarray, n_block: int) -> np.ndarray:
+    """(block, 3) centroid and rotation of the rigid motion nearest (least squares, mass-weighted)
+    to each block's nodes: mean translation of the centroid, best-fit rotation about it."""
+    m, owner = mesh.mass, mesh.node_block
+    total = np.bincount(owner, weights=m, minlength=n_block)
+    cx0 = np.bincount(owner, weights=m * mesh.x0, minlength=n_block) / total
+    cy0 = np.bincount(owner, weights=m * mesh.y0, minlength=n_block) / total
+    cx = np.bincount(owner, weights=m * x, minlength=n_block) / total
+    cy = np.bincount(owner, weights=m * y, minlength=n_block) / total
+    rx, ry = mesh.x0 - cx0[owner], mesh.y0 - cy0[owner]
+    qx, qy = x - cx[owner], y - cy[owner]
+    sin_sum = np.bincount(owner, weights=m * (rx * qy - ry * qx), minlength=n_block)
+    cos_sum = np.bincount(owner, weights=m * (rx * qx + ry * qy), minlength=n_block)
+    return np.stack((cx, cy, np.arctan2(sin_sum, cos_sum)), axis=1)
