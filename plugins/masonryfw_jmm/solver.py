@@ -1,0 +1,209 @@
+"""The ``jmm`` solve: gravity, then incremental settlement of the moving support to the reaction plateau."""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import xarray as xr
+
+import masonryfw as mf
+
+from .cracks import crack_indicator
+from .newton import NewtonSolver, State
+from .problem import Problem, build_problem
+
+MIN_INCREMENT = 1e-4  # of the elastic unloading settlement: below it a failing step stops the run
+
+
+@dataclass
+class History:
+    settlement: list = field(default_factory=list)
+    reaction: list = field(default_factory=list)
+    iterations: list = field(default_factory=list)
+    plastic_points: list = field(default_factory=list)
+    residuals: list = field(default_factory=list)
+
+
+GRAVITY_ITERATIONS = 4  # times max_iterations: with c = sigma_t = 0 the domain is a cone, so smaller
+# gravity increments meet the same (scaled) problem and do not help; more iterations do
+
+
+def _gravity_stage(newton: NewtonSolver, state: State, history: History) -> tuple[State, str]:
+    """Apply gravity (halved when a step fails); all supports held."""
+    factor, increment, iterations = 0.0, 1.0, 0
+    while factor < 1.0:
+        target = min(1.0, factor + increment)
+        trial, report = newton.step(state, target, 0.0, GRAVITY_ITERATIONS * newton.max_iterations)
+        iterations += report.iterations
+        if report.converged:
+            state, factor = trial, target
+            continue
+        increment /= 2
+        if increment < 1e-3:
+            return state, f"gravity stage did not converge at gravity factor {factor:.4f}"
+    history.settlement.append(0.0)
+    history.reaction.append(newton.reaction(state))
+    history.iterations.append(iterations)
+    history.plastic_points.append(int(state.active.any(axis=1).sum()))
+    return state, ""
+
+
+def elastic_unloading_settlement(newton: NewtonSolver, state: State) -> tuple[float, float]:
+    """Settlement (non-dimensional) that would unload the support with the current tangent, and the slope."""
+    trial, _ = newton.step(state, 1.0, 1.0)  # one linear predictor solve under a unit settlement
+    p = newton.problem
+    K = p.disc.stiffness(state.tangent)
+    du = trial.u - state.u
+    slope = float((K @ du)[p.moving[p.moving_vertical]].sum())
+    reaction = newton.reaction(state)
+    if not slope < 0 or not reaction > 0:
+        raise mf.SolveError(
+            f"jmm: the moving support carries {reaction:.3g} (non-dimensional) and unloads at slope {slope:.3g}: "
+            "nothing to settle"
+        )
+    return reaction / -slope, slope
+
+
+def _plateau(history: History, slope: float, options) -> bool:
+    n = options["plateau_steps"]
+    if len(history.settlement) < n + 2:
+        return False
+    s = np.asarray(history.settlement[-n - 1:])
+    r = np.asarray(history.reaction[-n - 1:])
+    return bool(np.all(np.abs(np.diff(r) / np.diff(s)) < options["plateau_slope"] * abs(slope)))
+
+
+def run(problem: Problem, options, progress) -> tuple[State, History, dict]:
+    """Gravity, then settlement steps until the plateau; every converged step kept."""
+    kappa = options["vertex_stiffness"], options["settled_stiffness"]
+    newton = NewtonSolver(problem, options["tolerance"], options["max_iterations"], regularisation=kappa)
+    history = History()
+    info = {"jmm_interrupted": 0, "jmm_stop_reason": ""}
+    state = State.initial(problem)
+    try:
+        progress(0.0, "gravity")
+        state, failure = _gravity_stage(newton, state, history)
+        if failure:
+            info["jmm_stop_reason"] = failure
+            return state, history, info
+        unloading, slope = elastic_unloading_settlement(newton, state)
+        info["jmm_elastic_unloading_settlement_m"] = unloading * problem.displacement
+        limit = options["max_settlement"] / problem.displacement if options["max_settlement"] > 0 else 30 * unloading
+        increment, settlement = options["first_increment"] * unloading, 0.0
+        largest = options["max_increment"] * unloading
+        while True:
+            if len(history.settlement) - 1 >= options["max_steps"]:
+                info["jmm_stop_reason"] = f"max_steps ({options['max_steps']}) reached"
+                break
+            target = min(settlement + increment, limit)
+            trial, report = newton.step(state, 1.0, target)
+            if not report.converged:
+                increment /= 2
+                if increment < MIN_INCREMENT * unloading:
+                    info["jmm_stop_reason"] = f"no convergence at settlement {target * problem.displacement:.4g} m"
+                    break
+                continue
+            state, settlement = trial, target
+            history.settlement.append(settlement)
+            history.reaction.append(newton.reaction(state))
+            history.iterations.append(report.iterations)
+            history.plastic_points.append(int(state.active.any(axis=1).sum()))
+            history.residuals.append(report.residuals)
+            progress(min(0.99, settlement / limit), f"step {len(history.settlement) - 1}: settlement "
+                     f"{settlement * problem.displacement:.3g} m, reaction {history.reaction[-1] * problem.force:.4g} N, "
+                     f"{report.iterations} Newton iterations")
+            if _plateau(history, slope, options):
+                info["jmm_stop_reason"] = "reaction plateau"
+                break
+            if settlement >= limit:
+                info["jmm_stop_reason"] = "max_settlement reached"
+                break
+            if report.iterations <= options["target_iterations"]:
+                increment = min(1.5 * increment, largest)
+            elif report.iterations > 2 * options["target_iterations"]:
+                increment *= 0.5
+    except KeyboardInterrupt:
+        info["jmm_interrupted"] = 1
+        info["jmm_stop_reason"] = "interrupted"
+    return state, history, info
+
+
+def _var(dims, values, units: str, long_name: str, **attrs) -> xr.Variable:
+    return xr.Variable(dims, values, {"units": units, "long_name": long_name, **attrs})
+
+
+def result_dataset(model: xr.Dataset, problem: Problem, state: State, history: History, info: dict,
+                   spacing: float) -> xr.Dataset:
+    """FORMAT.md result variables (physical units) from the final converged state and the history."""
+    p, disc = problem, problem.disc
+    H, U = p.length, p.displacement
+    vertex = disc.vertex_dofs()
+    failure = np.zeros(disc.n_points, dtype=np.int8)
+    failure[p.masonry_points] = p.return_map.failure_mode(state.active[p.masonry_points])
+    qx, qy = disc.qp_xy * H
+    flags = mf.flags("qp_failure")
+    stress = state.stress * p.stress
+    variables = {
+        "mesh": _var((), np.int32(0), "1", "UGRID mesh topology", cf_role="mesh_topology", topology_dimension=2,
+                     node_coordinates="mesh_node_x mesh_node_y", face_node_connectivity="mesh_face_nodes"),
+        "mesh_node_x": _var("mesh_node", disc.mesh.p[0] * H, "m", "continuum mesh node x"),
+        "mesh_node_y": _var("mesh_node", disc.mesh.p[1] * H, "m", "continuum mesh node y"),
+        "mesh_face_nodes": _var(("mesh_face", "mesh_face_node"), disc.mesh.t.T.astype(np.int32), "1",
+                                "node indices of each mesh face (0-based, UGRID face_node_connectivity)",
+                                cf_role="face_node_connectivity", start_index=0),
+        "mesh_node_ux": _var("mesh_node", state.u[2 * vertex] * U, "m", "final horizontal displacement of the mesh node"),
+        "mesh_node_uy": _var("mesh_node", state.u[2 * vertex + 1] * U, "m", "final vertical displacement of the mesh node"),
+        "qp_x": _var("qp", qx, "m", "quadrature point x"),
+        "qp_y": _var("qp", qy, "m", "quadrature point y"),
+        "qp_failure": _var("qp", failure, "1", "failure mode of the quadrature point in the last step",
+                           flag_values=np.array(sorted(flags.values()), dtype=np.int8),
+                           flag_meanings=" ".join(sorted(flags, key=flags.get))),
+        "qp_stress_xx": _var("qp", stress[:, 0], "Pa", "final stress sigma_xx (tension positive)"),
+        "qp_stress_yy": _var("qp", stress[:, 1], "Pa", "final stress sigma_yy (tension positive)"),
+        "qp_stress_xy": _var("qp", stress[:, 2], "Pa", "final shear stress sigma_xy"),
+        "step_settlement": _var("step", np.asarray(history.settlement) * U, "m", "imposed settlement"),
+        "step_reaction": _var("step", np.asarray(history.reaction) * p.force, "N",
+                              "vertical reaction on the moving support"),
+        "step_newton_iterations": _var("step", np.asarray(history.iterations, dtype=np.int32), "1",
+                                       "Newton iterations of the step (step 0: the whole gravity stage)"),
+        "step_plastic_points": _var("step", np.asarray(history.plastic_points, dtype=np.int32), "1",
+                                    "quadrature points yielding in the step"),
+        "crack_indicator": _var("interface", crack_indicator(model, qx, qy, failure > 0, spacing / 4), "1",
+                                "fraction of the nearest quadrature points that yield in the last step"),
+    }
+    iterations = np.asarray(history.iterations[1:], dtype=float)
+    attrs = {
+        **info,
+        "jmm_beta": p.beta,
+        "jmm_young_modulus_pa": p.young,
+        "jmm_poisson_ratio": p.poisson,
+        "jmm_dofs": int(disc.ndof),
+        "jmm_quadrature_points": int(disc.n_points),
+        "jmm_mean_newton_iterations": float(iterations.mean()) if iterations.size else 0.0,
+    }
+    return xr.Dataset(variables, attrs=attrs)
+
+
+NON_NEGATIVE = ("mesh_size", "shear_modulus", "poisson_ratio", "vertex_stiffness", "settled_stiffness",
+                "apex_shift", "max_settlement")
+POSITIVE = ("tolerance", "max_iterations", "first_increment", "max_increment", "max_steps", "plateau_slope",
+            "plateau_steps", "target_iterations")
+
+
+def check_options(options) -> None:
+    """Raise PluginError naming the first option out of range."""
+    for name in NON_NEGATIVE:
+        if not options[name] >= 0:
+            raise mf.PluginError(f"solver 'jmm': option {name!r} must be >= 0, got {options[name]}")
+    for name in POSITIVE:
+        if not options[name] > 0:
+            raise mf.PluginError(f"solver 'jmm': option {name!r} must be > 0, got {options[name]}")
+
+
+def solve(model: xr.Dataset, options, progress) -> xr.Dataset:
+    """Solve ``model`` with the Jointed Masonry Model: the ``jmm`` solver entry point."""
+    check_options(options)
+    problem = build_problem(model, options)
+    state, history, info = run(problem, options, progress)
+    progress(1.0, info["jmm_stop_reason"])
+    return result_dataset(model, problem, state, history, info, problem.mesh_size)

@@ -1,0 +1,116 @@
+"""The jmm solver through masonryfw.solve on a small wall: result format, gravity, settlement, interruption."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import masonryfw as mf
+
+SPEC = {
+    "title": "jmm small wall",
+    "length_unit": "m",
+    "wall": {"width": 0.4, "height": 0.2, "thickness": 0.1},
+    "unit": {"length": 0.1, "height": 0.05},
+    "bond": {"pattern": "running", "first_course": "full"},
+    "material": {"unit_weight": 12000.0, "friction_angle": 21.8, "cohesion": 0.0, "tensile_strength": 0.0,
+                 "young_modulus": 1.2264e9, "poisson_ratio": 0.2},
+    "supports": {
+        "fixed": {"kind": "fixed", "start": 0.0, "end": 0.2},
+        "settling": {"kind": "moving", "start": 0.2, "end": 0.4, "motion": "translation"},
+    },
+    "loading": {"type": "settlement"},
+}
+FAST = {"mesh_size": 0.025, "max_steps": 6, "first_increment": 0.2}
+
+
+@pytest.fixture(scope="module")
+def model():
+    return mf.build(SPEC)
+
+
+@pytest.fixture(scope="module")
+def result(model):
+    return mf.solve(model, "jmm", FAST)
+
+
+def test_result_has_the_format_variables(result):
+    for name in ["mesh", "mesh_node_x", "mesh_node_y", "mesh_face_nodes", "mesh_node_ux", "mesh_node_uy",
+                 "qp_x", "qp_y", "qp_failure", "step_settlement", "step_reaction", "step_newton_iterations",
+                 "crack_indicator"]:
+        assert name in result, name
+    assert result["mesh"].attrs["cf_role"] == "mesh_topology"
+    assert mf.check(result) == []
+    assert set(np.unique(result.qp_failure.values)) <= {0, 1, 2, 3}
+    assert ((result.crack_indicator.values >= 0) & (result.crack_indicator.values <= 1)).all()
+
+
+def test_mesh_covers_the_wall_and_follows_the_courses(result):
+    # 0.4 x 0.2 m in 25 mm cells: 16 x 8 cells, two triangles each; every course line is a mesh line
+    assert result.sizes["mesh_face"] == 2 * 16 * 8
+    y = np.unique(np.round(result.mesh_node_y.values, 9))
+    assert set(np.round(np.arange(0, 0.2001, 0.05), 9)) <= set(y)
+
+
+def test_gravity_reaction_splits_the_weight(result, model):
+    weight = 12000.0 * 0.4 * 0.2 * 0.1
+    first = float(result.step_reaction.values[0])
+    # the moving support carries part of the weight; an elastic wall on a rigid base gives it about half
+    assert 0.3 * weight < first < 0.7 * weight
+    assert result.step_settlement.values[0] == 0.0
+
+
+def test_settlement_unloads_the_moving_support(result):
+    reaction = result.step_reaction.values
+    settlement = result.step_settlement.values
+    assert np.all(np.diff(settlement) > 0)
+    assert reaction[-1] < reaction[0]
+    assert np.all(np.diff(reaction) <= 1e-9 * reaction[0])
+    assert (result.qp_failure.values > 0).any()
+
+
+def test_interrupt_keeps_the_converged_steps(model):
+    calls = []
+
+    def progress(fraction, message):
+        calls.append(message)
+        if len(calls) == 3:  # reported: gravity, step 1, step 2; then the user presses ctrl-c
+            raise KeyboardInterrupt
+
+    result = mf.solve(model, "jmm", FAST, progress)
+    assert result.attrs["jmm_interrupted"] == 1
+    assert result.sizes["step"] == 3  # gravity + the two converged settlement steps
+    assert "qp_failure" in result
+
+
+def test_beta_from_the_unit_geometry(result):
+    # beta = tan(phi) b / (2a) = 0.4 * 100 / (2 * 50) for 100 x 50 mm units
+    assert result.attrs["jmm_beta"] == pytest.approx(0.4, rel=1e-3)
+
+
+def test_bad_option_is_named():
+    with pytest.raises(mf.MasonryError, match="mesh_size"):
+        mf.solve(mf.build(SPEC), "jmm", {"mesh_size": -1.0})
+
+
+FIXED = {**FAST, "max_steps": 4}
+
+
+def reactions_at(result, settlements):
+    """The reaction history interpolated at ``settlements`` (step sizes adapt to the Newton work)."""
+    return np.interp(settlements, result.step_settlement.values, result.step_reaction.values)
+
+
+def test_tangent_regularisation_does_not_move_the_result(model):
+    # kappa only changes the Newton direction; the converged reactions agree to the Newton tolerance
+    reference = mf.solve(model, "jmm", FIXED)
+    other = mf.solve(model, "jmm", {**FIXED, "vertex_stiffness": 3e-2, "settled_stiffness": 3e-2})
+    common = reference.step_settlement.values[reference.step_settlement.values <= other.step_settlement.values[-1]]
+    np.testing.assert_allclose(reactions_at(other, common), reactions_at(reference, common), rtol=2e-3)
+
+
+def test_apex_regularisation_changes_the_reaction_by_less_than_its_size(model):
+    # apexes moved by 1e-3 gamma H (default) against 1e-4: reactions (interpolated between steps) within 1 %
+    reference = mf.solve(model, "jmm", FIXED)
+    finer = mf.solve(model, "jmm", {**FIXED, "apex_shift": 1e-4})
+    common = reference.step_settlement.values[reference.step_settlement.values <= finer.step_settlement.values[-1]]
+    np.testing.assert_allclose(reactions_at(finer, common), reactions_at(reference, common), rtol=1e-2)
