@@ -17,7 +17,16 @@ except PackageNotFoundError:  # running from a source tree that is not installed
 
 from .errors import MasonryError, ModelError, PluginError, SolveError, SpecError
 from .progress import ProgressCallback, no_progress
-from .hookspecs import Comparator, Option, Plotter, Solver, hookimpl, lazy, resolve_options
+from .hookspecs import (
+    Comparator,
+    Option,
+    Plotter,
+    Solver,
+    hookimpl,
+    lazy,
+    parse_option_pairs,
+    resolve_options,
+)
 from .schema import FORMAT_VERSION, flags, load_schema, variable_attrs
 from .geometry import (
     DERIVED_GEOMETRY_VARIABLES,

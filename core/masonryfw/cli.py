@@ -80,18 +80,16 @@ def _is_path(path_or_name: str) -> bool:
     return Path(path_or_name).exists()
 
 
-def _parse_options(pairs: tuple[str, ...]) -> dict[str, str]:
-    options = {}
-    for pair in pairs:
-        key, sep, value = pair.partition("=")
-        if not sep or not key.strip():
-            raise click.BadParameter(f"{pair!r} is not KEY=VALUE", param_hint="--option")
-        options[key.strip()] = value
-    return options
+def _option_pairs(ctx, param, value) -> dict[str, str]:
+    try:
+        return mf.parse_option_pairs(value)
+    except mf.PluginError as exc:  # a malformed pair is a usage error (exit 2)
+        raise click.BadParameter(str(exc)) from None
 
 
 _OPTION = click.option(
-    "--option", "options", multiple=True, metavar="KEY=VALUE", help="A plugin option (repeatable)."
+    "--option", "options", multiple=True, metavar="KEY=VALUE", callback=_option_pairs,
+    help="A plugin option (repeatable).",
 )
 
 
@@ -276,16 +274,15 @@ def _scalar_summary(ds, names) -> str:
 @click.option("-o", "--output", type=click.Path(dir_okay=False), help="[default: <model>.<plugin>.nc]")
 @_OPTION
 @click.option("--no-progress", is_flag=True, help="Do not draw a progress bar.")
-def solve(model: str, solver: str, output: str | None, options: tuple[str, ...], no_progress: bool) -> None:
+def solve(model: str, solver: str, output: str | None, options: dict[str, str], no_progress: bool) -> None:
     """Solve MODEL (a file or a bundled case name) with a solver plugin."""
-    parsed = _parse_options(options)
     inputs = [Path(model)] if _is_path(model) else []
     out = Path(output) if output else Path(f"{Path(model).stem if inputs else model}.{solver}.nc")
     _refuse_overwriting(out, inputs)
     dataset = mf.open_model(model)
     bar = _progress_bar(not no_progress)
     try:
-        result = mf.solve(dataset, solver, parsed, progress=bar)
+        result = mf.solve(dataset, solver, options, progress=bar)
     finally:
         if bar is not None:
             bar.close()
@@ -304,11 +301,10 @@ def solve(model: str, solver: str, output: str | None, options: tuple[str, ...],
 @_OPTION
 @click.option("--json", "as_json", is_flag=True, help="Print the scalar scores as JSON.")
 def compare(
-    a: str, b: str, comparator: str | None, output: str | None, options: tuple[str, ...], as_json: bool
+    a: str, b: str, comparator: str | None, output: str | None, options: dict[str, str], as_json: bool
 ) -> None:
     """Compare two results A and B."""
-    parsed = _parse_options(options)
-    comparison = mf.compare(mf.open_dataset(a), mf.open_dataset(b), comparator, parsed)
+    comparison = mf.compare(mf.open_dataset(a), mf.open_dataset(b), comparator, options)
     if output:
         mf.save(comparison, output, command=_command_line(), protect=[a, b])
     scalars = [n for n in comparison.data_vars if comparison[n].ndim == 0]
@@ -326,10 +322,9 @@ def compare(
 @click.option("--kind", help="Plot kind (see `masonryfw plugins`) [default: the only one installed].")
 @click.option("-o", "--output", type=click.Path(dir_okay=False), required=True, help="Image file (png, svg, pdf).")
 @_OPTION
-def plot(results: tuple[str, ...], kind: str | None, output: str, options: tuple[str, ...]) -> None:
+def plot(results: tuple[str, ...], kind: str | None, output: str, options: dict[str, str]) -> None:
     """Plot one or more RESULTS (files or bundled case names) with a plotter plugin."""
-    parsed = _parse_options(options)
-    figure = render([mf.open_model(r) for r in results], kind, parsed)
+    figure = render([mf.open_model(r) for r in results], kind, options)
     if Path(output).suffix.lower() not in mf.io.FIGURE_FORMATS:
         raise click.BadParameter(
             f"{output}: unknown image type; use one of {', '.join(mf.io.FIGURE_FORMATS)}", param_hint="-o"

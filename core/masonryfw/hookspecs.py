@@ -66,6 +66,17 @@ class Option:
         return parsed
 
 
+def parse_option_pairs(pairs: Sequence[str]) -> dict[str, str]:
+    """``["solver=highs", "tolerance=1e-9"]`` -> ``{"solver": "highs", "tolerance": "1e-9"}`` (CLI ``--option``)."""
+    options = {}
+    for pair in pairs:
+        key, sep, value = pair.partition("=")
+        if not sep or not key.strip():
+            raise PluginError(f"--option {pair!r} is not KEY=VALUE")
+        options[key.strip()] = value
+    return options
+
+
 def resolve_options(
     owner: str, declared: Sequence[Option], given: Mapping[str, Any]
 ) -> dict[str, Any]:

@@ -25,16 +25,6 @@ def _command_line() -> str:
     return shlex.join(["masonryfw", *sys.argv[1:]])
 
 
-def _parse_options(pairs: tuple[str, ...]) -> dict[str, str]:
-    options = {}
-    for pair in pairs:
-        key, sep, value = pair.partition("=")
-        if not sep or not key.strip():
-            raise click.BadParameter(f"{pair!r} is not KEY=VALUE", param_hint="--option")
-        options[key.strip()] = value
-    return options
-
-
 def _default_output(spec: str, solver: str) -> Path:
     stem = Path(spec).stem if Path(spec).is_file() else spec
     return Path(f"{stem}.{solver}.sweep.nc")
@@ -76,7 +66,7 @@ def sweep_command(spec: str, solver: str, params: tuple[str, ...], zipped: bool,
     """
     if scheduler and workers:
         raise click.UsageError("--workers sizes the local cluster; it cannot be used with --scheduler")
-    plan = plan_sweep(spec, solver, params, _parse_options(options), zipped)
+    plan = plan_sweep(spec, solver, params, mf.parse_option_pairs(options), zipped)
     out = Path(output) if output else _default_output(spec, solver)
     if not out.resolve().parent.is_dir():
         raise mf.ModelError(f"{out}: cannot write: directory {out.resolve().parent} does not exist")
