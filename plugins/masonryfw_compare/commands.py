@@ -14,13 +14,27 @@ import masonryfw as mf
 @click.option("--agreement", type=click.Path(dir_okay=False), default=None,
               help="Markdown table of the scores [default: agreement.md beside the output folder].")
 @click.option("--case", "cases", multiple=True, help="Only this bundled case (repeatable) [default: all ten].")
-def gallery_command(output: str, agreement: str | None, cases: tuple[str, ...]) -> None:
-    """Solve every bundled wall with every installed method, draw and score them."""
-    from .gallery import run_gallery  # imported here: the CLI starts without matplotlib
+@click.option("--method", "methods", multiple=True,
+              help="Only this method among la, fdem, jmm (repeatable) [default: all installed].")
+@click.option("--option", "options", multiple=True, metavar="METHOD.KEY=VALUE",
+              help="A solver option of one method, e.g. jmm.mesh_size=0.05 (repeatable).")
+@click.option("--skip", "skips", multiple=True, metavar="METHOD:CASE",
+              help="Do not run METHOD on bundled case CASE, e.g. jmm:facade-3 (repeatable).")
+@click.option("--notes", type=click.Path(dir_okay=False, exists=True), default=None,
+              help="Markdown file put into the agreement file as its Discussion section.")
+def gallery_command(
+    output: str, agreement: str | None, cases: tuple[str, ...], methods: tuple[str, ...], options: tuple[str, ...],
+    skips: tuple[str, ...], notes: str | None,
+) -> None:
+    """Solve every bundled wall with every chosen method, draw and score them."""
+    from .gallery import gallery_command_line, run_gallery  # imported here: the CLI starts without matplotlib
 
     out = Path(output)
     table = Path(agreement) if agreement else out.parent / "agreement.md"
-    for path in run_gallery(out, table, list(cases) or None, echo=click.echo):
+    command = gallery_command_line(output, str(table), methods, options, skips, cases, notes)
+    for path in run_gallery(out, table, list(cases) or None, echo=click.echo, methods=list(methods) or None,
+                            options=options, skips=skips, command=command,
+                            notes=Path(notes) if notes else None):
         click.echo(f"wrote {path}")
 
 

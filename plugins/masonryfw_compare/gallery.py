@@ -1,15 +1,18 @@
 """The gallery: every bundled wall solved by every installed method, drawn side by side and scored.
 
 ``masonryfw gallery`` writes ``docs/gallery/<case>.png`` (the panels of the
-paper's figures 5-15: one per method, the later ones titled with their scores
-against the first) and ``docs/agreement.md`` (the pairwise scores of every
-wall). The limit analysis is run with each of its three LP backends, whose
-mechanisms differ where the optimum is degenerate; fdem and jmm join when
-installed.
+paper's figures 5-15: one per run, the later ones titled with their scores
+against the first) and ``docs/agreement.md``: each method's first run scored
+against the other methods' (with each method's headline number), and the
+limit analysis's three LP backends, whose mechanisms may differ where the
+optimum is degenerate, against each other. ``--method``, ``--option
+METHOD.KEY=VALUE`` and ``--skip METHOD:CASE`` choose what runs; the command
+line is written at the top of the agreement file.
 """
 from __future__ import annotations
 
 import json
+import shlex
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -26,6 +29,7 @@ METHODS = ("la", "fdem", "jmm")
 LA_BACKENDS = ("highs", "clarabel", "osqp")
 GALLERY_DPI = 110
 IDENTICAL_COSINE_GAP = 1e-3
+SKIPPED = "skipped (--skip)"
 # Columns of the agreement table: (header, comparison variable, number format).
 SCORE_COLUMNS = (
     ("alpha A", "collapse_multiplier_a", "{:.4f}"),
@@ -62,27 +66,95 @@ class CaseOutcome:
     seconds: dict[str, float]
 
 
-def planned_runs() -> tuple[list[Run], list[str]]:
-    """The runs of every installed method among METHODS (la once per backend) and the missing methods."""
+def parse_method_options(pairs: list[str] | tuple[str, ...]) -> dict[str, dict[str, str]]:
+    """``["jmm.mesh_size=0.05", ...]`` as ``{"jmm": {"mesh_size": "0.05"}}`` (values are parsed by the solver)."""
+    options: dict[str, dict[str, str]] = {}
+    for pair in pairs:
+        key, sep, value = pair.partition("=")
+        method, dot, name = key.strip().partition(".")
+        if not sep or not dot or not name:
+            raise mf.PluginError(f"gallery option {pair!r} is not METHOD.KEY=VALUE (e.g. jmm.max_steps=40)")
+        if method not in METHODS:
+            raise mf.PluginError(f"gallery option {pair!r}: method {method!r} is not one of {', '.join(METHODS)}")
+        options.setdefault(method, {})[name] = value
+    return options
+
+
+def parse_skips(pairs: list[str] | tuple[str, ...]) -> set[tuple[str, str]]:
+    """``["jmm:facade-1", ...]`` as ``{("jmm", "facade-1")}``: the method is not run on that wall."""
+    skips = set()
+    for pair in pairs:
+        method, sep, case = pair.partition(":")
+        if not sep or method not in METHODS or not case:
+            raise mf.PluginError(f"gallery skip {pair!r} is not METHOD:CASE with METHOD one of {', '.join(METHODS)}")
+        skips.add((method, case))
+    return skips
+
+
+def planned_runs(
+    methods: list[str] | tuple[str, ...] | None = None, options: dict[str, dict[str, str]] | None = None
+) -> tuple[list[Run], list[str]]:
+    """The runs of the chosen (default: every installed) methods among METHODS and the missing ones.
+
+    la runs once per LP backend unless ``options["la"]`` names one (``la.solver=highs``).
+    Every method's options are checked against the solver's declared options here,
+    before any wall is solved, so a misspelt name fails at once.
+    """
+    chosen = list(dict.fromkeys(methods or METHODS))
+    unknown = [m for m in chosen if m not in METHODS]
+    if unknown:
+        raise mf.PluginError(f"gallery method(s) {', '.join(unknown)}: not one of {', '.join(METHODS)}")
+    options = options or {}
+    unused = sorted(set(options) - set(chosen))
+    if unused:
+        raise mf.PluginError(f"gallery options given for {', '.join(unused)}, which is not among the methods run")
     runs, missing = [], []
-    for name in METHODS:
+    for name in chosen:
         try:
-            mf.get_solver(name)
+            solver = mf.get_solver(name)
         except mf.PluginError:
             missing.append(name)
             continue
-        if name == "la":
-            runs += [Run(f"la ({backend})", "la", {"solver": backend}) for backend in LA_BACKENDS]
+        given = options.get(name, {})
+        mf.resolve_options(name, solver.options, given)
+        if name == "la" and "solver" not in given:
+            runs += [Run(f"la ({backend})", "la", {**given, "solver": backend}) for backend in LA_BACKENDS]
+        elif name == "la":
+            runs.append(Run(f"la ({given['solver']})", "la", dict(given)))
         else:
-            runs.append(Run(name, name))
+            runs.append(Run(name, name, dict(given)))
     return runs, missing
 
 
-def solve_case(case: str, title: str, runs: list[Run], echo: Callable[[str], None]) -> CaseOutcome:
-    """Solve one bundled wall with every run and compare every pair of results."""
+def method_of(label: str) -> str:
+    """The solver of a run label (``la (highs)`` -> ``la``)."""
+    return label.split(" (")[0]
+
+
+def compared_pairs(labels: list[str]) -> list[tuple[int, int]]:
+    """Indices of the pairs to score: every pair of runs of the same method (la's backends),
+    and each method's first run against every other method's first run."""
+    first: dict[str, int] = {}
+    for i, label in enumerate(labels):
+        first.setdefault(method_of(label), i)
+    leads = list(first.values())
+    same = [(i, j) for i in range(len(labels)) for j in range(i + 1, len(labels))
+            if method_of(labels[i]) == method_of(labels[j])]
+    cross = [(i, j) for k, i in enumerate(leads) for j in leads[k + 1:]]
+    return sorted(same + cross)
+
+
+def solve_case(
+    case: str, title: str, runs: list[Run], echo: Callable[[str], None], skipped: set[tuple[str, str]] = frozenset()
+) -> CaseOutcome:
+    """Solve one bundled wall with every run (but the skipped methods) and score the pairs of compared_pairs."""
     model = mf.open_model(case)
     results, failures, seconds = [], [], {}
     for run in runs:
+        if (run.solver, case) in skipped:
+            failures.append((run.label, SKIPPED))
+            echo(f"  {run.label}: skipped")
+            continue
         start = time.perf_counter()
         try:
             results.append(mf.solve(model, run.solver, run.options))
@@ -92,9 +164,10 @@ def solve_case(case: str, title: str, runs: list[Run], echo: Callable[[str], Non
             continue
         seconds[run.label] = time.perf_counter() - start
         echo(f"  {run.label}: {seconds[run.label]:.2f} s")
+    labels = [solver_label(r) for r in results]
     comparisons = [
-        (solver_label(a), solver_label(b), mf.compare(a, b, "crack", {"threshold": DEFAULT_THRESHOLD}))
-        for i, a in enumerate(results) for b in results[i + 1:]
+        (labels[i], labels[j], mf.compare(results[i], results[j], "crack", {"threshold": DEFAULT_THRESHOLD}))
+        for i, j in compared_pairs(labels)
     ]
     return CaseOutcome(case, title, results, failures, comparisons, seconds)
 
@@ -117,15 +190,51 @@ def _cell(comparison: xr.Dataset, name: str | None, number: str) -> str:
     return number.format(comparison[name].item()) if name in comparison else "-"
 
 
+def headline(result: xr.Dataset) -> str:
+    """A method's own number: the collapse multiplier alpha (la) or the reaction drop 1 - R_min/R_dead (fdem, jmm).
+
+    R_dead is the moving support's reaction after gravity (step 0), R_min the
+    smallest reaction of the settlement history. A run that stopped for another
+    reason than a reaction plateau says why (its drop may still be growing).
+    """
+    if "collapse_multiplier" in result:
+        return f"alpha {float(result.collapse_multiplier.values):.4f}"
+    if "step_reaction" in result and result.step_reaction.size > 1:
+        reaction = result.step_reaction.values
+        reason = str(result.attrs.get(f"{result.attrs.get('solver', '')}_stop_reason", ""))
+        note = f" ({reason})" if reason and "plateau" not in reason else ""
+        return f"drop {1.0 - reaction.min() / reaction[0]:.3f}{note}"
+    return "-"
+
+
+def _pairs(outcomes: list[CaseOutcome], same_method: bool) -> list[tuple[CaseOutcome, str, str, xr.Dataset]]:
+    return [(o, la, lb, c) for o in outcomes for la, lb, c in o.comparisons
+            if (method_of(la) == method_of(lb)) == same_method]
+
+
+def _table(header: list[str], rows: list[str]) -> str:
+    return "\n".join(["| " + " | ".join(header) + " |", "|" + "---|" * len(header), *rows])
+
+
 def agreement_table(outcomes: list[CaseOutcome]) -> str:
-    """Markdown table: one row per wall and pair of results."""
-    header = "| wall | A | B | " + " | ".join(h for h, _, _ in SCORE_COLUMNS) + " |"
-    rule = "|" + "---|" * (3 + len(SCORE_COLUMNS))
+    """Markdown table of the method-against-method pairs: one row per wall and pair, with each method's headline."""
+    columns = [c for c in SCORE_COLUMNS if not c[0].startswith("alpha")]
+    rows = []
+    for o, la, lb, c in _pairs(outcomes, same_method=False):
+        by_label = {solver_label(r): r for r in o.results}
+        cells = [o.title, la, lb, headline(by_label[la]) if la in by_label else "-",
+                 headline(by_label[lb]) if lb in by_label else "-", *(_cell(c, name, fmt) for _, name, fmt in columns)]
+        rows.append("| " + " | ".join(cells) + " |")
+    return _table(["wall", "A", "B", "A's number", "B's number", *(h for h, _, _ in columns)], rows)
+
+
+def backend_table(outcomes: list[CaseOutcome]) -> str:
+    """Markdown table of the pairs of runs of one method (la's LP backends): one row per wall and pair."""
     rows = [
         f"| {o.title} | {la} | {lb} | " + " | ".join(_cell(c, name, fmt) for _, name, fmt in SCORE_COLUMNS) + " |"
-        for o in outcomes for la, lb, c in o.comparisons
+        for o, la, lb, c in _pairs(outcomes, same_method=True)
     ]
-    return "\n".join([header, rule, *rows])
+    return _table(["wall", "A", "B", *(h for h, _, _ in SCORE_COLUMNS)], rows)
 
 
 def timing_table(outcomes: list[CaseOutcome], runs: list[Run]) -> str:
@@ -135,7 +244,9 @@ def timing_table(outcomes: list[CaseOutcome], runs: list[Run]) -> str:
     rows = []
     for o in outcomes:
         failed = dict(o.failures)
-        cells = [f"{o.seconds[r.label]:.2f}" if r.label in o.seconds else f"failed ({failed.get(r.label, '?')})" for r in runs]
+        cells = [f"{o.seconds[r.label]:.2f}" if r.label in o.seconds
+                 else SKIPPED if failed.get(r.label) == SKIPPED
+                 else f"failed ({failed[r.label]})" if r.label in failed else "-" for r in runs]
         rows.append(f"| {o.title} | " + " | ".join(cells) + " |")
     return "\n".join([header, rule, *rows])
 
@@ -145,15 +256,27 @@ INTRODUCTION = """\
 
 Regenerated, together with the pictures in `docs/gallery/`, by one command:
 
-    masonryfw gallery -o docs/gallery --agreement docs/agreement.md
+    {command}
 
-Every bundled wall is solved by every installed method; every pair of results
-of the same wall is scored by the `crack` comparator of the `compare` plugin
-(`masonryfw compare A B --json` gives the same numbers for two result files).
-Result A is the reference of a pair.
+Every bundled wall is solved by every chosen method (`--method`, default all
+installed among la, fdem, jmm) with the options named on that command line
+(`--option METHOD.KEY=VALUE`; the others are the solvers' defaults, see
+`masonryfw plugins`); `--skip METHOD:CASE` leaves a method out on a wall. Each
+method's first run is scored against every other method's (the main table), and
+the runs of one method against each other (la's three LP backends, the second
+table), by the `crack` comparator of the `compare` plugin (`masonryfw compare A B
+--json` gives the same numbers for two result files). Result A is the reference
+of a pair.
 
 ## The scores
 
+- **A's / B's number**: each method's headline: the collapse multiplier **alpha** of
+  the limit analysis (the share of the moving support's dead load W L_m / L_total,
+  docs/architecture.md, it can lose before a mechanism forms), the reaction **drop** 1 - R_min/R_dead of the
+  incremental methods (R_dead the moving support's reaction after gravity, R_min
+  the smallest of the settlement history). Both measure how much of its load the
+  settling support sheds at collapse, so they are comparable, though not equal
+  by construction.
 - **cracks A/B/both**: interfaces with `crack_indicator > {threshold}` in A, in B, in both.
   The threshold: `crack_indicator` is normalised to 1 at the joint that takes the
   largest part in the failure; 0.1 keeps every joint moving at least a tenth as
@@ -204,39 +327,74 @@ def observations(outcomes: list[CaseOutcome]) -> str:
         if scored and same < len(pairs):
             title, la, lb, c = min(scored, key=lambda p: p[3].crack_f1.item())
             lines.append(f"Lowest F1: {c.crack_f1.item():.2f} ({title}, {la} vs {lb}).")
-    failed = [f"{label} on {o.title} ({message})" for o in outcomes for label, message in o.failures]
+    failed = [f"{label} on {o.title} ({message})" for o in outcomes for label, message in o.failures
+              if message != SKIPPED]
     if failed:
         lines.append("Failed solves (left out of the table): " + "; ".join(failed) + ".")
+    skipped = [f"{label} on {o.title}" for o in outcomes for label, message in o.failures if message == SKIPPED]
+    if skipped:
+        lines.append("Not run (--skip): " + "; ".join(skipped) + ".")
     return " ".join(lines)
 
 
-def agreement_markdown(outcomes: list[CaseOutcome], runs: list[Run], missing: list[str]) -> str:
-    """The whole of docs/agreement.md."""
-    parts = [INTRODUCTION.format(threshold=DEFAULT_THRESHOLD)]
+DEFAULT_COMMAND = "masonryfw gallery -o docs/gallery --agreement docs/agreement.md"
+
+
+def gallery_command_line(
+    output: str, agreement: str, methods: list[str] | tuple[str, ...] = (), options: list[str] | tuple[str, ...] = (),
+    skips: list[str] | tuple[str, ...] = (), cases: list[str] | tuple[str, ...] = (), notes: str | None = None,
+) -> str:
+    """The one shell command that regenerates a gallery with these choices."""
+    words = ["masonryfw", "gallery", "-o", str(output), "--agreement", str(agreement)]
+    for flag, values in (("--method", methods), ("--option", options), ("--skip", skips), ("--case", cases)):
+        for value in values:
+            words += [flag, value]
+    if notes is not None:
+        words += ["--notes", str(notes)]
+    return shlex.join(words)
+
+
+def agreement_markdown(
+    outcomes: list[CaseOutcome], runs: list[Run], missing: list[str], command: str = DEFAULT_COMMAND,
+    notes: str = "",
+) -> str:
+    """The whole of docs/agreement.md (``notes``: hand-written markdown put in as its Discussion section)."""
+    parts = [INTRODUCTION.format(threshold=DEFAULT_THRESHOLD, command=command)]
     installed = sorted({r.solver for r in runs})
     parts.append("## Status\n")
     parts.append(
-        f"Methods installed: {', '.join(installed) or 'none'}. "
-        + (f"Not installed (skipped): {', '.join(missing)}." if missing else "All three methods are installed.")
+        f"Methods run: {', '.join(installed) or 'none'}."
+        + (f" Not installed or not chosen (skipped): {', '.join(missing)}." if missing else "")
     )
-    if missing:
+    options = {r.solver: {k: v for k, v in r.options.items() if not (r.solver == "la" and k == "solver")}
+               for r in runs}
+    given = "; ".join(f"{m}: `{json.dumps(o)}`" for m, o in options.items() if o)
+    parts.append(f"\nSolver options other than the defaults: {given or 'none'}.")
+    if len(installed) < 2:
         parts.append(
-            "\nThe method-against-method comparisons (la vs fdem, la vs jmm, fdem vs jmm) await "
-            f"{' and '.join(missing)}. Until then the table compares the three LP backends of the "
-            "limit analysis with each other. They should reach the same collapse multiplier; where the "
-            "optimum is degenerate (several mechanisms with the same alpha) each may pick another "
-            "mechanism - highs a vertex of the optimal face, clarabel its centre, osqp the "
-            "minimum-norm one - and the scores measure how far apart those are."
+            "\nWith a single method there is no method-against-method comparison; the second table "
+            "compares the three LP backends of the limit analysis with each other."
         )
+    parts.append(
+        "\nThe LP backends should reach the same collapse multiplier; where the optimum is "
+        "degenerate (several mechanisms with the same alpha) each may pick another mechanism - "
+        "highs a vertex of the optimal face, clarabel its centre, osqp the minimum-norm one - and "
+        "the second table measures how far apart those are."
+    )
     found = observations(outcomes)
     if found:
         parts.append("\n" + found)
-    parts.append("\n## Pairwise scores\n")
+    parts.append("\n## Method against method\n")
     parts.append(agreement_table(outcomes))
+    parts.append("\n## LA backends against each other\n")
+    parts.append(backend_table(outcomes))
+    if notes.strip():
+        parts.append("\n## Discussion\n")
+        parts.append(notes.strip())
     parts.append("\n## Solve times [s]\n")
     parts.append(timing_table(outcomes, runs))
-    options = json.dumps({"threshold": DEFAULT_THRESHOLD})
-    parts.append(f"\nComparator options: `{options}`; masonryfw {mf.__version__}.\n")
+    comparator = json.dumps({"threshold": DEFAULT_THRESHOLD})
+    parts.append(f"\nComparator options: `{comparator}`; masonryfw {mf.__version__}.\n")
     return "\n".join(parts)
 
 
@@ -245,27 +403,44 @@ def run_gallery(
     agreement: Path,
     cases: list[str] | None = None,
     echo: Callable[[str], Any] = print,
+    methods: list[str] | None = None,
+    options: list[str] | tuple[str, ...] = (),
+    skips: list[str] | tuple[str, ...] = (),
+    command: str = DEFAULT_COMMAND,
+    notes: Path | None = None,
 ) -> list[Path]:
-    """Solve, draw and score every (or the named) bundled wall; returns the files written."""
+    """Solve, draw and score every (or the named) bundled wall with the chosen methods; returns the files written.
+
+    ``options`` are ``METHOD.KEY=VALUE`` strings, ``skips`` ``METHOD:CASE`` strings;
+    ``command`` is written at the top of the agreement file, the markdown file
+    ``notes`` (the discussion of a run's disagreements) as its Discussion section.
+    """
     bundled = mf.bundled_cases()
     unknown = sorted(set(cases or []) - set(bundled))
     if unknown:
         raise mf.MasonryError(f"unknown case(s) {', '.join(unknown)}; bundled cases: {', '.join(bundled)}")
-    runs, missing = planned_runs()
+    skipped = parse_skips(skips)
+    unknown_skips = sorted({case for _, case in skipped} - set(bundled))
+    if unknown_skips:
+        raise mf.MasonryError(
+            f"--skip names unknown case(s) {', '.join(unknown_skips)}; bundled cases: {', '.join(bundled)}")
+    runs, missing = planned_runs(methods, parse_method_options(options))
     for name in missing:
         echo(f"skipping {name}: solver not installed")
     if not runs:
         raise mf.PluginError(f"none of the solvers {', '.join(METHODS)} is installed")
+    notes_text = notes.read_text() if notes is not None else ""
+    output.mkdir(parents=True, exist_ok=True)
     written, outcomes = [], []
     for case in cases or list(bundled):
         echo(f"{case}:")
-        outcome = solve_case(case, bundled[case], runs, echo)
+        outcome = solve_case(case, bundled[case], runs, echo, skipped)
         outcomes.append(outcome)
         figure = case_figure(outcome, output / f"{case}.png")
         if figure is not None:
             written.append(figure)
     agreement.parent.mkdir(parents=True, exist_ok=True)
     temporary = agreement.with_name(f".{agreement.name}.tmp")
-    temporary.write_text(agreement_markdown(outcomes, runs, missing))
+    temporary.write_text(agreement_markdown(outcomes, runs, missing, command, notes_text))
     temporary.replace(agreement)
     return written + [agreement]

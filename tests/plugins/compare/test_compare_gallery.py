@@ -7,7 +7,19 @@ from PIL import Image
 
 import masonryfw as mf
 from masonryfw_compare.commands import gallery_command
-from masonryfw_compare.gallery import CaseOutcome, Run, agreement_markdown, case_figure, planned_runs
+from masonryfw_compare.gallery import (
+    CaseOutcome,
+    Run,
+    agreement_markdown,
+    case_figure,
+    compared_pairs,
+    gallery_command_line,
+    headline,
+    parse_method_options,
+    parse_skips,
+    planned_runs,
+    run_gallery,
+)
 
 
 def _outcome(build, results) -> CaseOutcome:
@@ -21,15 +33,20 @@ def _outcome(build, results) -> CaseOutcome:
 
 
 def test_agreement_table_holds_the_scores_and_says_what_is_missing(build, results):
-    runs = [Run("la (highs)", "la"), Run("la (clarabel)", "la"), Run("la (osqp)", "la")]
-    text = agreement_markdown([_outcome(build, results)], runs, ["fdem", "jmm"])
+    runs = [Run("la (highs)", "la", {"solver": "highs"}), Run("la (clarabel)", "la", {"solver": "clarabel"}),
+            Run("la (osqp)", "la", {"solver": "osqp"}), Run("jmm", "jmm", {"max_steps": "40"})]
+    command = "masonryfw gallery -o docs/gallery --agreement docs/agreement.md --option jmm.max_steps=40"
+    text = agreement_markdown([_outcome(build, results)], runs, ["fdem"], command)
     assert text.startswith("# Agreement between methods")
-    assert "masonryfw gallery -o docs/gallery --agreement docs/agreement.md" in text
-    assert "await fdem and jmm" in text
+    assert f"\n    {command}\n" in text
+    assert "Not installed or not chosen (skipped): fdem." in text
+    assert 'Solver options other than the defaults: jmm: `{"max_steps": "40"}`.' in text
     assert "In this run 1 of 2 pairs found the same failure" in text
     assert "Lowest F1: 0.00 (Grid wall, la (highs) vs la (clarabel))." in text
     assert "Failed solves (left out of the table): la (osqp) on Grid wall (OSQP failed)." in text
-    rows = [line for line in text.splitlines() if line.startswith("| Grid wall |")]
+    method_part, backend_part = text.split("## LA backends against each other")
+    method_rows = [line for line in method_part.splitlines() if line.startswith("| Grid wall |")]
+    rows = [line for line in backend_part.splitlines() if line.startswith("| Grid wall |")]
     # la (highs) vs its crack shifted one column right (4 x 6 grid, crack after column 3 vs 4):
     # 4 cracks each, none shared; Spearman of the 0/1 indicators = phi = (0*36 - 4*4) / sqrt(4*40*4*40) = -0.1;
     # ARI of [[12, 0], [4, 8]]: (100 - 132*148/276) / (140 - 132*148/276) = 0.42;
@@ -38,9 +55,85 @@ def test_agreement_table_holds_the_scores_and_says_what_is_missing(build, result
         "| Grid wall | la (highs) | la (clarabel) | 0.3000 | 0.3000 | 4/4/0 | 0.00 | 0.00 | 0.00 | -0.10 | "
         "0.42 | 0.82 | 0.154 |"
     )
-    # la vs jmm: the same crack_indicator; no multiplier, partition or mechanism in jmm ("-")
-    assert rows[1].endswith("| - | - | 4/4/4 | 1.00 | 1.00 | 1.00 | 1.00 | - | - | 0.084 |")
-    assert rows[2] == "| Grid wall | 0.25 | 0.50 | failed (OSQP failed) |"
+    # la vs jmm, in the method table only: la's alpha 0.3; jmm's reaction 100 -> 90 N, drop 0.100;
+    # the same crack_indicator; no partition or mechanism in jmm ("-")
+    assert method_rows == [
+        "| Grid wall | la (highs) | jmm | alpha 0.3000 | drop 0.100 | 4/4/4 | 1.00 | 1.00 | 1.00 | 1.00 | - | - "
+        "| 0.084 |"
+    ]
+    assert rows[1] == "| Grid wall | 0.25 | 0.50 | failed (OSQP failed) | - |"
+
+
+def test_headline_is_alpha_or_the_reaction_drop(results):
+    assert headline(results["la"]) == "alpha 0.3000"
+    # fdem fake: R = 100 exp(-s / 1 mm) up to s = 5 mm, so 1 - R_min/R_dead = 1 - exp(-5) = 0.993
+    assert headline(results["fdem"]) == "drop 0.993"
+    # jmm fake: R = 100 - 10 sqrt(s / 5 mm), 100 N -> 90 N
+    assert headline(results["jmm"]) == "drop 0.100"
+    assert headline(results["jmm"].assign_attrs(jmm_stop_reason="reaction plateau")) == "drop 0.100"
+    assert headline(results["jmm"].assign_attrs(jmm_stop_reason="max_steps (40) reached")) == (
+        "drop 0.100 (max_steps (40) reached)")
+
+
+def test_only_backends_of_one_method_and_the_leads_of_methods_are_paired():
+    labels = ["la (highs)", "la (clarabel)", "la (osqp)", "fdem", "jmm"]
+    # 3 backend pairs + la (highs)/fdem, la (highs)/jmm, fdem/jmm; never la (clarabel) vs fdem
+    assert compared_pairs(labels) == [(0, 1), (0, 2), (0, 3), (0, 4), (1, 2), (3, 4)]
+    assert compared_pairs(["la (clarabel)", "jmm"]) == [(0, 1)]
+
+
+def test_method_options_and_skips_are_parsed_and_bad_ones_named():
+    assert parse_method_options(["jmm.mesh_size=0.05", "jmm.max_steps=40", "fdem.mode=rigid"]) == {
+        "jmm": {"mesh_size": "0.05", "max_steps": "40"}, "fdem": {"mode": "rigid"}}
+    assert parse_skips(["jmm:facade-1", "fdem:panel-2"]) == {("jmm", "facade-1"), ("fdem", "panel-2")}
+    with pytest.raises(mf.PluginError, match="'max_steps=40' is not METHOD.KEY=VALUE"):
+        parse_method_options(["max_steps=40"])
+    with pytest.raises(mf.PluginError, match="method 'fem' is not one of la, fdem, jmm"):
+        parse_method_options(["fem.max_steps=40"])
+    with pytest.raises(mf.PluginError, match="'jmm-facade-1' is not METHOD:CASE"):
+        parse_skips(["jmm-facade-1"])
+
+
+def test_planned_runs_follow_the_chosen_methods_and_check_their_options():
+    installed = {r.solver for r in planned_runs()[0]}
+    if not {"la", "jmm"} <= installed:
+        pytest.skip("needs la and jmm installed")
+    runs, missing = planned_runs(["jmm", "la"], {"jmm": {"max_steps": "40"}, "la": {"solver": "highs"}})
+    assert runs == [Run("jmm", "jmm", {"max_steps": "40"}), Run("la (highs)", "la", {"solver": "highs"})]
+    assert missing == []
+    with pytest.raises(mf.PluginError, match="jmm: unknown option.*mesh_sise"):
+        planned_runs(["jmm"], {"jmm": {"mesh_sise": "0.05"}})
+    with pytest.raises(mf.PluginError, match="option 'max_steps': cannot read 'many' as int"):
+        planned_runs(["jmm"], {"jmm": {"max_steps": "many"}})
+    with pytest.raises(mf.PluginError, match="options given for fdem, which is not among the methods run"):
+        planned_runs(["la"], {"fdem": {"mode": "rigid"}})
+    with pytest.raises(mf.PluginError, match="method\\(s\\) fem: not one of"):
+        planned_runs(["fem"])
+
+
+def test_command_line_reproduces_the_choices():
+    line = gallery_command_line("docs/gallery", "docs/agreement.md", ["la", "jmm"], ["jmm.mesh_size=0.05"],
+                                ["jmm:facade-1"], ["test-8c"], "my notes.md")
+    assert line == ("masonryfw gallery -o docs/gallery --agreement docs/agreement.md --method la --method jmm "
+                    "--option jmm.mesh_size=0.05 --skip jmm:facade-1 --case test-8c --notes 'my notes.md'")
+
+
+def test_a_skipped_method_is_reported_and_not_run(tmp_path):
+    if "la" not in {r.solver for r in planned_runs()[0]}:
+        pytest.skip("needs la installed")
+    lines = []
+    (tmp_path / "notes.md").write_text("Test 8C: nothing to compare.\n")
+    written = run_gallery(tmp_path / "g", tmp_path / "agreement.md", ["test-8c"], echo=lines.append,
+                          methods=["la"], options=["la.solver=highs"], skips=["la:test-8c"], command="CMD",
+                          notes=tmp_path / "notes.md")
+    assert written == [tmp_path / "agreement.md"] and (tmp_path / "g").is_dir()
+    assert "  la (highs): skipped" in lines
+    text = (tmp_path / "agreement.md").read_text()
+    assert "| Test 8C | skipped (--skip) |" in text
+    assert "Not run (--skip): la (highs) on Test 8C." in text
+    assert "\n## Discussion\n\nTest 8C: nothing to compare.\n" in text
+    with pytest.raises(mf.MasonryError, match="--skip names unknown case"):
+        run_gallery(tmp_path / "g", tmp_path / "a.md", ["test-8c"], echo=lines.append, skips=["la:test-99"])
 
 
 def test_planned_runs_cover_the_installed_methods():
@@ -60,11 +153,28 @@ def test_case_figure_has_one_panel_per_result(build, results, tmp_path):
 
 @pytest.mark.slow
 def test_the_gallery_command_solves_draws_and_scores_a_bundled_wall(tmp_path):
-    outcome = CliRunner().invoke(
-        gallery_command, ["-o", str(tmp_path / "gallery"), "--agreement", str(tmp_path / "agreement.md"),
-                          "--case", "test-12c"],
-    )
+    arguments = ["-o", str(tmp_path / "gallery"), "--agreement", str(tmp_path / "agreement.md"),
+                 "--method", "la", "--method", "fdem", "--case", "test-12c"]
+    outcome = CliRunner().invoke(gallery_command, arguments)
     assert outcome.exit_code == 0, outcome.output
     assert (tmp_path / "gallery" / "test-12c.png").stat().st_size > 10_000
     text = (tmp_path / "agreement.md").read_text()
+    assert "    masonryfw gallery " + " ".join(arguments) + "\n" in text
     assert "| Test 12C | la (highs) | la (clarabel) |" in text
+    assert "| Test 12C | la (highs) | fdem | alpha " in text
+
+
+def test_the_command_passes_methods_and_options_and_writes_its_own_line(tmp_path):
+    if "la" not in {r.solver for r in planned_runs()[0]}:
+        pytest.skip("needs la installed")
+    arguments = ["-o", str(tmp_path / "gallery"), "--agreement", str(tmp_path / "agreement.md"),
+                 "--method", "la", "--option", "la.solver=highs", "--case", "test-8c"]
+    outcome = CliRunner().invoke(gallery_command, arguments)
+    assert outcome.exit_code == 0, outcome.output
+    assert "la (highs)" in outcome.output and "clarabel" not in outcome.output
+    text = (tmp_path / "agreement.md").read_text()
+    assert "    masonryfw gallery " + " ".join(arguments) + "\n" in text
+    assert "| wall | la (highs) |\n|---|---|\n| Test 8C | " in text
+    # a misspelt option fails before any wall is solved
+    bad = CliRunner().invoke(gallery_command, [*arguments[:4], "--option", "la.solvr=highs"])
+    assert bad.exit_code != 0 and "unknown option(s) solvr" in str(bad.exception)
