@@ -34,7 +34,7 @@ from .scene import Scene, name_list
 
 jit = njit(cache=True, error_model="numpy")
 # the element loop has no nan/inf logic: fastmath (fused multiply-adds) makes it ~25 % faster
-fast_jit = njit(cache=True, error_model="numpy", fastmath=True)
+fast_jit = njit(cache=True, error_model="numpy", fastmath=True, boundscheck=False)
 
 
 @dataclass
@@ -168,45 +168,74 @@ def prev_edge(offs: np.ndarray) -> np.ndarray:
     return idx
 
 
+@jit
+def element_constants(triangles, grad_x, grad_y, area0, young, poisson, active_tri):
+    """The active elements and their constants packed for :func:`cst_element_forces`.
+
+    Returns ``(active triangles (n, 3), constants (n, 8))`` with the constants of an element
+    contiguous in one row: ``dN/dX`` of its 3 nodes, ``dN/dY`` of its 3 nodes,
+    ``A0 E t / (1 - nu^2)`` and ``nu``. The element loop then reads one cache line per element
+    and does no division (measured: 1.2-1.5x the throughput of seven separate arrays).
+    """
+    keep = np.flatnonzero(active_tri)
+    tri = np.empty((keep.size, 3), dtype=np.int64)
+    constants = np.empty((keep.size, 8))
+    for i in range(keep.size):
+        e = keep[i]
+        for j in range(3):
+            tri[i, j] = triangles[e, j]
+            constants[i, j] = grad_x[e, j]
+            constants[i, 3 + j] = grad_y[e, j]
+        constants[i, 6] = area0[e] * young[e] / (1.0 - poisson[e] * poisson[e])
+        constants[i, 7] = poisson[e]
+    return tri, constants
+
+
 @fast_jit
-def cst_forces(x, y, triangles, grad_x, grad_y, area0, young, poisson, active_tri, force):
-    """Add the internal forces of every active CST to ``force`` (node, 2); returns the strain energy.
+def cst_element_forces(x, y, triangles, constants, force):
+    """Add the internal forces of the CSTs (packed by :func:`element_constants`) to ``force``
+    (node, 2); returns the strain energy.
 
     Deformation gradient ``F = sum_i x_i grad N_i``, Green strain ``E = (F^T F - I) / 2``,
     plane-stress ``S = D E``, first Piola ``P = F S``, nodal force ``-A0 P grad N_i``.
     """
     energy = 0.0
     for e in range(triangles.shape[0]):
-        if not active_tri[e]:
-            continue
         n0, n1, n2 = triangles[e, 0], triangles[e, 1], triangles[e, 2]
-        bx0, bx1, bx2 = grad_x[e, 0], grad_x[e, 1], grad_x[e, 2]
-        by0, by1, by2 = grad_y[e, 0], grad_y[e, 1], grad_y[e, 2]
-        f11 = x[n0] * bx0 + x[n1] * bx1 + x[n2] * bx2
-        f12 = x[n0] * by0 + x[n1] * by1 + x[n2] * by2
-        f21 = y[n0] * bx0 + y[n1] * bx1 + y[n2] * bx2
-        f22 = y[n0] * by0 + y[n1] * by1 + y[n2] * by2
+        bx0, bx1, bx2 = constants[e, 0], constants[e, 1], constants[e, 2]
+        by0, by1, by2 = constants[e, 3], constants[e, 4], constants[e, 5]
+        stiffness, nu = constants[e, 6], constants[e, 7]
+        x0, x1, x2, y0, y1, y2 = x[n0], x[n1], x[n2], y[n0], y[n1], y[n2]
+        f11 = x0 * bx0 + x1 * bx1 + x2 * bx2
+        f12 = x0 * by0 + x1 * by1 + x2 * by2
+        f21 = y0 * bx0 + y1 * bx1 + y2 * bx2
+        f22 = y0 * by0 + y1 * by1 + y2 * by2
         e11 = 0.5 * (f11 * f11 + f21 * f21 - 1.0)
         e22 = 0.5 * (f12 * f12 + f22 * f22 - 1.0)
         e12 = 0.5 * (f11 * f12 + f21 * f22)
-        nu = poisson[e]
-        c = young[e] / (1.0 - nu * nu)
-        s11 = c * (e11 + nu * e22)
-        s22 = c * (e22 + nu * e11)
-        s12 = c * (1.0 - nu) * e12
-        a = area0[e]
-        energy += 0.5 * a * (s11 * e11 + s22 * e22 + 2.0 * s12 * e12)
-        p11 = a * (f11 * s11 + f12 * s12)
-        p12 = a * (f11 * s12 + f12 * s22)
-        p21 = a * (f21 * s11 + f22 * s12)
-        p22 = a * (f21 * s12 + f22 * s22)
+        s11 = stiffness * (e11 + nu * e22)  # A0 times the second Piola-Kirchhoff stress
+        s22 = stiffness * (e22 + nu * e11)
+        s12 = stiffness * (1.0 - nu) * e12
+        energy += s11 * e11 + s22 * e22 + 2.0 * s12 * e12
+        p11 = f11 * s11 + f12 * s12
+        p12 = f11 * s12 + f12 * s22
+        p21 = f21 * s11 + f22 * s12
+        p22 = f21 * s12 + f22 * s22
         force[n0, 0] -= p11 * bx0 + p12 * by0
         force[n0, 1] -= p21 * bx0 + p22 * by0
         force[n1, 0] -= p11 * bx1 + p12 * by1
         force[n1, 1] -= p21 * bx1 + p22 * by1
         force[n2, 0] -= p11 * bx2 + p12 * by2
         force[n2, 1] -= p21 * bx2 + p22 * by2
-    return energy
+    return 0.5 * energy
+
+
+@jit
+def cst_forces(x, y, triangles, grad_x, grad_y, area0, young, poisson, active_tri, force):
+    """Add the internal forces of every active CST to ``force`` (node, 2); returns the strain energy
+    (:func:`cst_element_forces` on the packed constants; the time loop packs them once per call)."""
+    tri, constants = element_constants(triangles, grad_x, grad_y, area0, young, poisson, active_tri)
+    return cst_element_forces(x, y, tri, constants, force)
 
 
 @jit
@@ -313,11 +342,9 @@ def node_contact_forces(x, y, vel, offs, faces, props, kn, kt, min_half, contact
 
 
 @jit
-def driven_motion(settlement, rate, x0, y0, node_block, driven, pos0, direction, x, y, vel):
+def driven_motion(settlement, rate, x0, y0, node_block, driven_nodes, pos0, direction, x, y, vel):
     """Positions and velocities of the support nodes: rigid motion ``pos0 + settlement * direction``."""
-    for k in range(x0.size):
-        if not driven[k]:
-            continue
+    for k in driven_nodes:
         b = node_block[k]
         theta = settlement * direction[b, 2]
         c, s = np.cos(theta), np.sin(theta)
@@ -338,56 +365,64 @@ def advance(n_steps, dt, x, y, vel, x0, y0, x_detect, y_detect, offs, node_block
     damping, the loads, the supports, the stop conditions and ``out``; stored energy = strain + springs)."""
     n_node = x.size
     force = np.zeros((n_node, 2))
+    elements, constants = element_constants(triangles, grad_x, grad_y, area0, young, poisson, active_tri)
+    driven_nodes = np.flatnonzero(driven)
     steps = 0
     rebuild = 0
     load_norm = 0.0
     for k in range(n_node):
         load_norm += abs(load[k, 0]) + abs(load[k, 1])
+    limit = half_buffer * half_buffer
     for step in range(n_steps):
-        force[:, :] = 0.0
         time = acc[TIME]
         rate_now = settlement_rate(time + 0.5 * dt, rate, ramp_time, start_time)
-        driven_motion(acc[SETTLEMENT], rate_now, x0, y0, node_block, driven, pos0, direction, x, y, vel)
-        cst_forces(x, y, triangles, grad_x, grad_y, area0, young, poisson, active_tri, force)
+        driven_motion(acc[SETTLEMENT], rate_now, x0, y0, node_block, driven_nodes, pos0, direction, x, y, vel)
+        cst_element_forces(x, y, elements, constants, force)
         node_contact_forces(x, y, vel, offs, faces, props, kn, kt, min_half, contact_damping, inv_mass, dt,
                             shear, bonded, normal, energy, force, acc, True)
         load_share = 1.0
         if time < load_ramp:
             load_share = 0.5 * (1.0 - np.cos(np.pi * time / load_ramp))
+        # one pass over the nodes: velocity, position, distance since the detection; the force
+        # buffer is cleared behind it for the next step
+        moved = 0.0
+        work_gravity = 0.0
+        damping_work = 0.0
         for k in range(n_node):
             if driven[k]:
-                acc[WORK_SUPPORT] -= (force[k, 0] * vel[k, 0] + force[k, 1] * vel[k, 1]) * dt
                 continue
             for d in range(2):
                 f = force[k, d] + load_share * load[k, d]
+                force[k, d] = 0.0
                 v_old = vel[k, d]
-                damp = 0.0
-                if v_old > 0.0:
-                    damp = -damping * abs(f)
-                elif v_old < 0.0:
-                    damp = damping * abs(f)
-                v_new = v_old + dt * (f + damp) / mass[k]
+                damp = -damping * abs(f) * np.sign(v_old)  # branch-free (0 at rest)
+                v_new = v_old + dt * (f + damp) * inv_mass[k]
                 vel[k, d] = v_new
-                acc[WORK_GRAVITY] += load_share * load[k, d] * v_new * dt
-                acc[DISSIPATED_DAMPING] -= damp * v_new * dt
+                work_gravity += load_share * load[k, d] * v_new
+                damping_work -= damp * v_new
+            x[k] += dt * vel[k, 0]
+            y[k] += dt * vel[k, 1]
+            dx, dy = x[k] - x_detect[k], y[k] - y_detect[k]
+            moved = max(moved, dx * dx + dy * dy)
+        acc[WORK_GRAVITY] += work_gravity * dt
+        acc[DISSIPATED_DAMPING] += damping_work * dt
+        for k in driven_nodes:
+            acc[WORK_SUPPORT] -= (force[k, 0] * vel[k, 0] + force[k, 1] * vel[k, 1]) * dt
+            force[k, 0] = force[k, 1] = 0.0
         acc[SETTLEMENT] += rate_now * dt
-        moved = 0.0
-        for k in range(n_node):
-            if not driven[k]:
-                x[k] += dt * vel[k, 0]
-                y[k] += dt * vel[k, 1]
-        driven_motion(acc[SETTLEMENT], rate_now, x0, y0, node_block, driven, pos0, direction, x, y, vel)
-        for k in range(n_node):
-            moved = max(moved, np.hypot(x[k] - x_detect[k], y[k] - y_detect[k]))
+        driven_motion(acc[SETTLEMENT], rate_now, x0, y0, node_block, driven_nodes, pos0, direction, x, y, vel)
+        for k in driven_nodes:
+            dx, dy = x[k] - x_detect[k], y[k] - y_detect[k]
+            moved = max(moved, dx * dx + dy * dy)
         acc[TIME] = time + dt
         steps += 1
-        if moved > half_buffer:
+        if moved > limit:
             rebuild = 1
             break
         if target > 0.0 and acc[SETTLEMENT] >= target:
             break
     force[:, :] = 0.0
-    strain = cst_forces(x, y, triangles, grad_x, grad_y, area0, young, poisson, active_tri, force)
+    strain = cst_element_forces(x, y, elements, constants, force)
     springs = node_contact_forces(x, y, vel, offs, faces, props, kn, kt, min_half, contact_damping, inv_mass,
                                   dt, shear, bonded, normal, energy, force, acc, False)
     reaction = 0.0

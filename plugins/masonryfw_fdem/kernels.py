@@ -195,6 +195,43 @@ def carry_history(old_keys, old_shear, old_bonded, old_energy, new_keys, new_she
 
 
 @jit
+def wake_sleepers(pos, vel, vx, vy, offs, faces, kn, min_half, normal, active, driven, calm, wake_speed):
+    """Wake every sleeping block with a contact end shared with an active block that moves
+    faster than ``wake_speed`` or has lost half its compression (the sleeper's support goes).
+
+    Runs before the force loop: a block woken inside it would miss the forces of the pairs
+    with other sleepers already skipped, move for one step without them, and the energy of
+    those springs would change with its motion, made from nothing (the energy leak of the
+    first version: 3.7 % on the small test wall, ~20 % on Facade 3).
+    """
+    for f in range(faces.shape[0]):
+        a, ea, b, eb = faces[f, 0], faces[f, 1], faces[f, 2], faces[f, 3]
+        if active[a] == active[b]:
+            continue
+        sleeper = a if not active[a] else b
+        if driven[sleeper]:
+            continue
+        g = face_geometry(vx, vy, offs, a, ea, b, eb)
+        nx, ny, ox, oy, s_lo, s_hi = g[0], g[1], g[2], g[3], g[4], g[5]
+        half = 0.5 * (s_hi - s_lo)
+        if half <= min_half:
+            continue
+        for e in range(2):
+            s = s_lo if e == 0 else s_hi
+            h = g[8] if e == 0 else g[9]
+            px = ox + s * ny + h * nx
+            py = oy - s * nx + h * ny
+            dvx = (vel[b, 0] - vel[b, 2] * (py - pos[b, 1])) - (vel[a, 0] - vel[a, 2] * (py - pos[a, 1]))
+            dvy = (vel[b, 1] + vel[b, 2] * (px - pos[b, 0])) - (vel[a, 1] + vel[a, 2] * (px - pos[a, 0]))
+            fn_elastic = -kn * half * (g[6] if e == 0 else g[7])
+            losing = normal[f, e] > 0.0 and fn_elastic < 0.5 * normal[f, e]
+            if losing or np.hypot(dvx, dvy) > wake_speed:
+                active[sleeper] = 1
+                calm[sleeper] = 0
+                break
+
+
+@jit
 def contact_forces(pos, vel, vx, vy, offs, faces, props, kn, kt, min_half, contact_damping, inv_mass,
                    dt, shear, bonded, normal, energy, force, acc, update_history, active, driven, calm,
                    wake_speed):
@@ -217,9 +254,13 @@ def contact_forces(pos, vel, vx, vy, offs, faces, props, kn, kt, min_half, conta
     touching sliding, which has no normal relative velocity.
 
     Sleeping: a pair of two inactive blocks (asleep, or supports standing still) is
-    skipped, its forces and spring energy frozen. A sleeping block is woken when
-    a contact point it shares with an active block moves faster than ``wake_speed``.
+    skipped, its forces and spring energy frozen; :func:`wake_sleepers` runs first, so
+    every block integrated in this step gets all its contact forces. A loaded end sliding
+    or opening faster than ``wake_speed`` resets both blocks' calm counters: nothing
+    touched by a moving block falls asleep.
     """
+    if wake_speed > 0.0:
+        wake_sleepers(pos, vel, vx, vy, offs, faces, kn, min_half, normal, active, driven, calm, wake_speed)
     stored = 0.0
     for f in range(faces.shape[0]):
         a, ea, b, eb = faces[f, 0], faces[f, 1], faces[f, 2], faces[f, 3]
@@ -254,13 +295,6 @@ def contact_forces(pos, vel, vx, vy, offs, faces, props, kn, kt, min_half, conta
             dvx = (vel[b, 0] - vel[b, 2] * (py - pos[b, 1])) - (vel[a, 0] - vel[a, 2] * (py - pos[a, 1]))
             dvy = (vel[b, 1] + vel[b, 2] * (px - pos[b, 0])) - (vel[a, 1] + vel[a, 2] * (px - pos[a, 0]))
             opening_rate = dvx * nx + dvy * ny
-            if wake_speed > 0.0 and (not active[a] or not active[b]):
-                # wake on a fast partner, or on a loaded end losing compression (the sleeper's support goes)
-                losing = normal[f, e] > 0.0 and fn_elastic < 0.5 * normal[f, e]
-                sleeper = a if not active[a] else b
-                if not driven[sleeper] and (losing or np.hypot(dvx, dvy) > wake_speed):
-                    active[sleeper] = 1
-                    calm[sleeper] = 0
             ft = shear[f, e]
             if bonded[f, e] and fn_elastic < -ten and update_history:
                 bonded[f, e] = 0
@@ -272,6 +306,8 @@ def contact_forces(pos, vel, vx, vy, offs, faces, props, kn, kt, min_half, conta
                 normal[f, e] = 0.0
                 energy[f, e] = 0.0
                 continue
+            if wake_speed > 0.0 and np.hypot(dvx, dvy) > wake_speed:
+                calm[a] = calm[b] = 0  # touched by something moving: neither may fall asleep
             fn = fn_elastic - dashpot * opening_rate
             if not bonded[f, e] and fn < 0.0:
                 fn = 0.0
@@ -404,9 +440,11 @@ def advance(n_steps, dt, pos, vel, pos0, pos_detect, radius, lx, ly, offs, faces
                 if sleeping:
                     speed = np.hypot(vel[i, 0], vel[i, 1]) + abs(vel[i, 2]) * radius[i]
                     calm[i] = calm[i] + 1 if speed < sleep_speed else 0
-                    if calm[i] >= sleep_steps:
+                    if calm[i] >= sleep_steps:  # the kinetic energy it still had is dissipated
                         active[i] = 0
-                        vel[i, 0] = vel[i, 1] = vel[i, 2] = 0.0
+                        for d in range(3):
+                            acc[DISSIPATED_DAMPING] += 0.5 * mass[i, d] * vel[i, d] * vel[i, d]
+                            vel[i, d] = 0.0
         acc[TIME] = time + dt
         steps += 1
         moved = 0.0
