@@ -102,6 +102,9 @@ def solve_clarabel(cost, constraints, live, tolerance) -> LPSolution:
     rhs = np.concatenate([[1.0], np.zeros(n_row)])
     settings = clarabel.DefaultSettings()
     settings.verbose = False
+    # "auto" picks faer (multithreaded supernodal) here; on these 2-D contact KKT systems QDLDL is
+    # 5x faster per iteration at 10,000 units (0.5 s vs 2.5 s) with bit-identical alpha.
+    settings.direct_solve_method = "qdldl"
     settings.tol_gap_abs = settings.tol_gap_rel = settings.tol_feas = tolerance
     settings.tol_ktratio = min(settings.tol_ktratio, tolerance)
     solver = clarabel.DefaultSolver(
