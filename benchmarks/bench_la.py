@@ -5,13 +5,15 @@ Writes the ``la`` section of docs/benchmarks.md. Run from the project root::
     python benchmarks/bench_la.py            # everything (about 5-10 minutes)
     python benchmarks/bench_la.py --quick    # sizes 100 and 1,000 only
 
-(a) every bundled wall with the three backends: median run time, alpha error
+(a) every bundled wall with the four backends: median run time, alpha error
     against HiGHS at tolerance 1e-10, and the crack pattern against HiGHS
     (share of cracked joints in common: |A and B| / |A or B|);
 (b) the macro-block count of every wall against the "intact" threshold;
 (c) the LP in other forms (multiplier form, static form) on two walls;
 (d) running-bond settlement walls of 100, 1,000 and 10,000 units: time per phase,
-    peak memory (each size in its own process: peak RSS), growth exponent.
+    peak memory (each size in its own process: peak RSS), growth exponent, iterations
+    and alpha against the exact vertex (HiGHS in the same run at 100 and 1,000 units;
+    at 10,000 units ``VERTEX_10K``).
 
 Wall-clock times depend on the machine's load; the CPU time of the process is
 reported beside them, and the load average at the start is printed.
@@ -38,11 +40,16 @@ from masonryfw_la import assembly, backends, solver
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from _report import write_section  # noqa: E402
 
-BACKENDS = ("highs", "clarabel", "osqp")
+BACKENDS = ("ipm", "clarabel", "highs", "osqp")
 REPEATS = 3
 THRESHOLDS = (1e-6, 1e-4, 1e-3, 1e-2, 5e-2)
 SIZES = {100: (10, 10), 1_000: (25, 40), 10_000: (80, 125)}  # units: (courses, units per course)
-BIG_WALL_BACKENDS = {100: BACKENDS, 1_000: ("clarabel", "highs"), 10_000: ("clarabel",)}  # osqp: 300 s at 1,000
+BIG_WALL_BACKENDS = {100: BACKENDS, 1_000: ("ipm", "clarabel", "highs"), 10_000: ("ipm", "clarabel")}  # osqp: 300 s at 1,000
+# alpha of the 10,000-unit wall: backends.solve_ipm at tolerance 1e-11 (86 iterations; its dual alpha is
+# 0.2357212999249, so the optimum lies in that 5e-11 bracket). At 1,000 units the same run is 1.1e-12 from
+# HiGHS's dual simplex vertex (0.317795703314560, 28 s); HiGHS at 10,000 units takes over 20 minutes.
+VERTEX_10K = 0.2357212999365
+WARM_UP_BELOW = 1_000  # units: these sizes are timed on a second solve in the same process
 
 
 def options(**given):
@@ -151,6 +158,8 @@ def other_forms() -> str:
         row("inequalities", "HiGHS IPM + crossover", g.shape, t, res.alpha_primal)
         t, res = clock(lambda: backends.solve_clarabel(c, g, a, 1e-9))
         row("inequalities (used)", "Clarabel", g.shape, t, res.alpha_primal)
+        t, res = clock(lambda: backends.solve_ipm(c, g, a, 1e-9))
+        row("inequalities (used)", "ipm (normal equations, CHOLMOD)", g.shape, t, res.alpha_primal)
         t, res = clock(lambda: linprog(cost, A_eq=eq, b_eq=rhs, bounds=bounds, method="highs-ds"))
         row("multipliers (eq. 9)", "HiGHS dual simplex", eq.shape, t, res.fun)
 
@@ -198,6 +207,8 @@ def one_size(size: int, backend: str) -> dict:
     """Solve one running-bond wall once (run in a child process: its peak RSS is this solve's)."""
     model = mf.derive_geometry(mf.build(running_bond_spec(*SIZES[size])))
     rss_before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    if size <= WARM_UP_BELOW:  # imports (cvxopt: 30 ms) and first calls would otherwise be most of the LP time
+        solver.solve(model, options(solver=backend))
     c0, t0 = time.process_time(), time.perf_counter()
     result = solver.solve(model, options(solver=backend))
     a = result.attrs
@@ -229,16 +240,19 @@ def growth(sizes: list[int], timeout: float) -> str:
                 runs.append(json.loads(out.stdout.strip().splitlines()[-1]))
             except subprocess.TimeoutExpired:
                 runs.append({"size": size, "backend": backend, "timeout": timeout})
+    vertex = {r["size"]: r["alpha"] for r in runs if r.get("backend") == "highs" and "alpha" in r}
+    vertex.setdefault(10_000, VERTEX_10K)
     rows = []
     for r in runs:
         if "timeout" in r:
-            rows.append(f"| {r['size']} | | {r['backend']} | | > {r['timeout']:.0f} s (stopped) | | | | | | |")
+            rows.append(f"| {r['size']} | | {r['backend']} | | > {r['timeout']:.0f} s (stopped) | | | | | | | | |")
             continue
         overhead = (r["assembly"] + r["post"]) / r["lp"]
+        error = f"{abs(r['alpha'] - vertex[r['size']]) / abs(vertex[r['size']]):.1e}" if r["size"] in vertex else "n/a"
         rows.append(
             f"| {r['size']} | {r['blocks']} | {r['backend']} | {r['rows']} x {r['columns']} | {r['total']:.2f} "
             f"| {r['cpu']:.2f} | {r['assembly']:.3f} | {r['lp']:.3f} | {r['post']:.3f} | {overhead:.0%} "
-            f"| {r['rss_peak_mib']:.0f} ({r['rss_peak_mib'] - r['rss_before_mib']:.0f}) |"
+            f"| {r['iterations']} | {error} | {r['rss_peak_mib']:.0f} ({r['rss_peak_mib'] - r['rss_before_mib']:.0f}) |"
         )
     exponents = []
     for backend in BACKENDS:
@@ -250,7 +264,8 @@ def growth(sizes: list[int], timeout: float) -> str:
             )
     return (
         "| units | blocks | backend | LP rows x columns | total [s] | CPU [s] | assembly [s] | LP [s] "
-        "| post [s] | overhead / LP | peak RSS MiB (solve's share) |\n|---|---|---|---|---|---|---|---|---|---|---|\n"
+        "| post [s] | overhead / LP | iterations | alpha rel. error vs vertex | peak RSS MiB (solve's share) |\n"
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n"
         + "\n".join(rows)
         + "\n\nGrowth: "
         + "; ".join(exponents)
@@ -283,16 +298,16 @@ def main(argv=None) -> None:
     )
     body = f"""
 Load average when the run started: {load:.1f} on {os.cpu_count()} cores (wall times grow with it; CPU
-times much less). Defaults: backend `clarabel`, tolerance 1e-9, crack threshold 1e-4.
+times much less). Defaults: backend `{solver.DEFAULT_BACKEND}`, tolerance 1e-9, crack threshold 1e-4.
 
-### (a) The three backends on the ten walls
+### (a) The four backends on the ten walls
 Median of {REPEATS} runs. "Same cracks as HiGHS": cracked joints in common over cracked joints in either.
 
 {table}
 
 {facade_lines}
 
-### (b) Macro-blocks against the "intact" threshold (clarabel)
+### (b) Macro-blocks against the "intact" threshold ({solver.DEFAULT_BACKEND})
 A joint is intact when no end moves more than the threshold times the largest joint motion.
 
 {thresholds}
@@ -303,7 +318,10 @@ The inequality form `dn >= mu |dt|` (two rows per end) is what the solver assemb
 {forms}
 
 ### (d) Running-bond settlement walls (200 x 50 mm units, the right 40 % of the base settles)
-One solve per row, each in its own process. Overhead = (assembly + post-processing) / LP.
+One solve per row, each in its own process (up to {WARM_UP_BELOW:,} units the second of two solves, so that imports
+and first calls are not counted). Overhead = (assembly + post-processing) / LP. Alpha error
+relative to the exact vertex: HiGHS in the same run at 100 and 1,000 units; at 10,000 units
+{VERTEX_10K!r} (`ipm` at tolerance 1e-11, bracketed to 5e-11 by its dual alpha; see `VERTEX_10K`).
 
 {big}
 """

@@ -40,6 +40,7 @@ from .geometry import (
 )
 from .interfaces import detect_interfaces
 from .checks import Problem, check
+from .linalg import cholesky_factor, has_cholmod
 from .io import add_history, content_sha256, open_dataset, open_model, save, save_figure, sha256_file
 from .builder import build, dump_toml, load_spec
 from .datasets import bundled_cases, bundled_spec_path

@@ -26,7 +26,7 @@ class Discretisation:
         scalar = self.basis.element_dofs.T  # (elements, nb)
         self.ndof = 2 * self.basis.N
         self.edofs = np.stack([2 * scalar, 2 * scalar + 1], axis=2).reshape(scalar.shape[0], 2 * nb)
-        values = np.stack([self.basis.basis[j][0].value for j in range(nb)], axis=-1)  # (el, qp, nb)
+        values = np.stack([np.asarray(self.basis.basis[j][0]) for j in range(nb)], axis=-1)  # (el, qp, nb)
         grads = np.stack([self.basis.basis[j][0].grad for j in range(nb)], axis=-1)  # (2, el, qp, nb)
         nel, nqp = values.shape[:2]
         B = np.zeros((nel, nqp, 3, 2 * nb))
@@ -38,7 +38,7 @@ class Discretisation:
         self.values = values
         self.weights = self.basis.dx * thickness[:, None]  # (el, qp)
         self.nqp = nqp
-        xy = self.basis.global_coordinates().value  # (2, el, qp)
+        xy = np.asarray(self.basis.global_coordinates())  # (2, el, qp)
         self.qp_xy = xy.reshape(2, -1)
         rows = np.repeat(self.edofs, 2 * nb, axis=1).ravel()
         cols = np.tile(self.edofs, (1, 2 * nb)).ravel()

@@ -4,6 +4,10 @@ from __future__ import annotations
 import masonryfw as mf
 
 OPTIONS = (
+    mf.Option("method", str, "incremental",
+              "incremental: gravity then settlement steps to the reaction plateau (Newton); limit: the collapse "
+              "state directly, as one linear programme on the mesh (static lower bound, limit.py)",
+              ("incremental", "limit")),
     mf.Option("hypothesis", str, "plane_stress", "2D hypothesis", ("plane_stress", "plane_strain")),
     mf.Option("element", str, "p2", "triangle: quadratic (p2, 3 quadrature points) or linear (p1)", ("p2", "p1")),
     mf.Option("mesh_size", float, 0.0, "largest cell side [m]; 0 = half the unit height"),

@@ -9,6 +9,7 @@ import xarray as xr
 import masonryfw as mf
 
 from .cracks import crack_indicator
+from .output import mesh_variables, point_variables, variable
 from .newton import NewtonSolver, State
 from .problem import Problem, build_problem
 
@@ -128,10 +129,6 @@ def run(problem: Problem, options, progress) -> tuple[State, History, dict]:
     return state, history, info
 
 
-def _var(dims, values, units: str, long_name: str, **attrs) -> xr.Variable:
-    return xr.Variable(dims, values, {"units": units, "long_name": long_name, **attrs})
-
-
 def result_dataset(model: xr.Dataset, problem: Problem, state: State, history: History, info: dict,
                    spacing: float) -> xr.Dataset:
     """FORMAT.md result variables (physical units) from the final converged state and the history."""
@@ -141,34 +138,20 @@ def result_dataset(model: xr.Dataset, problem: Problem, state: State, history: H
     failure = np.zeros(disc.n_points, dtype=np.int8)
     failure[p.masonry_points] = p.return_map.failure_mode(state.active[p.masonry_points])
     qx, qy = disc.qp_xy * H
-    flags = mf.flags("qp_failure")
     stress = state.stress * p.stress
     variables = {
-        "mesh": _var((), np.int32(0), "1", "UGRID mesh topology", cf_role="mesh_topology", topology_dimension=2,
-                     node_coordinates="mesh_node_x mesh_node_y", face_node_connectivity="mesh_face_nodes"),
-        "mesh_node_x": _var("mesh_node", disc.mesh.p[0] * H, "m", "continuum mesh node x"),
-        "mesh_node_y": _var("mesh_node", disc.mesh.p[1] * H, "m", "continuum mesh node y"),
-        "mesh_face_nodes": _var(("mesh_face", "mesh_face_node"), disc.mesh.t.T.astype(np.int32), "1",
-                                "node indices of each mesh face (0-based, UGRID face_node_connectivity)",
-                                cf_role="face_node_connectivity", start_index=0),
-        "mesh_node_ux": _var("mesh_node", state.u[2 * vertex] * U, "m", "final horizontal displacement of the mesh node"),
-        "mesh_node_uy": _var("mesh_node", state.u[2 * vertex + 1] * U, "m", "final vertical displacement of the mesh node"),
-        "qp_x": _var("qp", qx, "m", "quadrature point x"),
-        "qp_y": _var("qp", qy, "m", "quadrature point y"),
-        "qp_failure": _var("qp", failure, "1", "failure mode of the quadrature point in the last step",
-                           flag_values=np.array(sorted(flags.values()), dtype=np.int8),
-                           flag_meanings=" ".join(sorted(flags, key=flags.get))),
-        "qp_stress_xx": _var("qp", stress[:, 0], "Pa", "final stress sigma_xx (tension positive)"),
-        "qp_stress_yy": _var("qp", stress[:, 1], "Pa", "final stress sigma_yy (tension positive)"),
-        "qp_stress_xy": _var("qp", stress[:, 2], "Pa", "final shear stress sigma_xy"),
-        "step_settlement": _var("step", np.asarray(history.settlement) * U, "m", "imposed settlement"),
-        "step_reaction": _var("step", np.asarray(history.reaction) * p.force, "N",
+        **mesh_variables(disc.mesh.p * H, disc.mesh.t),
+        "mesh_node_ux": variable("mesh_node", state.u[2 * vertex] * U, "m", "final horizontal displacement of the mesh node"),
+        "mesh_node_uy": variable("mesh_node", state.u[2 * vertex + 1] * U, "m", "final vertical displacement of the mesh node"),
+        **point_variables((qx, qy), failure, stress, "quadrature point", "in the last step"),
+        "step_settlement": variable("step", np.asarray(history.settlement) * U, "m", "imposed settlement"),
+        "step_reaction": variable("step", np.asarray(history.reaction) * p.force, "N",
                               "vertical reaction on the moving support"),
-        "step_newton_iterations": _var("step", np.asarray(history.iterations, dtype=np.int32), "1",
+        "step_newton_iterations": variable("step", np.asarray(history.iterations, dtype=np.int32), "1",
                                        "Newton iterations of the step (step 0: the whole gravity stage)"),
-        "step_plastic_points": _var("step", np.asarray(history.plastic_points, dtype=np.int32), "1",
+        "step_plastic_points": variable("step", np.asarray(history.plastic_points, dtype=np.int32), "1",
                                     "quadrature points yielding in the step"),
-        "crack_indicator": _var("interface", crack_indicator(model, qx, qy, failure > 0, spacing / 4), "1",
+        "crack_indicator": variable("interface", crack_indicator(model, qx, qy, failure > 0, spacing / 4), "1",
                                 "fraction of the nearest quadrature points that yield in the last step"),
     }
     iterations = np.asarray(history.iterations[1:], dtype=float)
@@ -203,6 +186,10 @@ def check_options(options) -> None:
 def solve(model: xr.Dataset, options, progress) -> xr.Dataset:
     """Solve ``model`` with the Jointed Masonry Model: the ``jmm`` solver entry point."""
     check_options(options)
+    if options["method"] == "limit":
+        from .limit import solve_limit
+
+        return solve_limit(model, options, progress)
     problem = build_problem(model, options)
     state, history, info = run(problem, options, progress)
     progress(1.0, info["jmm_stop_reason"])

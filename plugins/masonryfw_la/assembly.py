@@ -66,7 +66,8 @@ class Wall:
 
     @classmethod
     def from_model(cls, model: xr.Dataset) -> "Wall":
-        v = {name: np.asarray(var.values) for name, var in model.data_vars.items()}
+        # Variables, not DataArrays: building a DataArray for each of the 26 took 1.5 ms at 100 units
+        v = {name: np.asarray(var.values) for name, var in model.variables.items()}
         return cls(
             role=v["block_role"],
             fixed=v["block_fixed"] != 0,
@@ -281,8 +282,9 @@ def assemble(wall: Wall, scales: Scales, kin: Kinematics) -> KinematicLP:
     cost[:n_col] = -(cmap.T @ nondimensional_loads(wall.dead, scales))
     live[:n_col] = cmap.T @ nondimensional_loads(wall.live, scales)
 
-    mu_dry = sp.diags(mu[dry])
-    rows = [normal[dry] - mu_dry @ tangent[dry], normal[dry] + mu_dry @ tangent[dry]]
+    normal_dry = normal[dry]
+    mu_tangent_dry = tangent[dry].multiply(mu[dry][:, None]).tocsr()
+    rows = [normal_dry - mu_tangent_dry, normal_dry + mu_tangent_dry]
     if coh.size:
         eye = sp.identity(coh.size, format="csr")
         rows += [

@@ -1,4 +1,4 @@
-"""Three solvers for ``min c.x  s.t.  G x >= 0,  a.x = 1`` (the kinematic programme).
+"""Four solvers for ``min c.x  s.t.  G x >= 0,  a.x = 1`` (the kinematic programme).
 
 Each returns the mechanism ``x``, the multipliers ``y >= 0`` of ``G x >= 0``
 (the static contact forces) and the multiplier of ``a.x = 1`` (the static
@@ -7,9 +7,15 @@ alpha), so that ``G^T y + alpha_dual a = c`` at the optimum.
 - ``highs``: HiGHS dual simplex through ``scipy.optimize.linprog``: an exact
   vertex; when mechanisms tie it returns one of them (not symmetric in general).
   Fast below ~100 blocks, slow beyond a few hundred (docs/benchmarks.md).
+- ``ipm``: our primal-dual interior point on the normal equations ``G^T D G``
+  with a CHOLMOD factor (:mod:`.ipm`; SciPy's SuperLU without ``cvxopt``). Like
+  Clarabel it converges to the interior of the optimal face (tied mechanisms
+  come out as their mean). Problems without a finite optimum, and any failure
+  to converge, are handed to Clarabel, whose infeasibility certificates give
+  the messages; the status then says so.
 - ``clarabel``: interior point on the LP as a conic problem; it converges to the
   centre of the optimal face, so tied mechanisms come out as their mean
-  (symmetric on a symmetric wall). The fastest from ~50 blocks up: the default.
+  (symmetric on a symmetric wall).
 - ``osqp``: ADMM on the LP plus ``eps/2 ||x - x_k||^2`` (``eps`` = :data:`OSQP_REGULARISATION`),
   proximal-point steps from ``x_0 = 0``: the first picks the minimum-norm
   mechanism, the next ones remove the regularisation's effect on alpha. Slow
@@ -18,14 +24,14 @@ alpha), so that ``G^T y + alpha_dual a = c`` at the optimum.
 from __future__ import annotations
 
 import warnings
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 import scipy.sparse as sp
 
 import masonryfw as mf
 
-BACKENDS = ("highs", "clarabel", "osqp")
+BACKENDS = ("ipm", "highs", "clarabel", "osqp")
 OSQP_REGULARISATION = 1e-3
 OSQP_FIRST_STEP_TOLERANCE = 1e-5
 OSQP_MAX_PROXIMAL_STEPS = 100
@@ -54,8 +60,27 @@ class LPSolution:
 
 def solve_lp(backend: str, cost, constraints, live, tolerance: float) -> LPSolution:
     """Solve with ``backend``; infeasible / unbounded / failed solves raise :class:`SolveError`."""
-    return {"highs": solve_highs, "clarabel": solve_clarabel, "osqp": solve_osqp}[backend](
+    return {"ipm": solve_ipm, "highs": solve_highs, "clarabel": solve_clarabel, "osqp": solve_osqp}[backend](
         cost, constraints, live, tolerance
+    )
+
+
+def solve_ipm(cost, constraints, live, tolerance) -> LPSolution:
+    """:func:`.ipm.solve`; when it cannot certify an optimum, Clarabel (the status names the reason)."""
+    from . import ipm
+
+    try:
+        sol = ipm.solve(cost, constraints, live, tolerance)
+    except ipm.IPMFailure as failure:
+        fallback = solve_clarabel(cost, constraints, live, tolerance)
+        return replace(fallback, status=f"{fallback.status} (ipm fell back to clarabel: {failure})")
+    return LPSolution(
+        x=sol.x,
+        y=sol.y,
+        alpha_primal=float(np.asarray(cost) @ sol.x),
+        alpha_dual=sol.lam,
+        status="optimal",
+        iterations=sol.iterations,
     )
 
 

@@ -6,26 +6,12 @@ import pytest
 
 import masonryfw as mf
 
-SPEC = {
-    "title": "jmm small wall",
-    "length_unit": "m",
-    "wall": {"width": 0.4, "height": 0.2, "thickness": 0.1},
-    "unit": {"length": 0.1, "height": 0.05},
-    "bond": {"pattern": "running", "first_course": "full"},
-    "material": {"unit_weight": 12000.0, "friction_angle": 21.8, "cohesion": 0.0, "tensile_strength": 0.0,
-                 "young_modulus": 1.2264e9, "poisson_ratio": 0.2},
-    "supports": {
-        "fixed": {"kind": "fixed", "start": 0.0, "end": 0.2},
-        "settling": {"kind": "moving", "start": 0.2, "end": 0.4, "motion": "translation"},
-    },
-    "loading": {"type": "settlement"},
-}
 FAST = {"mesh_size": 0.025, "max_steps": 6, "first_increment": 0.2}
 
 
 @pytest.fixture(scope="module")
-def model():
-    return mf.build(SPEC)
+def model(small_wall):
+    return small_wall
 
 
 @pytest.fixture(scope="module")
@@ -87,9 +73,9 @@ def test_beta_from_the_unit_geometry(result):
     assert result.attrs["jmm_beta"] == pytest.approx(0.4, rel=1e-3)
 
 
-def test_bad_option_is_named():
+def test_bad_option_is_named(small_wall):
     with pytest.raises(mf.MasonryError, match="mesh_size"):
-        mf.solve(mf.build(SPEC), "jmm", {"mesh_size": -1.0})
+        mf.solve(small_wall, "jmm", {"mesh_size": -1.0})
 
 
 FIXED = {**FAST, "max_steps": 4}
@@ -114,3 +100,12 @@ def test_apex_regularisation_changes_the_reaction_by_less_than_its_size(model):
     finer = mf.solve(model, "jmm", {**FIXED, "apex_shift": 1e-4})
     common = reference.step_settlement.values[reference.step_settlement.values <= finer.step_settlement.values[-1]]
     np.testing.assert_allclose(reactions_at(finer, common), reactions_at(reference, common), rtol=1e-2)
+
+
+def test_cholesky_and_lu_take_the_same_newton_path(model, monkeypatch):
+    # associated flow: CHOLMOD on the SPD tangent; the SuperLU fallback (no cvxopt) must give the same iterates
+    cholesky = mf.solve(model, "jmm", FIXED)
+    monkeypatch.setattr("masonryfw.linalg.has_cholmod", lambda: False)
+    lu = mf.solve(model, "jmm", FIXED)
+    np.testing.assert_array_equal(lu.step_newton_iterations.values, cholesky.step_newton_iterations.values)
+    np.testing.assert_allclose(lu.step_reaction.values, cholesky.step_reaction.values, rtol=1e-9)

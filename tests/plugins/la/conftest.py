@@ -129,11 +129,21 @@ def running_bond(n_courses, width, unit_length, unit_height, *, half_first=True,
     return np.array(rects)
 
 
+def ferris_tin_loi_wall(length_unit=1.0):
+    """Ferris & Tin-Loi (2001) wall 1: 6 courses of 0.4 x 0.175 m units in running bond (33 units),
+    2.0 x 1.05 m on a fixed base, mu = 0.65, horizontal live load = weight; published lambda 0.643."""
+    units = running_bond(6, 2.0, 0.4, 0.175, half_first=True)
+    rects = np.vstack([(-0.2, -0.175, 2.2, 0.0), units])
+    roles = [ROLE["fixed_support"]] + [ROLE["unit"]] * len(units)
+    return rect_model(rects, roles, mu=0.65, length_unit=length_unit)
+
+
 class Walls:
     """Factories shared by the la tests (pytest fixture ``walls``)."""
 
     rect_model = staticmethod(rect_model)
     running_bond = staticmethod(running_bond)
+    ferris_tin_loi_wall = staticmethod(ferris_tin_loi_wall)
     ROLE = ROLE
 
     @staticmethod

@@ -99,12 +99,9 @@ def test_la_cohesion_and_tensile_strength(walls, backend, mu, cohesion, tension,
 
 
 def ferris_tin_loi_wall_1(walls, backend):
-    """Ferris & Tin-Loi (2001), wall 1: 6 courses of 0.4 x 0.175 m units, 2.0 x 1.05 m, mu = 0.65."""
-    units = walls.running_bond(6, 2.0, 0.4, 0.175, half_first=True)
-    assert len(units) == 33 and np.ptp(units[:, [0, 2]]) == pytest.approx(2.0)
-    rects = np.vstack([(-0.2, -0.175, 2.2, 0.0), units])
-    roles = [walls.ROLE["fixed_support"]] + [walls.ROLE["unit"]] * len(units)
-    return walls.solve(walls.rect_model(rects, roles, mu=0.65), solver=backend)
+    model = walls.ferris_tin_loi_wall()
+    assert model.sizes["block"] == 34 and np.ptp(model.node_x.values) == pytest.approx(2.4)  # 33 units + base
+    return walls.solve(model, solver=backend)
 
 
 @pytest.mark.parametrize("backend", BACKENDS)

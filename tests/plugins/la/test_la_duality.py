@@ -37,12 +37,6 @@ def contact_resultants(result) -> np.ndarray:
     return out
 
 
-def ferris_wall(walls):
-    units = walls.running_bond(6, 2.0, 0.4, 0.175)
-    rects = np.vstack([(-0.2, -0.175, 2.2, 0.0), units])
-    return walls.rect_model(rects, [ROLE["fixed_support"]] + [ROLE["unit"]] * len(units), mu=0.65)
-
-
 def cohesive_wall(walls):
     units = walls.running_bond(4, 1.2, 0.4, 0.2)
     rects = np.vstack([(0.0, -0.2, 0.6, 0.0), (0.6, -0.2, 1.2, 0.0), units])
@@ -52,7 +46,7 @@ def cohesive_wall(walls):
 
 def model_for(walls, case):
     if case == "ferris":
-        return ferris_wall(walls)
+        return walls.ferris_tin_loi_wall()
     if case == "cohesive":
         return cohesive_wall(walls)
     return mf.derive_geometry(mf.open_model(case))

@@ -34,11 +34,8 @@ def test_la_same_wall_in_mm_and_in_m(walls, backend):
 
 def test_la_ferris_wall_in_mm(walls):
     """A tilting case too (no moving support: the largest translation is normalised to 1)."""
-    units = walls.running_bond(6, 2.0, 0.4, 0.175)
-    rects = np.vstack([(-0.2, -0.175, 2.2, 0.0), units])
-    roles = [ROLE["fixed_support"]] + [ROLE["unit"]] * len(units)
     alphas = [
-        float(walls.solve(walls.rect_model(rects, roles, mu=0.65, length_unit=k), solver="highs").collapse_multiplier)
+        float(walls.solve(walls.ferris_tin_loi_wall(length_unit=k), solver="highs").collapse_multiplier)
         for k in (1.0, 1000.0)
     ]
     assert alphas[1] == pytest.approx(alphas[0], rel=1e-9)

@@ -1,0 +1,393 @@
+"""``method=limit``: the collapse state of the JMM continuum as one linear programme on the mesh.
+
+The JMM strength domain is the polyhedron ``A s <= b`` (material.py), so the lower-bound
+(static) theorem of limit analysis on a finite-element stress field is a linear programme.
+The formulation is Sloan's (1988) static one, as used by Lyamin and Sloan:
+
+- **stress field**: linear in every triangle of the wall mesh (the corners of the P2 mesh of
+  ``build_problem``), three nodal stress triplets ``[sxx, syy, sxy]`` per triangle,
+  discontinuous between triangles; variable ``9 e + 3 k + c`` is component ``c`` at corner
+  ``k`` of triangle ``e``;
+- **equilibrium** with gravity in every triangle (``div s + b = 0`` is constant there: two rows);
+- **traction continuity** ``t_e s_e n = t_f s_f n`` across every interior edge at both end
+  points (``t``: thickness), which makes the piecewise-linear tractions continuous along it;
+- **free boundary** (top, sides, openings, base not on a support): ``s n = 0`` at both ends;
+- **supports**: on a fixed support's edges the traction is free (unknown); on the moving
+  support's edges it is free too and its vertical resultant is the reaction ``R``;
+- **strength**: ``A s <= b`` at every corner of every masonry triangle (the domain is convex
+  and the field linear, so it then holds everywhere in the triangle: the field is statically
+  admissible everywhere, not only at sample points). Lintel triangles are left
+  unconstrained: they are elastic in the incremental solver, i.e. never yield.
+
+Objective: **minimise R**. A settling support unloads until the wall carries the least
+reaction it can by arching over it; the incremental analysis approaches that value as its
+plateau. Every feasible field is statically admissible for the discretised continuum, so
+the optimum ``R_min`` is an upper bound on the continuum's exact smallest reaction (a lower
+bound on the collapse multiplier ``alpha = 1 - R_min / R_0``) that decreases as the mesh
+is refined. ``R_0`` is the paper's settlement dead load (docs/architecture.md): the masonry
+weight times the moving support's share of the wall-on-support contact length, as the
+``la`` solver's alpha, so the two alphas compare directly.
+
+Why this and not the kinematic (upper-bound) form: the static form needs no flow rule and
+no velocity-discontinuity elements, its equilibrium rows mirror the FE residual, and the
+duals of the strength rows are the plastic multipliers, which give the mechanism (the
+plastic zone) at no extra cost. The strength is the one the incremental solver uses, with
+its apex regularisation (``apex_shift``; 0 gives the exact paper domain).
+
+The LP is solved by Clarabel (interior point, QDLDL: several times faster than "auto" on
+these problems). Its duals are maximally complementary, so a face whose multiplier is
+positive in some optimal mechanism has a positive multiplier here: the plastic zone is the
+union of the collapse mechanisms, not one arbitrary vertex of the dual polyhedron.
+"""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+import xarray as xr
+
+import masonryfw as mf
+
+from .cracks import crack_indicator
+from .output import mesh_variables, point_variables, variable
+from .problem import Problem, build_problem
+
+ROLE = mf.flags("block_role")
+#: a strength row is plastic when its multiplier per unit volume exceeds this fraction of the largest
+PLASTIC_DUAL_FRACTION = 1e-4
+#: local corner pairs of the three edges of a triangle
+LOCAL_EDGES = np.array([[0, 1], [1, 2], [2, 0]])
+
+
+@dataclass(frozen=True)
+class Edges:
+    """Every edge of a triangle mesh, once per adjacent triangle (``occurrence``)."""
+
+    element: np.ndarray  # (occ,) triangle of the occurrence
+    local: np.ndarray  # (occ, 2) local corners of the edge's two end points, sorted by global node index
+    normal: np.ndarray  # (occ, 2) unit normal pointing out of the triangle
+    length: np.ndarray  # (occ,)
+    interior: np.ndarray  # (pairs, 2) occurrence indices of the two sides of each interior edge
+    boundary: np.ndarray  # (b,) occurrence indices of the boundary edges
+
+
+def mesh_edges(points: np.ndarray, triangles: np.ndarray) -> Edges:
+    """The edge table of ``triangles`` (3, e) on ``points`` (2, n)."""
+    n_el = triangles.shape[1]
+    element = np.repeat(np.arange(n_el), 3)
+    local = np.tile(LOCAL_EDGES, (n_el, 1))
+    nodes = triangles[local, element[:, None]]  # (occ, 2) global nodes
+    swap = nodes[:, 0] > nodes[:, 1]
+    local = np.where(swap[:, None], local[:, ::-1], local)
+    nodes = np.sort(nodes, axis=1)
+    p, q = points[:, nodes[:, 0]].T, points[:, nodes[:, 1]].T
+    length = np.hypot(*(q - p).T)
+    normal = np.stack([q[:, 1] - p[:, 1], p[:, 0] - q[:, 0]], axis=1) / length[:, None]
+    opposite = np.tile(3 - LOCAL_EDGES.sum(axis=1), n_el)  # local corner not on the edge
+    third = points[:, triangles[opposite, element]].T
+    normal *= np.where(((third - p) * normal).sum(axis=1) > 0, -1.0, 1.0)[:, None]
+    key = nodes[:, 0].astype(np.int64) * points.shape[1] + nodes[:, 1]
+    order = np.argsort(key, kind="stable")
+    _, first, counts = np.unique(key[order], return_index=True, return_counts=True)
+    interior = np.stack([order[first[counts == 2]], order[first[counts == 2] + 1]], axis=1)
+    return Edges(element, local, normal, length, interior, np.sort(order[first[counts == 1]]))
+
+
+def traction_operator(n_var: int, element, local, normal, weight) -> sp.csr_matrix:
+    """``(2 m, n_var)``: ``weight * s n`` (x then y component) at corner ``local`` of ``element``, m points."""
+    m = element.size
+    base = 9 * element + 3 * local
+    rows = np.repeat(np.arange(2 * m).reshape(m, 2), 2, axis=1).ravel()  # x, x, y, y per point
+    cols = np.stack([base, base + 2, base + 2, base + 1], axis=1).ravel()  # sxx, sxy | sxy, syy
+    data = (np.stack([normal[:, 0], normal[:, 1], normal[:, 0], normal[:, 1]], axis=1) * weight[:, None]).ravel()
+    return sp.csr_matrix((data, (rows, cols)), shape=(2 * m, n_var))
+
+
+class StaticField:
+    """Operators of the piecewise-linear discontinuous stress field on a triangle mesh (non-dimensional)."""
+
+    def __init__(self, points: np.ndarray, triangles: np.ndarray, thickness: np.ndarray):
+        self.points, self.triangles, self.thickness = points, triangles, np.asarray(thickness, dtype=float)
+        self.n_el = triangles.shape[1]
+        self.n_var = 9 * self.n_el
+        x, y = points[0, triangles], points[1, triangles]  # (3, e)
+        x1, x2 = np.roll(x, -1, axis=0), np.roll(x, -2, axis=0)
+        y1, y2 = np.roll(y, -1, axis=0), np.roll(y, -2, axis=0)
+        twice_area = (x[1] - x[0]) * (y[2] - y[0]) - (x[2] - x[0]) * (y[1] - y[0])
+        self.area = 0.5 * np.abs(twice_area)  # the gradients below hold for either orientation
+        degenerate = self.area <= 1e-12 * np.ptp(points, axis=1).prod()
+        if degenerate.any():
+            raise mf.ModelError(f"jmm limit: mesh triangle {int(np.argmax(degenerate))} has no area")
+        self.grad = np.stack([(y1 - y2) / twice_area, (x2 - x1) / twice_area])  # (2, 3 corners, e)
+        self.edges = mesh_edges(points, triangles)
+
+    def equilibrium(self, body: np.ndarray) -> tuple[sp.csr_matrix, np.ndarray]:
+        """Rows ``V (div s + b) = 0`` per triangle (V = area x thickness) for a ``(e, 2)`` body force."""
+        volume = self.area * self.thickness
+        e = np.arange(self.n_el)
+        cols = 9 * e[:, None] + 3 * np.arange(3)[None, :]  # (e, 3): sxx of each corner
+        gx, gy = self.grad[0].T * volume[:, None], self.grad[1].T * volume[:, None]  # (e, 3)
+        rows_x = np.repeat(2 * e, 6)
+        rows_y = rows_x + 1
+        cols_x = np.concatenate([cols, cols + 2], axis=1).ravel()  # d sxx/dx + d sxy/dy
+        cols_y = np.concatenate([cols + 2, cols + 1], axis=1).ravel()  # d sxy/dx + d syy/dy
+        data = np.concatenate([gx, gy], axis=1).ravel()
+        matrix = sp.csr_matrix((np.concatenate([data, data]), (np.concatenate([rows_x, rows_y]),
+                                np.concatenate([cols_x, cols_y]))), shape=(2 * self.n_el, self.n_var))
+        return matrix, -(body * volume[:, None]).ravel()
+
+    def _edge_traction(self, occurrences: np.ndarray, normal: np.ndarray | None = None) -> sp.csr_matrix:
+        """Thickness x traction ``s n`` at both end points of each edge occurrence (4 rows per edge)."""
+        E = self.edges
+        element = np.repeat(E.element[occurrences], 2)
+        n = np.repeat(E.normal[occurrences] if normal is None else normal, 2, axis=0)
+        return traction_operator(self.n_var, element, E.local[occurrences].ravel(), n, self.thickness[element])
+
+    def continuity(self) -> sp.csr_matrix:
+        """Rows ``t_e s_e n - t_f s_f n = 0`` at both ends of every interior edge (``n`` of side e)."""
+        side_e, side_f = self.edges.interior.T
+        n = self.edges.normal[side_e]
+        return self._edge_traction(side_e, n) - self._edge_traction(side_f, n)
+
+    def boundary_traction(self, occurrences: np.ndarray) -> sp.csr_matrix:
+        """Thickness x traction on the body (``s n_out``) at both ends of boundary edges (4 rows per edge)."""
+        return self._edge_traction(occurrences)
+
+    def boundary_resultant(self, occurrences: np.ndarray) -> sp.csr_matrix:
+        """``(2, n_var)``: the force the outside exerts on the body through these boundary edges (x, y)."""
+        traction = self.boundary_traction(occurrences)  # rows (edge, end, component)
+        half_length = np.repeat(0.5 * self.edges.length[occurrences], 4)
+        component = np.tile([0, 1], 2 * occurrences.size)
+        summing = sp.csr_matrix((half_length, (component, np.arange(half_length.size))),
+                                shape=(2, half_length.size))
+        return summing @ traction
+
+    def strength(self, A: np.ndarray, b: np.ndarray, corner: np.ndarray, face: np.ndarray):
+        """Rows ``A[face] s <= b[face]`` at stress nodes ``corner`` (= 3 element + local corner); one row each."""
+        rows = np.repeat(np.arange(corner.size), 3)
+        cols = (3 * corner[:, None] + np.arange(3)).ravel()
+        return sp.csr_matrix((A[face].ravel(), (rows, cols)), shape=(corner.size, self.n_var)), b[face]
+
+    def implied_by_free_edges(self, A: np.ndarray, free: np.ndarray) -> np.ndarray:
+        """Boolean ``(3 e, faces)``: strength rows that the traction-free conditions already decide.
+
+        On a free edge with normal n the stress at its end points is uniaxial along the edge,
+        ``s = k (ny^2, nx^2, -nx ny)``; a face with ``A s_t = 0`` then reads ``0 <= b``. At c = 0
+        that row is tight but says nothing, and its multiplier is arbitrary (any value is
+        cancelled by the boundary rows' multipliers), so it would mark the whole free surface
+        plastic. A stress node on two free edges of different direction has ``s = 0``: all its
+        rows are decided.
+        """
+        E = self.edges
+        corner = (3 * np.repeat(E.element[free], 2) + E.local[free].ravel())
+        nx, ny = np.repeat(E.normal[free], 2, axis=0).T
+        implied = np.zeros((3 * self.n_el, A.shape[0]), dtype=bool)
+        tangential = np.stack([ny**2, nx**2, -nx * ny], axis=1) @ A.T  # (entries, faces)
+        np.logical_or.at(implied, corner, np.abs(tangential) <= 1e-12 * np.abs(A).max())
+        direction = np.round(np.abs(np.stack([nx, ny], axis=1)), 9)
+        distinct = np.unique(np.column_stack([corner, direction]), axis=0)[:, 0].astype(int)
+        implied[np.bincount(distinct, minlength=3 * self.n_el) > 1] = True
+        return implied
+
+
+@dataclass
+class LPSolution:
+    x: np.ndarray
+    strength_duals: np.ndarray
+    objective: float
+    status: str
+    iterations: int
+    seconds: float
+
+
+def solve_lp(cost: np.ndarray, equalities: sp.spmatrix, rhs: np.ndarray, inequalities: sp.spmatrix,
+             bounds: np.ndarray, tolerance: float = 1e-8) -> LPSolution:
+    """``min cost.x`` s.t. ``equalities x = rhs``, ``inequalities x <= bounds``, by Clarabel (QDLDL)."""
+    import clarabel
+
+    n_eq, n_in = equalities.shape[0], inequalities.shape[0]
+    settings = clarabel.DefaultSettings()
+    settings.verbose = False
+    settings.direct_solve_method = "qdldl"
+    settings.tol_gap_abs = settings.tol_gap_rel = settings.tol_feas = tolerance
+    start = time.perf_counter()
+    solver = clarabel.DefaultSolver(
+        sp.csc_matrix((cost.size, cost.size)), np.asarray(cost, dtype=float),
+        sp.vstack([equalities, inequalities], format="csc"), np.concatenate([rhs, bounds]),
+        [clarabel.ZeroConeT(n_eq), clarabel.NonnegativeConeT(n_in)], settings,
+    )
+    sol = solver.solve()
+    seconds = time.perf_counter() - start
+    status = str(sol.status).split(".")[-1]
+    if status in ("PrimalInfeasible", "AlmostPrimalInfeasible"):
+        raise mf.SolveError(
+            f"jmm limit: Clarabel finds no statically admissible stress field ({status}) on this mesh. With "
+            "c = 0 a lintel or strip one cell deep cannot pass its shear to the masonry (measured on Facade 3 at "
+            "mesh_size 0.05 m; 0.025 m works): try a smaller mesh_size"
+        )
+    if status not in ("Solved", "AlmostSolved"):
+        raise mf.SolveError(f"jmm limit: Clarabel stopped with status {status} after {sol.iterations} iterations")
+    x = np.asarray(sol.x)
+    return LPSolution(x, np.asarray(sol.z)[n_eq:], float(cost @ x), status, int(sol.iterations), seconds)
+
+
+def plastic_rows(duals: np.ndarray, volume: np.ndarray) -> np.ndarray:
+    """Strength rows whose multiplier per unit volume (of their stress node) is significant."""
+    rate = duals / volume
+    return rate > PLASTIC_DUAL_FRACTION * rate.max(initial=0.0)
+
+
+def support_edges(problem: Problem, field: StaticField) -> tuple[np.ndarray, np.ndarray]:
+    """Boundary edge occurrences on fixed and on moving supports.
+
+    An edge is on a support when it is horizontal, at the support block's top and within its
+    x range (the same test as the incremental solver's prescribed DOFs).
+    """
+    E, H = field.edges, problem.length
+    tol = 1e-6 * problem.mesh_size / H
+    occ = E.boundary
+    ends = field.triangles[E.local[occ], E.element[occ][:, None]]  # (b, 2) global nodes
+    px, py = field.points[0, ends], field.points[1, ends]
+    horizontal = np.isclose(py[:, 0], py[:, 1], atol=tol)
+    mid_x, mid_y = px.mean(axis=1), py.mean(axis=1)
+    fixed, moving = np.zeros(occ.size, bool), np.zeros(occ.size, bool)
+    for x0, x1, y, _, role in problem.mesh.supports:  # a handful of supports
+        on = horizontal & np.isclose(mid_y, y / H, atol=tol) & (mid_x > x0 / H - tol) & (mid_x < x1 / H + tol)
+        (fixed if role == ROLE["fixed_support"] else moving)[on] = True
+    moving &= ~fixed
+    return occ[fixed], occ[moving]
+
+
+def check_vertical_settlement(model: xr.Dataset) -> None:
+    """The LP's objective is the vertical reaction: every moving support must translate straight down."""
+    moving = np.nonzero(model.block_role.values == ROLE["moving_support"])[0]
+    direction = model.settlement_direction.values[moving]
+    bad = moving[~(np.isclose(direction[:, 0], 0) & np.isclose(direction[:, 2], 0) & (direction[:, 1] < 0))]
+    if bad.size:
+        raise mf.ModelError(
+            f"jmm method=limit: moving support block {int(bad[0])} has settlement_direction "
+            f"{model.settlement_direction.values[bad[0]].tolist()}; the limit LP needs a downward vertical "
+            "translation (0, -1, 0) (use method=incremental for rotations)"
+        )
+
+
+@dataclass
+class SettlementLP:
+    """The assembled settlement LP ``min R`` and what is needed to read its solution."""
+
+    field: StaticField
+    cost: np.ndarray  # R: vertical resultant of the moving support's traction on the body
+    equalities: sp.csr_matrix
+    rhs: np.ndarray
+    inequalities: sp.csr_matrix
+    bounds: np.ndarray
+    strength_corner: np.ndarray  # stress node (3 element + local corner) of every strength row
+    strength_face: np.ndarray  # face (row of A) of every strength row
+    dead_reaction: float  # W L_moving / L_contact: the settlement dead load of the moving support
+    n_faces: int
+
+
+def settlement_lp(field: StaticField, unit_weight: np.ndarray, strong: np.ndarray, A: np.ndarray, b: np.ndarray,
+                  fixed: np.ndarray, moving: np.ndarray) -> SettlementLP:
+    """``min R`` for a body under its weight (``unit_weight`` per triangle, acting in -y) on supports.
+
+    ``fixed`` and ``moving`` are boundary edge occurrences on the supports (traction free to
+    take any value); every other boundary edge is traction free; ``A s <= b`` holds at the
+    corners of the ``strong`` triangles.
+    """
+    body = np.stack([np.zeros(field.n_el), -unit_weight], axis=1)
+    equilibrium, load = field.equilibrium(body)
+    free = np.setdiff1d(field.edges.boundary, np.concatenate([fixed, moving]))
+    equalities = sp.vstack([equilibrium, field.continuity(), field.boundary_traction(free)], format="csr")
+    rhs = np.concatenate([load, np.zeros(equalities.shape[0] - load.size)])
+    corner = np.repeat((3 * np.asarray(strong)[:, None] + np.arange(3)).ravel(), A.shape[0])
+    face = np.tile(np.arange(A.shape[0]), corner.size // A.shape[0])
+    keep = ~field.implied_by_free_edges(A, free)[corner, face]
+    corner, face = corner[keep], face[keep]
+    inequalities, bounds = field.strength(A, b, corner, face)
+    weight = float((unit_weight * field.area * field.thickness).sum())
+    lengths = field.edges.length
+    share = lengths[moving].sum() / (lengths[fixed].sum() + lengths[moving].sum())
+    cost = field.boundary_resultant(moving).toarray()[1]
+    return SettlementLP(field, cost, equalities, rhs, inequalities, bounds, corner, face, float(weight * share),
+                        A.shape[0])
+
+
+def wall_settlement_lp(problem: Problem, model: xr.Dataset) -> SettlementLP:
+    """The settlement LP of the wall meshed by ``build_problem`` (non-dimensional, see the module docstring)."""
+    mesh, blocks, H = problem.disc.mesh, problem.mesh.block, problem.length
+    field = StaticField(mesh.p, mesh.t, model.block_thickness.values[blocks] / H)
+    unit_weight = model.block_unit_weight.values[blocks] / (problem.stress / H)
+    fixed, moving = support_edges(problem, field)
+    strong = np.nonzero(model.block_role.values[blocks] == ROLE["unit"])[0]
+    return settlement_lp(field, unit_weight, strong, problem.return_map.A, problem.return_map.b, fixed, moving)
+
+
+def collapse_points(field: StaticField, stress: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Points midway between each corner and its triangle's centroid, and the stress there.
+
+    They are the P2 solver's quadrature points (barycentric (2/3, 1/6, 1/6)), so ``qp_*`` of
+    both methods sit at the same places; point ``k`` takes the flags of corner ``k``.
+    """
+    corners = field.points[:, field.triangles]  # (2, 3, e)
+    xy = 0.5 * (corners + corners.mean(axis=1, keepdims=True))
+    s = stress.reshape(field.n_el, 3, 3)  # (e, corner, component)
+    at_points = 0.5 * s + 0.5 * s.mean(axis=1, keepdims=True)
+    return xy.transpose(0, 2, 1).reshape(2, -1), at_points.reshape(-1, 3)
+
+
+def limit_dataset(model: xr.Dataset, problem: Problem, lp: SettlementLP, sol: LPSolution, assembly: float) -> xr.Dataset:
+    """FORMAT.md result variables (physical units) of the limit LP."""
+    field, H, S = lp.field, problem.length, problem.stress
+    element = lp.strength_corner // 3
+    plastic = plastic_rows(sol.strength_duals, field.area[element] * field.thickness[element] / 3.0)
+    active = np.zeros((3 * field.n_el, lp.n_faces), dtype=bool)
+    active[lp.strength_corner[plastic], lp.strength_face[plastic]] = True
+    failure = problem.return_map.failure_mode(active)
+    (qx, qy), stress = collapse_points(field, sol.x)
+    qx, qy, stress = qx * H, qy * H, stress * S
+    reaction = sol.objective * problem.force
+    dead = lp.dead_reaction * problem.force
+    variables = {
+        **mesh_variables(field.points * H, field.triangles),
+        **point_variables((qx, qy), failure, stress, "point (midway between a triangle corner and its centroid)",
+                          "in the collapse state (failure: LP duals of the strength rows)"),
+        "collapse_multiplier": variable((), 1.0 - reaction / dead, "1",
+                                    "alpha = 1 - R_min / (W L_moving / L_contact), lower bound on the mesh"),
+        "moving_support_reaction": variable((), reaction, "N",
+                                        "smallest upward vertical reaction of the moving support (static LP)"),
+        "crack_indicator": variable("interface", crack_indicator(model, qx, qy, failure > 0, problem.mesh_size / 4), "1",
+                                "fraction of the nearest points that are plastic in the collapse mechanism"),
+    }
+    attrs = {
+        "jmm_method": "limit",
+        "jmm_beta": problem.beta,
+        "jmm_dead_reaction_n": dead,
+        "jmm_lp_variables": int(field.n_var),
+        "jmm_lp_equalities": int(lp.equalities.shape[0]),
+        "jmm_lp_inequalities": int(lp.inequalities.shape[0]),
+        "jmm_lp_nonzeros": int(lp.equalities.nnz + lp.inequalities.nnz),
+        "jmm_lp_status": sol.status,
+        "jmm_lp_iterations": sol.iterations,
+        "jmm_lp_assembly_time_s": assembly,
+        "jmm_lp_solve_time_s": sol.seconds,
+    }
+    return xr.Dataset(variables, attrs=attrs)
+
+
+def solve_limit(model: xr.Dataset, options, progress) -> xr.Dataset:
+    """Smallest moving-support reaction the JMM continuum can carry, on the mesh of ``build_problem``."""
+    check_vertical_settlement(model)
+    start = time.perf_counter()
+    progress(0.0, "meshing and assembling the limit LP")
+    problem = build_problem(model, options)
+    lp = wall_settlement_lp(problem, model)
+    assembly = time.perf_counter() - start
+    progress(0.2, f"solving the limit LP: {lp.field.n_var} variables, {lp.equalities.shape[0]} equalities, "
+             f"{lp.inequalities.shape[0]} inequalities")
+    sol = solve_lp(lp.cost, lp.equalities, lp.rhs, lp.inequalities, lp.bounds)
+    result = limit_dataset(model, problem, lp, sol, assembly)
+    progress(1.0, f"limit LP {sol.status}: alpha = {float(result.collapse_multiplier):.4f}")
+    return result

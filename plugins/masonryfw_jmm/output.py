@@ -1,0 +1,40 @@
+"""Result variables both jmm methods write: the UGRID mesh and the quadrature-point fields (FORMAT.md)."""
+from __future__ import annotations
+
+import numpy as np
+import xarray as xr
+
+import masonryfw as mf
+
+
+def variable(dims, values, units: str, long_name: str, **attrs) -> xr.Variable:
+    return xr.Variable(dims, values, {"units": units, "long_name": long_name, **attrs})
+
+
+def mesh_variables(points: np.ndarray, triangles: np.ndarray) -> dict[str, xr.Variable]:
+    """UGRID topology of the triangles ``(3, faces)`` on ``points`` ``(2, nodes)`` [m]."""
+    return {
+        "mesh": variable((), np.int32(0), "1", "UGRID mesh topology", cf_role="mesh_topology", topology_dimension=2,
+                         node_coordinates="mesh_node_x mesh_node_y", face_node_connectivity="mesh_face_nodes"),
+        "mesh_node_x": variable("mesh_node", points[0], "m", "continuum mesh node x"),
+        "mesh_node_y": variable("mesh_node", points[1], "m", "continuum mesh node y"),
+        "mesh_face_nodes": variable(("mesh_face", "mesh_face_node"), triangles.T.astype(np.int32), "1",
+                                    "node indices of each mesh face (0-based, UGRID face_node_connectivity)",
+                                    cf_role="face_node_connectivity", start_index=0),
+    }
+
+
+def point_variables(xy: np.ndarray, failure: np.ndarray, stress: np.ndarray, where: str, when: str,
+                    ) -> dict[str, xr.Variable]:
+    """``qp_x/y`` (``where`` the points are), ``qp_failure`` and ``qp_stress_*`` [Pa] (``when`` they hold)."""
+    flags = mf.flags("qp_failure")
+    return {
+        "qp_x": variable("qp", xy[0], "m", f"{where} x"),
+        "qp_y": variable("qp", xy[1], "m", f"{where} y"),
+        "qp_failure": variable("qp", failure, "1", f"failure mode {when}",
+                               flag_values=np.array(sorted(flags.values()), dtype=np.int8),
+                               flag_meanings=" ".join(sorted(flags, key=flags.get))),
+        "qp_stress_xx": variable("qp", stress[:, 0], "Pa", f"stress sigma_xx {when} (tension positive)"),
+        "qp_stress_yy": variable("qp", stress[:, 1], "Pa", f"stress sigma_yy {when} (tension positive)"),
+        "qp_stress_xy": variable("qp", stress[:, 2], "Pa", f"shear stress sigma_xy {when}"),
+    }
