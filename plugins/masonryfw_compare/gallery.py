@@ -4,7 +4,7 @@
 paper's figures 5-15: one per run, the later ones titled with their scores
 against the first) and ``docs/agreement.md``: each method's first run scored
 against the other methods' (with each method's headline number), and the
-limit analysis's three LP backends, whose mechanisms may differ where the
+limit analysis's LP backends, whose mechanisms may differ where the
 optimum is degenerate, against each other. ``--method``, ``--option
 METHOD.KEY=VALUE`` and ``--skip METHOD:CASE`` choose what runs; the command
 line is written at the top of the agreement file.
@@ -26,7 +26,6 @@ from .comparison import solver_label
 from .records import DEFAULT_THRESHOLD
 
 METHODS = ("la", "fdem", "jmm")
-LA_BACKENDS = ("highs", "clarabel", "osqp")
 GALLERY_DPI = 110
 IDENTICAL_COSINE_GAP = 1e-3
 SKIPPED = "skipped (--skip)"
@@ -118,7 +117,8 @@ def planned_runs(
         given = options.get(name, {})
         mf.resolve_options(name, solver.options, given)
         if name == "la" and "solver" not in given:
-            runs += [Run(f"la ({backend})", "la", {**given, "solver": backend}) for backend in LA_BACKENDS]
+            backends = next(o.choices for o in solver.options if o.name == "solver")  # as the plugin declares them
+            runs += [Run(f"la ({backend})", "la", {**given, "solver": backend}) for backend in backends]
         elif name == "la":
             runs.append(Run(f"la ({given['solver']})", "la", dict(given)))
         else:
@@ -263,7 +263,7 @@ installed among la, fdem, jmm) with the options named on that command line
 (`--option METHOD.KEY=VALUE`; the others are the solvers' defaults, see
 `masonryfw plugins`); `--skip METHOD:CASE` leaves a method out on a wall. Each
 method's first run is scored against every other method's (the main table), and
-the runs of one method against each other (la's three LP backends, the second
+the runs of one method against each other (la's LP backends, the second
 table), by the `crack` comparator of the `compare` plugin (`masonryfw compare A B
 --json` gives the same numbers for two result files). Result A is the reference
 of a pair.
@@ -373,12 +373,12 @@ def agreement_markdown(
     if len(installed) < 2:
         parts.append(
             "\nWith a single method there is no method-against-method comparison; the second table "
-            "compares the three LP backends of the limit analysis with each other."
+            "compares the LP backends of the limit analysis with each other."
         )
     parts.append(
         "\nThe LP backends should reach the same collapse multiplier; where the optimum is "
         "degenerate (several mechanisms with the same alpha) each may pick another mechanism - "
-        "highs a vertex of the optimal face, clarabel its centre, osqp the minimum-norm one - and "
+        "highs a vertex of the optimal face, ipm and clarabel its centre, osqp the minimum-norm one - and "
         "the second table measures how far apart those are."
     )
     found = observations(outcomes)

@@ -141,7 +141,7 @@ def test_planned_runs_cover_the_installed_methods():
     solvers = {r.solver for r in runs}
     assert solvers | set(missing) == {"la", "fdem", "jmm"} and not solvers & set(missing)
     if "la" in solvers:
-        assert [r.options for r in runs if r.solver == "la"] == [{"solver": b} for b in ("highs", "clarabel", "osqp")]
+        assert [r.options for r in runs if r.solver == "la"] == [{"solver": b} for b in ("highs", "ipm", "clarabel", "osqp")]
 
 
 def test_case_figure_has_one_panel_per_result(build, results, tmp_path):
