@@ -29,10 +29,10 @@ def backends_agree(case):
     defaults = {o.name: o.default for o in solver.options}
     alphas = {
         b: float(solver.solve(model, defaults | {"solver": b}, mf.no_progress).collapse_multiplier)
-        for b in ("highs", "clarabel", "osqp")
+        for b in ("highs", "ipm", "clarabel", "osqp")
     }
-    assert alphas["clarabel"] == pytest.approx(alphas["highs"], abs=1e-6), alphas
-    assert alphas["osqp"] == pytest.approx(alphas["highs"], abs=1e-6), alphas
+    for backend in ("ipm", "clarabel", "osqp"):
+        assert alphas[backend] == pytest.approx(alphas["highs"], abs=1e-6), alphas
 
 
 @pytest.mark.parametrize("case", FAST_CASES)
