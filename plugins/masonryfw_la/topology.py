@@ -2,8 +2,6 @@
 from __future__ import annotations
 
 import numpy as np
-import scipy.sparse as sp
-from scipy.sparse.csgraph import connected_components
 
 import masonryfw as mf
 
@@ -14,16 +12,26 @@ MAX_NAMED = 20
 def components(n_block: int, edges: np.ndarray) -> np.ndarray:
     """Connected-component label of every block through the given ``(k, 2)`` block pairs.
 
-    Labels are 0..k-1 in order of the lowest block index of each component.
+    Labels are 0..k-1 in order of the lowest block index of each component. Min-label
+    hooking with pointer jumping, vectorised over the edges: every block's parent only
+    decreases, so each component ends on its lowest block. (``scipy.sparse.csgraph``
+    would do it too, but importing it imports ``scipy.sparse.linalg``: 0.1 s of every
+    ``masonryfw solve``.)
     """
     edges = np.asarray(edges, dtype=np.int64).reshape(-1, 2)
-    graph = sp.coo_matrix(
-        (np.ones(len(edges)), (edges[:, 0], edges[:, 1])), shape=(n_block, n_block)
-    )
-    _, labels = connected_components(graph, directed=False)
-    _, first = np.unique(labels, return_index=True)
-    order = np.argsort(np.argsort(first))  # relabel by first appearance
-    return order[labels]
+    parent = np.arange(n_block)
+    while True:
+        a, b = parent[edges[:, 0]], parent[edges[:, 1]]
+        apart = a != b
+        if not apart.any():
+            break
+        np.minimum.at(parent, np.maximum(a, b)[apart], np.minimum(a, b)[apart])
+        while True:  # pointer jumping: every block straight onto its current root
+            grand = parent[parent]
+            if np.array_equal(grand, parent):
+                break
+            parent = grand
+    return np.unique(parent, return_inverse=True)[1].reshape(n_block)
 
 
 def name_blocks(blocks: np.ndarray) -> str:
