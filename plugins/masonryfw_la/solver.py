@@ -69,9 +69,20 @@ def check_live_load(lp: assembly.KinematicLP) -> None:
         )
 
 
+def check_options(options: Mapping[str, Any]) -> None:
+    """Raise PluginError naming an option out of range (the types and choices are checked by the core)."""
+    if not 0 < options["tolerance"] < 1:
+        raise mf.PluginError(f"solver 'la': option 'tolerance' must be in (0, 1), got {options['tolerance']}")
+    if not 0 <= options["crack_threshold"] < 1:
+        raise mf.PluginError(
+            f"solver 'la': option 'crack_threshold' must be in [0, 1), got {options['crack_threshold']}"
+        )
+
+
 def solve(model: xr.Dataset, options: Mapping[str, Any], progress=mf.no_progress) -> xr.Dataset:
     """Collapse multiplier, mechanism, contact forces and crack pattern of ``model``."""
     options = {o.name: o.default for o in OPTIONS} | dict(options)
+    check_options(options)
     clock = time.perf_counter()
     progress(0.0, "la: assembling the kinematic programme")
     wall = assembly.Wall.from_model(model)

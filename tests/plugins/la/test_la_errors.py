@@ -92,3 +92,10 @@ def test_la_through_the_core(walls):
     assert 0.0 <= result.crack_indicator.min() and result.crack_indicator.max() == 1.0
     with pytest.raises(mf.PluginError, match="gurobi"):
         mf.solve(model, "la", {"solver": "gurobi"})
+
+
+@pytest.mark.parametrize("name, value", [("tolerance", -1.0), ("tolerance", 0.0), ("crack_threshold", 1.5)])
+def test_la_option_out_of_range_is_named(walls, name, value):
+    model = walls.ferris_tin_loi_wall()
+    with pytest.raises(mf.PluginError, match=f"option '{name}' must be"):
+        walls.solve(model, **{name: value})
