@@ -18,6 +18,8 @@ from masonryfw_jmm.newton import NewtonSolver, State
 from masonryfw_jmm.problem import build_problem
 from masonryfw_jmm.options import OPTIONS
 
+DEFAULT = {o.name: o.default for o in OPTIONS}
+
 from _report import write_section
 
 
@@ -31,7 +33,7 @@ def median_time(function, repeat: int = 5) -> float:
 
 
 def kernels(case: str) -> list[str]:
-    options = {o.name: o.default for o in OPTIONS}
+    options = dict(DEFAULT)
     model = mf.derive_geometry(mf.open_model(case))
     problem = build_problem(model, options)
     newton = NewtonSolver(problem)
@@ -81,14 +83,20 @@ MESH_SIZES = (0.05, 0.035, 0.025, 0.0175)  # m
 FIRST_INCREMENTS = (0.2, 0.1, 0.05, 0.025)  # of the elastic unloading settlement; later steps grow from it
 
 
-def reaction_at(case: str, **given) -> tuple[float, float, int, float, int]:
-    """Reaction at CONVERGENCE_SETTLEMENT (plateau stop off), run time, DOFs, mean iterations, steps."""
+def fixed_settlement_run(case: str, **given):
+    """A run to CONVERGENCE_SETTLEMENT with the plateau stop off: the result and its run time."""
     options = {"max_settlement": CONVERGENCE_SETTLEMENT, "plateau_slope": 1e-12, "max_steps": 1000, **given}
     start = time.perf_counter()
     result = mf.solve(mf.open_model(case), "jmm", options)
     seconds = time.perf_counter() - start
     if not np.isclose(result.step_settlement.values[-1], CONVERGENCE_SETTLEMENT):
         raise RuntimeError(f"{case} {given}: stopped early ({result.attrs['jmm_stop_reason']})")
+    return result, seconds
+
+
+def reaction_at(case: str, **given) -> tuple[float, float, int, float, int]:
+    """Reaction at CONVERGENCE_SETTLEMENT (plateau stop off), run time, DOFs, mean iterations, steps."""
+    result, seconds = fixed_settlement_run(case, **given)
     iterations = result.step_newton_iterations.values[1:]
     return float(result.step_reaction.values[-1]), seconds, int(result.attrs["jmm_dofs"]), iterations.mean(), iterations.size
 
@@ -122,15 +130,67 @@ def convergence(case: str = "test-12c") -> str:
         "| mesh size [mm] | DOFs | reaction [N] | vs collapse | time [s] | mean Newton iterations |\n"
         "|---|---|---|---|---|---|\n" + "\n".join(rows) +
         "\n\nLoad-step size at the default mesh (the first increment, in elastic unloading settlements; later "
-        "increments grow by 1.5 after steps of <= 8 Newton iterations; difference against the smallest):\n\n"
+        f"increments grow by 1.5 after steps of <= {DEFAULT['target_iterations']} Newton iterations; difference against "
+        "the smallest):\n\n"
         "| first_increment | steps | reaction [N] | difference | time [s] | mean Newton iterations |\n"
         "|---|---|---|---|---|---|\n" + "\n".join(step_rows)
     )
 
 
+TOLERANCES = (1e-5, 1e-4, 1e-3, 1e-2)  # the first is the reference
+
+
+def tolerance_study(case: str = "test-12c") -> str:
+    """The reaction history against the Newton tolerance: run time against error.
+
+    Each run's reactions are compared with the tightest run's history interpolated at the
+    same settlements (the step sizes adapt to the Newton work, so the steps differ).
+    """
+    runs = {t: fixed_settlement_run(case, tolerance=t) for t in TOLERANCES}
+    reference = runs[TOLERANCES[0]][0]
+    rows = []
+    for t, (result, seconds) in runs.items():
+        s, r = result.step_settlement.values[1:], result.step_reaction.values[1:]
+        exact = np.interp(s, reference.step_settlement.values, reference.step_reaction.values)
+        iterations = result.step_newton_iterations.values[1:]
+        rows.append(f"| {t:g} | {iterations.size} | {iterations.sum()} | {iterations.mean():.1f} | {seconds:.1f} | "
+                    f"{r[-1]:.3f} | {np.abs(r / exact - 1).max():.1e} |")
+    return (
+        f"**Newton tolerance** on {reference.attrs['title']} (`||free residual|| / ||gravity load||`), to "
+        f"{CONVERGENCE_SETTLEMENT * 1000:.3f} mm with the plateau stop off; the error is the largest relative "
+        f"difference of the reaction history from the tolerance-{TOLERANCES[0]:g} run's, interpolated at the same "
+        "settlements:\n\n"
+        "| tolerance | steps | Newton iterations | per step | time [s] | final reaction [N] | reaction error |\n"
+        "|---|---|---|---|---|---|---|\n" + "\n".join(rows)
+    )
+
+
+TARGETS = (4, 8, 12, 16)
+
+
+def step_control(case: str = "facade-3") -> str:
+    """Whole runs to the plateau against target_iterations: mean iterations per step against run time."""
+    rows = []
+    for target in TARGETS:
+        start = time.perf_counter()
+        result = mf.solve(mf.open_model(case), "jmm", {"target_iterations": target})
+        seconds = time.perf_counter() - start
+        iterations = result.step_newton_iterations.values[1:]
+        rows.append(f"| {target} | {iterations.size} | {iterations.sum()} | {iterations.mean():.1f} | {seconds:.0f} | "
+                    f"{result.step_settlement.values[-1] * 1000:.4f} | {result.step_reaction.values[-1]:.1f} |")
+    return (
+        f"**Step control** on {result.attrs['title']} ({result.attrs['jmm_dofs']} DOFs), default options to the "
+        "reaction plateau: increments grow by 1.5 after steps of at most `target_iterations` Newton iterations "
+        "and halve after more than twice as many. A step needs about as many iterations whatever its size (the "
+        "active set changes at 100-300 points per step), so smaller steps lower the mean and raise the total:\n\n"
+        "| target_iterations | steps | Newton iterations | per step | time [s] | stop settlement [mm] | plateau [N] |\n"
+        "|---|---|---|---|---|---|---|\n" + "\n".join(rows)
+    )
+
+
 def main() -> None:
     cases = sys.argv[1:] or ["test-12c", "facade-3"]
-    parts = [big_return_map()] + kernels("facade-3") + [convergence()]
+    parts = [big_return_map()] + kernels("facade-3") + [convergence(), tolerance_study(), step_control()]
     runs = [whole_run(case) for case in cases]
     parts.append(
         "Whole runs with the default options (gravity, then settlement to the reaction plateau):\n\n"

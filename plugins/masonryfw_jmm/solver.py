@@ -51,7 +51,7 @@ def _gravity_stage(newton: NewtonSolver, state: State, history: History) -> tupl
 
 def elastic_unloading_settlement(newton: NewtonSolver, state: State) -> tuple[float, float]:
     """Settlement (non-dimensional) that would unload the support with the current tangent, and the slope."""
-    trial, _ = newton.step(state, 1.0, 1.0)  # one linear predictor solve under a unit settlement
+    trial, _ = newton.step(state, 1.0, 1.0, max_iterations=1)  # the tangent predictor alone: one linear solve
     p = newton.problem
     K = p.disc.stiffness(state.tangent)
     du = trial.u - state.u
