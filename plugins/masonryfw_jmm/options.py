@@ -28,7 +28,7 @@ OPTIONS = (
     mf.Option("first_increment", float, 0.05,
               "first settlement increment, as a fraction of the elastic settlement that would unload the support"),
     mf.Option("max_increment", float, 1.0, "largest settlement increment, same unit as first_increment"),
-    mf.Option("target_iterations", int, 12,
+    mf.Option("target_iterations", int, 3,
               "increments grow by 1.5 after steps of at most this many Newton iterations, halve after twice as many"),
     mf.Option("max_settlement", float, 0.0, "stop at this settlement [m]; 0 = 30 elastic unloading settlements"),
     mf.Option("max_steps", int, 200, "largest number of settlement steps"),

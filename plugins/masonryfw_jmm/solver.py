@@ -92,18 +92,24 @@ def run(problem: Problem, options, progress) -> tuple[State, History, dict]:
         limit = options["max_settlement"] / problem.displacement if options["max_settlement"] > 0 else 30 * unloading
         increment, settlement = options["first_increment"] * unloading, 0.0
         largest = options["max_increment"] * unloading
+        last_increment = None  # (du, ds) of the last converged step, extrapolated as a second predictor
         while True:
             if len(history.settlement) - 1 >= options["max_steps"]:
                 info["jmm_stop_reason"] = f"max_steps ({options['max_steps']}) reached"
                 break
             target = min(settlement + increment, limit)
-            trial, report = newton.step(state, 1.0, target)
+            guess = None
+            if last_increment is not None:
+                du, ds = last_increment
+                guess = state.u + (target - settlement) / ds * du
+            trial, report = newton.step(state, 1.0, target, guess=guess)
             if not report.converged:
                 increment /= 2
                 if increment < MIN_INCREMENT * unloading:
                     info["jmm_stop_reason"] = f"no convergence at settlement {target * problem.displacement:.4g} m"
                     break
                 continue
+            last_increment = (trial.u - state.u, target - settlement)
             state, settlement = trial, target
             history.settlement.append(settlement)
             history.reaction.append(newton.reaction(state))

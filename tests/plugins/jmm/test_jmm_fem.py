@@ -132,3 +132,20 @@ def test_newton_converges_quadratically_into_the_plastic_range():
     assert report.converged and r[-1] < 1e-13 and r[0] > 1e-2
     assert state.active.any(axis=1).sum() > 0  # plastic points exist
     assert all(b <= 10 * a**2 for a, b in zip(r[:-1], r[1:])), r
+
+
+def test_a_guess_at_the_solution_replaces_the_predictor():
+    # the extrapolated-increment predictor: an exact guess (the converged displacements of a tight
+    # solve) is taken and the step needs no Newton correction; a poor guess is ignored
+    problem, _ = shear_block_problem()
+    newton = NewtonSolver(problem, tolerance=1e-10, max_iterations=40, regularisation=(1e-2, 1e-2))
+    loaded, _ = newton.step(State.initial(problem), 1.0, 0.0)
+    exact, report = newton.step(loaded, 1.0, 0.2)
+    assert report.converged and report.iterations > 1
+    guessed, guessed_report = newton.step(loaded, 1.0, 0.2, guess=exact.u)
+    assert guessed_report.iterations == 1
+    np.testing.assert_allclose(guessed.stress, exact.stress, atol=1e-9)
+    noise = np.random.default_rng(0).normal(size=exact.u.size)
+    poor, poor_report = newton.step(loaded, 1.0, 0.2, guess=exact.u + noise)
+    assert poor_report.residuals[0] == report.residuals[0]  # the tangent predictor kept
+    np.testing.assert_allclose(poor.stress, exact.stress, atol=1e-8)
