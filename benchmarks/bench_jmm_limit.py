@@ -1,7 +1,7 @@
 """Benchmark of ``jmm`` method=limit (the static LP on the mesh): LP size, times, alpha, against LA.
 
 Run from the benchmarks folder: ``python bench_jmm_limit.py [case ...]`` (default: test-8c test-12c facade-3;
-``--incremental`` also runs the incremental solver to its plateau on the same mesh, minutes per wall).
+``--incremental`` also runs the incremental solver to its plateau on the same mesh, up to a minute per wall).
 Writes the ``jmm_limit`` section of docs/benchmarks.md.
 """
 from __future__ import annotations
