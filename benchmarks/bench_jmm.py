@@ -94,31 +94,45 @@ def fixed_settlement_run(case: str, **given):
     return result, seconds
 
 
-def reaction_at(case: str, **given) -> tuple[float, float, int, float, int]:
-    """Reaction at CONVERGENCE_SETTLEMENT (plateau stop off), run time, DOFs, mean iterations, steps."""
-    result, seconds = fixed_settlement_run(case, **given)
+COLUMNS = "| steps | reaction [N] | {} | cracked joints | F1 | locus distance | time [s] | mean Newton iterations |"
+
+
+def cells(result, seconds: float, difference: str, finest) -> str:
+    """Table cells of one run: reaction, ``difference``, and its crack pattern scored against ``finest``."""
     iterations = result.step_newton_iterations.values[1:]
-    return float(result.step_reaction.values[-1]), seconds, int(result.attrs["jmm_dofs"]), iterations.mean(), iterations.size
+    score = mf.compare(result, finest)
+    return (f"{iterations.size} | {float(result.step_reaction.values[-1]):.2f} | {difference} | "
+            f"{int(score.crack_count_a)} | {float(score.crack_f1):.2f} | {float(score.locus_distance):.3f} | "
+            f"{seconds:.1f} | {iterations.mean():.1f} |")
 
 
 def convergence(case: str = "test-12c") -> str:
-    """Reaction at a fixed settlement against mesh size and first load step, beside the collapse reaction.
+    """Reaction and plastic-zone pattern at a fixed settlement against mesh size and first load step.
 
-    The reference is independent of the incremental solver: the static limit LP on the
-    same continuum (method=limit), whose value on Test 12C is the closed-form wedge reaction
-    W_moving - gamma t h^2 tan(phi) / 2 (docs/jmm.md).
+    The reaction's reference is independent of the incremental solver: the static limit LP
+    on the same continuum (method=limit), whose value on Test 12C is the closed-form wedge
+    reaction W_moving - gamma t h^2 tan(phi) / 2 (docs/jmm.md). The pattern is the
+    crack_indicator on the block model's joints (mesh-independent), scored by the compare
+    plugin against the finest run's.
     """
     start = time.perf_counter()
     collapse = mf.solve(mf.open_model(case), "jmm", {"method": "limit"})
     limit_seconds = time.perf_counter() - start
     reference = float(collapse.moving_support_reaction)
-    mesh = {h: reaction_at(case, mesh_size=h) for h in MESH_SIZES}
-    rows = [f"| {h * 1000:.1f} | {dofs} | {r:.2f} | {(r - reference) / reference:+.2%} | {t:.1f} | {it:.1f} |"
-            for h, (r, t, dofs, it, _) in mesh.items()]
-    steps = {f: reaction_at(case, first_increment=f) for f in FIRST_INCREMENTS}
-    finest = steps[FIRST_INCREMENTS[-1]][0]
-    step_rows = [f"| {f} | {n} | {r:.2f} | {(r - finest) / finest:+.3%} | {t:.1f} | {it:.1f} |"
-                 for f, (r, t, _, it, n) in steps.items()]
+    mesh = {h: fixed_settlement_run(case, mesh_size=h) for h in MESH_SIZES}
+    finest = mesh[MESH_SIZES[-1]][0]
+    rows = []
+    for h, (result, seconds) in mesh.items():
+        r = float(result.step_reaction.values[-1])
+        rows.append(f"| {h * 1000:.1f} | {result.attrs['jmm_dofs']} | "
+                    + cells(result, seconds, f"{(r - reference) / reference:+.2%}", finest))
+    steps = {f: fixed_settlement_run(case, first_increment=f) for f in FIRST_INCREMENTS}
+    smallest = steps[FIRST_INCREMENTS[-1]][0]
+    r_smallest = float(smallest.step_reaction.values[-1])
+    step_rows = []
+    for f, (result, seconds) in steps.items():
+        r = float(result.step_reaction.values[-1])
+        step_rows.append(f"| {f} | " + cells(result, seconds, f"{(r - r_smallest) / r_smallest:+.3%}", smallest))
     return (
         f"**Convergence on Test 12C**: reaction on the moving support at a settlement of "
         f"{CONVERGENCE_SETTLEMENT * 1000:.3f} mm (the plateau stop turned off, so every run ends at the same "
@@ -126,14 +140,15 @@ def convergence(case: str = "test-12c") -> str:
         f"(`method=limit`, 25 mm: {reference:.2f} N in {limit_seconds:.1f} s; the closed-form wedge gives 345.61 N "
         "at apex_shift 0). Displacement elements let the wall arch too easily, so the reaction comes out "
         "low and rises towards the collapse value as the mesh is refined; the cells follow the 200 x 50 mm "
-        "units, so the nominal sizes are not a geometric sequence.\n\n"
-        "| mesh size [mm] | DOFs | reaction [N] | vs collapse | time [s] | mean Newton iterations |\n"
-        "|---|---|---|---|---|---|\n" + "\n".join(rows) +
+        "units, so the nominal sizes are not a geometric sequence. The plastic-zone pattern is the "
+        "`crack_indicator` (points yielding in the last step, mapped onto the joints; cracked above 0.1) "
+        "scored by the `compare` plugin against the finest run: F1 of the cracked joints and the locus "
+        "distance (fraction of the wall size).\n\n"
+        "| mesh size [mm] | DOFs " + COLUMNS.format("vs collapse") + "\n" + "|---" * 10 + "|\n" + "\n".join(rows) +
         "\n\nLoad-step size at the default mesh (the first increment, in elastic unloading settlements; later "
-        f"increments grow by 1.5 after steps of <= {DEFAULT['target_iterations']} Newton iterations; difference against "
-        "the smallest):\n\n"
-        "| first_increment | steps | reaction [N] | difference | time [s] | mean Newton iterations |\n"
-        "|---|---|---|---|---|---|\n" + "\n".join(step_rows)
+        f"increments grow by 1.5 after steps of <= {DEFAULT['target_iterations']} Newton iterations; differences "
+        "against the smallest):\n\n"
+        "| first_increment " + COLUMNS.format("difference") + "\n" + "|---" * 9 + "|\n" + "\n".join(step_rows)
     )
 
 
