@@ -18,9 +18,9 @@ from masonryfw_jmm.newton import NewtonSolver, State
 from masonryfw_jmm.problem import build_problem
 from masonryfw_jmm.options import OPTIONS
 
-DEFAULT = {o.name: o.default for o in OPTIONS}
-
 from _report import write_section
+
+DEFAULT = {o.name: o.default for o in OPTIONS}
 
 
 def median_time(function, repeat: int = 5) -> float:

@@ -149,13 +149,13 @@ class NewtonSolver:
         rhs = -(base[free] + K[free][:, fixed_all] @ jump)
         u[free] += self._solve(K, rhs)
         state = self.evaluate(u, start, gravity_factor)
-        if guess is not None:
+        residuals = [self._norm(state)]
+        if guess is not None and residuals[0] > self.tolerance:
             guessed = guess.copy()
             guessed[fixed_all] = u[fixed_all]
             other = self.evaluate(guessed, start, gravity_factor)
-            if self._norm(other) < self._norm(state):
-                state = other
-        residuals = [self._norm(state)]
+            if self._norm(other) < residuals[0]:
+                state, residuals = other, [self._norm(other)]
         iterations = 1
         previous = start.active
         while residuals[-1] > self.tolerance and iterations < limit:

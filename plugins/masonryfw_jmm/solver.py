@@ -53,7 +53,7 @@ def elastic_unloading_settlement(newton: NewtonSolver, state: State) -> tuple[fl
     """Settlement (non-dimensional) that would unload the support with the current tangent, and the slope."""
     trial, _ = newton.step(state, 1.0, 1.0, max_iterations=1)  # the tangent predictor alone: one linear solve
     p = newton.problem
-    K = p.disc.stiffness(state.tangent)
+    K = p.disc.stiffness(newton._regularised(state, False))  # the tangent the predictor solved with
     du = trial.u - state.u
     slope = float((K @ du)[p.moving[p.moving_vertical]].sum())
     reaction = newton.reaction(state)
