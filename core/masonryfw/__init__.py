@@ -18,14 +18,17 @@ except PackageNotFoundError:  # running from a source tree that is not installed
 from .errors import MasonryError, ModelError, PluginError, SolveError, SpecError
 from .progress import ProgressCallback, no_progress
 from .hookspecs import (
+    AUTO,
     Comparator,
     Option,
     Plotter,
     Solver,
+    Variant,
     hookimpl,
     lazy,
     parse_option_pairs,
     resolve_options,
+    unknown_name_message,
 )
 from .schema import FORMAT_VERSION, flags, load_schema, variable_attrs
 from .geometry import (
@@ -38,12 +41,46 @@ from .geometry import (
     node_block,
     polygon_area_centroid,
 )
+from .dofs import block_loads, block_motion, load_variables, motion_variables, upgrade
+from .semantics import (
+    INTACT_SHARE,
+    KeyNumber,
+    ModelScales,
+    connected_components,
+    crack_indicator,
+    dead_reaction,
+    interface_states,
+    joint_motion,
+    key_numbers,
+    macro_blocks,
+    masonry_blocks,
+    masonry_joints,
+    model_scales,
+    point_motion,
+    polar_moment,
+    relative_motion,
+    states_at,
+    support_blocks,
+)
 from .interfaces import detect_interfaces
 from .checks import Problem, check
 from .linalg import cholesky_factor, has_cholmod
-from .io import add_history, content_sha256, open_dataset, open_model, save, save_figure, sha256_file
+from .io import add_history, check_output_path, content_sha256, open_dataset, save, save_figure, sha256_file
+from .model import checked_model, model_part, open_model
 from .builder import build, dump_toml, load_spec
-from .datasets import bundled_cases, bundled_spec_path
-from .plugins import compare, get_comparator, get_plotter, get_solver, plugin_manager, render, solve
+from .datasets import CASE_NAMES, bundled_cases, bundled_spec_path
+from .plugins import (
+    compare,
+    core_version,
+    get_comparator,
+    get_plotter,
+    get_solver,
+    installed_solvers,
+    options_json,
+    plugin_manager,
+    render,
+    solve,
+    solver_version,
+)
 
 __all__ = [name for name in dir() if not name.startswith("_")]

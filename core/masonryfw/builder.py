@@ -1,4 +1,4 @@
-"""The wall builder: a TOML spec in, a complete model dataset (FORMAT.md) out.
+"""The wall builder: a TOML spec in, a complete model dataset (docs/format.md) out.
 
 A spec describes a plane wall of rectangular units in courses, its openings
 with lintels, its support ranges along the base, the material and the loading
@@ -24,13 +24,12 @@ Generation rules (the model is always in SI; ``length_unit`` only scales input):
   head joint on either side (e.g. a narrow pier between an opening and the
   wall end) stays as it is. Every block is a rectangle.
 * **Supports** are rectangular blocks one unit high under the wall, one per
-  support range; interfaces between two support blocks are dropped (supports
-  move as prescribed, a contact between them carries nothing).
-* **Loads** follow docs/architecture.md: self-weight of units and lintels;
-  settlement loading puts ``+R`` dead and ``-R`` live (vertical) on every
-  moving support, ``R = W L_m / L_total`` from the support contacts actually
-  found; tilt loading puts the weight horizontally as live load on every unit
-  and lintel and holds every support (moving ones become fixed supports).
+  support range.
+* **Interfaces, kinds and loads** as every model gets them (:mod:`masonryfw.blocks`):
+  self-weight of units and lintels; settlement loading puts ``+R`` dead and
+  ``-R`` live (vertical) on every moving support, ``R = W L_m / L_total`` from
+  the support contacts actually found; tilt loading puts the weight
+  horizontally as live load on every unit and lintel and holds every support.
 """
 from __future__ import annotations
 
@@ -44,10 +43,10 @@ from dataclasses import dataclass, replace
 import numpy as np
 import xarray as xr
 
+from . import blocks
 from .errors import SpecError
-from .geometry import derive_geometry
-from .interfaces import detect_interfaces
-from .schema import FORMAT_VERSION, flags, variable_attrs
+from .model import checked_model
+from .schema import flags
 
 try:  # Python >= 3.11
     import tomllib
@@ -55,7 +54,6 @@ except ModuleNotFoundError:  # pragma: no cover - Python 3.10
     import tomli as tomllib
 
 LENGTH_UNITS = {"m": 1.0, "mm": 1.0e-3}
-DOF_NAMES = ("ux", "uy", "rz")
 #: Relative tolerance on "a whole number of courses" (heights divided by the unit height).
 COURSE_TOLERANCE = 1.0e-6
 #: Position tolerance, relative to the wall size.
@@ -519,176 +517,36 @@ def masonry_blocks(wall: Wall):
     return x0[order], x1[order], y0, y0 + wall.unit_height, kinds[order].astype(np.int8)
 
 
-def _rectangle_nodes(x0, x1, y0, y1):
-    """Counter-clockwise vertices of rectangles, block after block."""
-    node_x = np.stack((x0, x1, x1, x0), axis=1).ravel()
-    node_y = np.stack((y0, y0, y1, y1), axis=1).ravel()
-    return node_x, node_y
-
-
-# --------------------------------------------------------------------------- loads and supports
-
-
-def _rotation_direction(centre, pivot) -> np.ndarray:
-    """Unit dof-space direction of a small rotation about ``pivot`` that moves ``centre`` down."""
-    dx, dy = centre[0] - pivot[0], centre[1] - pivot[1]
-    omega = -math.copysign(1.0, dx)
-    direction = np.array([-omega * dy, omega * dx, omega])
-    return direction / np.linalg.norm(direction)
-
-
-def _support_kinematics(wall: Wall, centres):
-    """``block_fixed``, ``settlement_direction`` and role of every support block."""
-    role = flags("block_role")
-    count = len(wall.supports)
-    fixed = np.ones((count, 3), dtype=np.int8)
-    direction = np.zeros((count, 3))
-    roles = np.full(count, role["fixed_support"], dtype=np.int8)
-    if wall.loading == "tilt":
-        return fixed, direction, roles
-    for i, support in enumerate(wall.supports):
-        if support.kind != "moving":
-            continue
-        roles[i] = role["moving_support"]
-        if support.motion == "translation":
-            fixed[i] = (1, 0, 1)
-            direction[i] = (0.0, -1.0, 0.0)
-        else:
-            fixed[i] = 0
-            direction[i] = _rotation_direction(centres[i], support.pivot)
-    return fixed, direction, roles
-
-
-def _interface_kinds(blocks, ix, iy, is_support) -> np.ndarray:
-    kind = flags("interface_kind")
-    dx = np.abs(ix[:, 1] - ix[:, 0])
-    dy = np.abs(iy[:, 1] - iy[:, 0])
-    length = np.hypot(dx, dy)
-    out = np.full(blocks.shape[0], kind["other"], dtype=np.int8)
-    out[dy <= POSITION_TOLERANCE * length] = kind["bed"]
-    out[dx <= POSITION_TOLERANCE * length] = kind["head"]
-    out[is_support[blocks].any(axis=1)] = kind["support"]
-    return out
-
-
-def _support_reactions(wall: Wall, blocks, length, first_support: int, weight_total: float) -> np.ndarray:
-    """Dead-load reaction ``R = W L_m / L_total`` of every support block (0 for fixed ones and under tilt).
-
-    ``L`` are the lengths of the wall-on-support interfaces actually found, so a
-    support partly under a door only counts where masonry stands on it.
-    """
-    count = len(wall.supports)
-    local = blocks - first_support
-    on_support = (local >= 0) & (local < count)
-    contact = np.bincount(local[on_support], weights=np.broadcast_to(length[:, None], blocks.shape)[on_support],
-                          minlength=count)
-    total = contact.sum()
-    if total <= 0:
-        raise SpecError("spec key 'supports': no masonry rests on any support")
-    reaction = np.zeros(count)
-    if wall.loading != "settlement":
-        return reaction
-    for i, support in enumerate(wall.supports):
-        if support.kind == "moving":
-            if contact[i] <= 0:
-                raise SpecError(f"spec key 'supports.{support.name}': no masonry rests on this moving support")
-            reaction[i] = weight_total * contact[i] / total
-    return reaction
-
-
 # --------------------------------------------------------------------------- the dataset
 
 
-def build(spec) -> xr.Dataset:
+def build(spec, *, validate: bool = True) -> xr.Dataset:
     """Build the model dataset of a wall spec (a dict, a path, a Traversable or TOML text).
 
     Blocks come course by course, left to right (units and lintels), then the
-    supports in spec order. Raises :class:`SpecError` naming the key at fault.
+    supports in spec order; interfaces, kinds and loads as every model gets them
+    (:mod:`masonryfw.blocks`). Raises :class:`SpecError` naming the key at fault.
+    The model is returned checked (:func:`masonryfw.checked_model`), unless
+    ``validate`` is False.
     """
     spec_dict, text = _read_spec(spec)
     wall = parse_spec(spec_dict)
-
     mx0, mx1, my0, my1, m_role = masonry_blocks(wall)
     s_x0 = np.array([s.start for s in wall.supports])
     s_x1 = np.array([s.end for s in wall.supports])
-    s_y1 = np.zeros(s_x0.size)
-    s_y0 = s_y1 - wall.unit_height
-    centres = np.stack((0.5 * (s_x0 + s_x1), 0.5 * (s_y0 + s_y1)), axis=1)
-    s_fixed, s_direction, s_role = _support_kinematics(wall, centres)
-
-    n_masonry, n_support = mx0.size, s_x0.size
-    n_block = n_masonry + n_support
     x0, x1 = np.concatenate((mx0, s_x0)), np.concatenate((mx1, s_x1))
-    y0, y1 = np.concatenate((my0, s_y0)), np.concatenate((my1, s_y1))
-    node_x, node_y = _rectangle_nodes(x0, x1, y0, y1)
-    node_count = np.full(n_block, 4, dtype=np.int32)
-    is_support = np.arange(n_block) >= n_masonry
-
-    found = detect_interfaces(node_x, node_y, node_count)
-    blocks = np.asarray(found["blocks"], dtype=np.int64).reshape(-1, 2)
-    keep = ~is_support[blocks].all(axis=1)
-    blocks = blocks[keep]
-    ix = np.asarray(found["x"], dtype=float).reshape(-1, 2)[keep]
-    iy = np.asarray(found["y"], dtype=float).reshape(-1, 2)[keep]
-    length = np.hypot(ix[:, 1] - ix[:, 0], iy[:, 1] - iy[:, 0])
-
-    unit_weight = np.concatenate((np.full(n_masonry, wall.unit_weight), np.zeros(n_support)))
-    weight = unit_weight * (x1 - x0) * (y1 - y0) * wall.thickness
-    reaction = _support_reactions(wall, blocks, length, n_masonry, weight.sum())
-
-    dead = np.zeros((n_block, 3))
-    live = np.zeros((n_block, 3))
-    dead[:, 1] = -weight
-    dead[n_masonry:, 1] = reaction
-    live[n_masonry:, 1] = -reaction
-    if wall.loading == "tilt":
-        live[:n_masonry, 0] = wall.tilt_direction * weight[:n_masonry]
-    fixed = np.zeros((n_block, 3), dtype=np.int8)
-    fixed[n_masonry:] = s_fixed
-    direction = np.zeros((n_block, 3))
-    direction[n_masonry:] = s_direction
-
-    n_interface = blocks.shape[0]
-    block_vars = {
-        "node_x": (("node",), node_x),
-        "node_y": (("node",), node_y),
-        "block_node_count": (("block",), node_count),
-        "block_geometry": ((), np.int8(0)),
-        "block_role": (("block",), np.concatenate((m_role, s_role)).astype(np.int8)),
-        "block_thickness": (("block",), np.full(n_block, wall.thickness)),
-        "block_unit_weight": (("block",), unit_weight),
-        "interface_blocks": (("interface", "side"), blocks.astype(np.int32)),
-        "interface_x": (("interface", "end"), ix),
-        "interface_y": (("interface", "end"), iy),
-        "interface_kind": (("interface",), _interface_kinds(blocks, ix, iy, is_support)),
-        "interface_friction": (("interface",), np.full(n_interface, wall.friction)),
-        "interface_cohesion": (("interface",), np.full(n_interface, wall.cohesion)),
-        "interface_tensile_strength": (("interface",), np.full(n_interface, wall.tensile_strength)),
-        "dead_load": (("block", "dof"), dead),
-        "live_load": (("block", "dof"), live),
-        "block_fixed": (("block", "dof"), fixed),
-        "settlement_direction": (("block", "dof"), direction),
-    }
-    if wall.young_modulus is not None:
-        block_vars["block_young_modulus"] = (("block",), np.full(n_block, wall.young_modulus))
-    if wall.poisson_ratio is not None:
-        block_vars["block_poisson_ratio"] = (("block",), np.full(n_block, wall.poisson_ratio))
-    data_vars = {name: (dims, values, variable_attrs(name)) for name, (dims, values) in block_vars.items()}
-    attrs = {
-        "Conventions": "CF-1.11",
-        "masonryfw_format": "model",
-        "masonryfw_format_version": FORMAT_VERSION,
-        "title": wall.title,
-        "source_spec": text,
-    }
+    y0 = np.concatenate((my0, np.full(s_x0.size, -wall.unit_height)))
+    y1 = np.concatenate((my1, np.zeros(s_x0.size)))
+    role = np.concatenate((m_role, np.full(s_x0.size, flags("block_role")["fixed_support"], dtype=np.int8)))
+    supports = [blocks.Support(f"spec key 'supports.{s.name}'", s.kind, s.motion, s.pivot) for s in wall.supports]
+    material = blocks.Material(wall.unit_weight, wall.friction, wall.cohesion, wall.tensile_strength,
+                               wall.young_modulus, wall.poisson_ratio)
+    attrs = {"title": wall.title, "source_spec": text}
     if wall.description:
         attrs["comment"] = wall.description
-    ds = xr.Dataset(
-        data_vars,
-        coords={"dof": ("dof", list(DOF_NAMES), variable_attrs("dof"))},
-        attrs=attrs,
-    )
-    return derive_geometry(ds)
+    ds = blocks.model_from_blocks(*blocks.rectangle_nodes(x0, x1, y0, y1), role, wall.thickness, material, supports,
+                                  wall.loading, wall.tilt_direction, attrs)
+    return checked_model(ds, repr(wall.title)) if validate else ds
 
 
 # --------------------------------------------------------------------------- TOML output

@@ -24,8 +24,9 @@ from dataclasses import dataclass
 import numpy as np
 import xarray as xr
 
+from .dofs import upgrade
 from .geometry import block_offsets, model_scale, next_node, node_block, polygon_area_centroid
-from .schema import FORMAT_VERSION, KINDS, load_schema
+from .schema import FORMAT_VERSION, KINDS, READABLE_VERSIONS, load_schema
 
 RELATIVE_TOLERANCE = 1e-6  # lengths below this fraction of the model scale count as zero
 UNIT_VECTOR_TOLERANCE = 1e-6  # |settlement_direction| must be 1 within this
@@ -45,18 +46,25 @@ class Problem:
         return f"{self.where}: {self.message}{at}"
 
 
-def check(ds: xr.Dataset, kind: str | None = None) -> list[Problem]:
+def check(ds: xr.Dataset, kind: str | None = None, *, model_checked: bool = False) -> list[Problem]:
     """Every problem of a ``model``, ``result`` or ``comparison`` dataset (``[]`` when valid).
 
     ``kind`` defaults to the dataset's ``masonryfw_format`` attribute. A result
     may be checked as a model (a result holds its model): its format attribute
-    may name any kind whose schema extends ``kind``.
+    may name any kind whose schema extends ``kind``. A dataset of an older
+    format version is checked as it reads (upgraded, :func:`masonryfw.dofs.upgrade`).
+    ``model_checked=True`` checks only what a result adds to a model already
+    checked (its variables' format and its attributes), as :func:`masonryfw.solve`
+    does with what a solver returned.
     """
     problems: list[Problem] = []
     kind = _dataset_kind(ds, kind, problems)
     if kind is None or not _version_is_known(ds, problems):
         return problems
+    ds = upgrade(ds)
     schema = load_schema(kind)
+    if model_checked:
+        return _added_variable_problems(ds, schema, kind)
     problems += _attribute_problems(ds, schema, kind)
     problems += _dimension_problems(ds, schema)
     usable, structure = _variable_structure_problems(ds, schema)
@@ -71,6 +79,15 @@ def check(ds: xr.Dataset, kind: str | None = None) -> list[Problem]:
     problems += _support_problems(ds, usable, model)
     problems += _load_problems(ds, usable)
     return problems
+
+
+def _added_variable_problems(ds, schema, kind) -> list[Problem]:
+    """The format layer for the variables a result adds to its (checked) model."""
+    model_variables = load_schema("model")["variables"]
+    added = {**schema, "variables": {n: v for n, v in schema["variables"].items() if n not in model_variables}}
+    problems = _attribute_problems(ds, added, kind)
+    usable, structure = _variable_structure_problems(ds, added)
+    return problems + structure + _value_problems(ds, added, usable, None)
 
 
 # ---------------------------------------------------------------- format layer
@@ -100,14 +117,14 @@ def _version_is_known(ds, problems) -> bool:
         return True  # reported with the other required attributes
     try:
         number = int(np.asarray(version).item())
-        known = number == FORMAT_VERSION and float(np.asarray(version).item()) == number
+        known = number in READABLE_VERSIONS and float(np.asarray(version).item()) == number
     except (TypeError, ValueError):
         known = False
     if not known:
         problems.append(Problem(
             "attribute masonryfw_format_version",
-            f"unknown format version {_shown(version)}; this masonryfw reads version {FORMAT_VERSION} "
-            "(upgrade masonryfw or convert the file)",
+            f"unknown format version {_shown(version)}; this masonryfw reads versions "
+            f"{', '.join(map(str, READABLE_VERSIONS))} (writes {FORMAT_VERSION}); upgrade masonryfw",
         ))
     return known
 
@@ -129,6 +146,10 @@ def _attribute_problems(ds, schema, kind) -> list[Problem]:
             continue
         if "value" in spec and str(value) != str(spec["value"]):
             problems.append(Problem(where, f"is {_shown(value)}, must be {_shown(spec['value'])}"))
+        if "contains" in spec and spec["contains"] not in str(value).split():
+            problems.append(Problem(where, f"is {_shown(value)}, must name {spec['contains']!r}"))
+        if "choices" in spec and str(value) not in spec["choices"]:
+            problems.append(Problem(where, f"is {_shown(value)}, must be one of {', '.join(map(repr, spec['choices']))}"))
         if spec.get("json"):
             try:
                 json.loads(value)
@@ -281,10 +302,12 @@ def _element_where(dim, index, model):
 
 
 def _component(ds, dims, index) -> str:
-    """``[uy]``, ``[side 1]``, ``[end 0]`` for the trailing index of a 2-D variable."""
+    """``[uy]``, ``[y]``, ``[side 1]``, ``[end 0]`` for the trailing index of a 2-D variable."""
     if len(dims) < 2:
         return ""
     dim, k = dims[1], index[1]
+    if dim == "axis":
+        return f"[{'xy'[k]}]"
     if dim in ds.coords and ds.coords[dim].dtype.kind in "USO":
         return f"[{ds.coords[dim].values[k]}]"
     return f"[{dim} {k}]"
@@ -736,10 +759,10 @@ def _dof_labels(ds) -> np.ndarray:
 
 
 def _load_problems(ds, usable) -> list[Problem]:
-    if "live_load" not in usable or ds.sizes.get("block", 0) == 0:
+    if not {"live_load", "live_moment"} <= usable or ds.sizes.get("block", 0) == 0:
         return []
-    live = np.asarray(ds["live_load"].values, dtype=float)
-    if np.any(np.isfinite(live) & (live != 0)):
+    live = [np.asarray(ds[name].values, dtype=float) for name in ("live_load", "live_moment")]
+    if any(np.any(np.isfinite(v) & (v != 0)) for v in live):
         return []
     return [Problem(
         "variable live_load",

@@ -7,7 +7,7 @@ unless ``--debug`` is given; usage errors exit with 2 (click's default).
 from __future__ import annotations
 
 import json
-import os
+import signal
 import shlex
 import sys
 import warnings
@@ -17,7 +17,10 @@ import click
 import numpy as np
 
 import masonryfw as mf
-from masonryfw.plugins import command_plugin, installed_plugins, model_part, plugin_commands, render
+from masonryfw.plugins import command_plugin, installed_plugins, plugin_commands, render
+
+#: Exit status of a run stopped by Ctrl-C (128 + SIGINT), as shells report it.
+INTERRUPTED = 130
 
 
 def _error_message(exc: BaseException) -> str:
@@ -58,6 +61,9 @@ class _MasonryGroup(click.Group):
     def invoke(self, ctx):
         try:
             return super().invoke(ctx)
+        except Interrupted as exc:
+            click.echo(str(exc), err=True)
+            ctx.exit(INTERRUPTED)
         except (mf.MasonryError, OSError) as exc:
             if ctx.params.get("debug"):
                 raise
@@ -130,11 +136,26 @@ def _progress_bar(enabled: bool) -> _StderrBar | None:
 @click.option("-o", "--output", type=click.Path(dir_okay=False), help="Model file to write [default: <spec stem>.nc].")
 def build(spec: str, output: str | None) -> None:
     """Build a model from SPEC (a TOML file or a bundled case name)."""
-    spec_path = Path(spec) if _is_path(spec) else mf.bundled_spec_path(spec)
-    model = mf.build(mf.load_spec(spec_path))
+    spec_path = Path(spec) if _is_path(spec) else _bundled_spec(spec)
+    inputs = _input_files(spec)
     out = Path(output) if output else Path(f"{Path(spec).stem}.nc")
-    mf.save(model, out, command=_command_line(), protect=[spec_path])
+    mf.check_output_path(out, inputs)
+    model = mf.build(spec_path)
+    mf.save(model, out, command=_command_line(), protect=inputs)
     click.echo(f"wrote {out}: {model.sizes['block']} blocks, {model.sizes.get('interface', 0)} interfaces")
+
+
+def _bundled_spec(name: str):
+    """The spec of a bundled case; a name that looks like a path is a missing file."""
+    if name in mf.CASE_NAMES:
+        return mf.bundled_spec_path(name)
+    if "/" in name or Path(name).suffix:
+        raise mf.SpecError(f"{name}: no such file")
+    raise mf.SpecError(f"{name}: no such file, and not a bundled case; bundled cases: {', '.join(mf.CASE_NAMES)}")
+
+
+def _input_files(*names: str) -> list[Path]:
+    return [Path(n) for n in names if _is_path(n)]
 
 
 @cli.command(name="check")
@@ -223,19 +244,19 @@ def info(model: str) -> None:
 @cli.command()
 def datasets() -> None:
     """List the bundled cases with their titles and block counts."""
-    for name in mf.bundled_cases():
-        model = mf.open_model(name, validate=False)
+    for name in mf.CASE_NAMES:
+        model = mf.build(mf.bundled_spec_path(name), validate=False)
         click.echo(f"{name:<12} {model.attrs.get('title', ''):<12} {model.sizes['block']:>5} blocks")
 
 
 # ---------------------------------------------------------------- plugins
 
 def _record_lines(kind: str, record) -> list[str]:
-    lines = [f"  {kind} {record.name} {record.version}: {record.summary}"]
+    lines = [f"  {kind} {record.name}: {record.summary}"]
     for option in record.options:
-        choices = f", one of {', '.join(map(str, option.choices))}" if option.choices else ""
-        usage = f"--option {option.name}=<{option.type.__name__}>  (default {option.default!r}{choices})"
-        lines.append(f"      {usage}  {option.help}".rstrip())
+        lines.append(f"      --option {option.name}={option.usage()}  {option.help}".rstrip())
+    for variant in getattr(record, "variants", ()):
+        lines.append(f"      variant {variant.label}: {json.dumps(dict(variant.options))}")
     return lines
 
 
@@ -268,6 +289,18 @@ def _scalar_summary(ds, names) -> str:
     return ", ".join(parts)
 
 
+def _open_input(path_or_name: str):
+    """A dataset file as it is (model, result); a spec file or a bundled case name as its model."""
+    path = Path(path_or_name)
+    if path.is_file() and path.suffix.lower() not in mf.model.SPEC_SUFFIXES:
+        return mf.open_dataset(path)
+    return mf.open_model(path_or_name)
+
+
+class Interrupted(mf.MasonryError):
+    """Ctrl-C stopped a command: the message says what was kept; exit status 130."""
+
+
 @cli.command()
 @click.argument("model")
 @click.option("--plugin", "solver", required=True, help="Name of the solver (see `masonryfw plugins`).")
@@ -275,22 +308,39 @@ def _scalar_summary(ds, names) -> str:
 @_OPTION
 @click.option("--no-progress", is_flag=True, help="Do not draw a progress bar.")
 def solve(model: str, solver: str, output: str | None, options: dict[str, str], no_progress: bool) -> None:
-    """Solve MODEL (a file or a bundled case name) with a solver plugin."""
-    inputs = [Path(model)] if _is_path(model) else []
+    """Solve MODEL (a model file, a spec file or a bundled case name) with a solver plugin.
+
+    Prints the headline numbers: alpha and the reaction at collapse (limit
+    analysis); the dead, smallest and plateau reactions with their settlements
+    (incremental solvers); else the solver's scalar outputs. Ctrl-C keeps what an incremental solver has computed
+    so far (exit status 130).
+    """
+    inputs = _input_files(model)
     out = Path(output) if output else Path(f"{Path(model).stem if inputs else model}.{solver}.nc")
-    _refuse_overwriting(out, inputs)
+    mf.check_output_path(out, inputs)
     dataset = mf.open_model(model)
     bar = _progress_bar(not no_progress)
     try:
         result = mf.solve(dataset, solver, options, progress=bar)
+    except KeyboardInterrupt:
+        raise Interrupted(f"solve {solver}: interrupted before its first step: nothing written") from None
     finally:
         if bar is not None:
             bar.close()
     mf.save(result, out, command=_command_line(), protect=inputs)
-    added = [name for name in result.data_vars if name not in model_part(dataset).variables]
-    summary = _scalar_summary(result, ["collapse_multiplier"] if "collapse_multiplier" in added else added)
+    if int(result.attrs.get("interrupted", 0)):
+        raise Interrupted(f"interrupted at settlement {_last_settlement(result)}: partial result written to {out}")
+    numbers = ", ".join(map(str, mf.key_numbers(result))) or _scalar_summary(
+        result, [name for name in result.data_vars if name not in dataset.variables])
+    stop = f"; {result.attrs['stop_reason']}" if result.attrs.get("stop_reason") else ""
     click.echo(f"result: {out}")
-    click.echo(f"{solver}: {summary + '; ' if summary else ''}wall time {result.attrs['wall_time_s']:.3g} s")
+    click.echo(f"{solver}: {numbers + stop + '; ' if numbers else ''}wall time {result.attrs['wall_time_s']:.3g} s")
+
+
+def _last_settlement(result) -> str:
+    if "step_settlement" in result and result.step_settlement.size:
+        return f"{float(result.step_settlement.values[-1]):.6g} m"
+    return "0 m"
 
 
 @cli.command()
@@ -304,6 +354,8 @@ def compare(
     a: str, b: str, comparator: str | None, output: str | None, options: dict[str, str], as_json: bool
 ) -> None:
     """Compare two results A and B."""
+    if output:
+        mf.check_output_path(output, [a, b])
     comparison = mf.compare(mf.open_dataset(a), mf.open_dataset(b), comparator, options)
     if output:
         mf.save(comparison, output, command=_command_line(), protect=[a, b])
@@ -323,21 +375,12 @@ def compare(
 @click.option("-o", "--output", type=click.Path(dir_okay=False), required=True, help="Image file (png, svg, pdf).")
 @_OPTION
 def plot(results: tuple[str, ...], kind: str | None, output: str, options: dict[str, str]) -> None:
-    """Plot one or more RESULTS (files or bundled case names) with a plotter plugin."""
-    figure = render([mf.open_model(r) for r in results], kind, options)
-    if Path(output).suffix.lower() not in mf.io.FIGURE_FORMATS:
-        raise click.BadParameter(
-            f"{output}: unknown image type; use one of {', '.join(mf.io.FIGURE_FORMATS)}", param_hint="-o"
-        )
-    mf.save_figure(figure, output, protect=[r for r in results if _is_path(r)])
+    """Plot one or more RESULTS (result or model files, spec files, bundled case names) with a plotter plugin."""
+    inputs = _input_files(*results)
+    mf.check_output_path(output, inputs, mf.io.FIGURE_FORMATS)
+    figure = render([_open_input(r) for r in results], kind, options)
+    mf.save_figure(figure, output, protect=inputs)
     click.echo(f"plot: {output}")
-
-
-def _refuse_overwriting(output: Path, inputs: list[Path]) -> None:
-    """Stop before any work if ``output`` is one of the ``inputs`` (through links and relative paths)."""
-    for source in inputs:
-        if output.resolve() == source.resolve() or (output.exists() and os.path.samefile(output, source)):
-            raise mf.ModelError(f"{output}: refusing to overwrite the input {source}; write to another path")
 
 
 def _show_warning(message, category, filename, lineno, file=None, line=None) -> None:
@@ -345,7 +388,22 @@ def _show_warning(message, category, filename, lineno, file=None, line=None) -> 
 
 
 def main(argv: list[str] | None = None) -> None:
-    """Entry point of the ``masonryfw`` script and of ``python -m masonryfw``."""
+    """Entry point of the ``masonryfw`` script and of ``python -m masonryfw``.
+
+    A closed output pipe (``masonryfw datasets | head -1``) ends the command
+    quietly, as for any Unix tool; Ctrl-C ends it with status 130 and a line
+    saying what was kept (see the commands).
+    """
+    if hasattr(signal, "SIGPIPE"):
+        signal.signal(signal.SIGPIPE, signal.SIG_DFL)
     with warnings.catch_warnings():
         warnings.showwarning = _show_warning
-        cli.main(args=argv, prog_name="masonryfw")
+        try:
+            code = cli.main(args=argv, prog_name="masonryfw", standalone_mode=False)
+        except click.ClickException as exc:  # usage errors: exit 2
+            exc.show()
+            sys.exit(exc.exit_code)
+        except click.exceptions.Abort:  # click's form of a KeyboardInterrupt outside a solve
+            click.echo("interrupted: nothing written", err=True)
+            sys.exit(INTERRUPTED)
+    sys.exit(code if isinstance(code, int) else 0)

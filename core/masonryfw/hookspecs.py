@@ -8,15 +8,20 @@ by name. A plugin is registered through the entry-point group ``masonryfw``::
     [project.entry-points.masonryfw]
     mysolver = "my_package"
 
-Data contract: a solve function receives a model dataset (FORMAT.md, with the
-derived geometry added by the core) and returns a dataset holding only its
-result variables; the core merges them with the model and adds the result
-attributes (``plugin``, ``plugin_version``, ``solver``, ``solver_options``,
-``wall_time_s``), the input hash and the history line.
+Data contract (docs/format.md): a solve function receives a checked model with
+its derived geometry and the options resolved by the core (defaults filled in,
+every rule checked once, here); it returns a dataset holding only its primary
+result variables. The core derives the comparable fields (relative motion at
+the joints, joint states, crack indicator, macro-blocks) from
+``block_displacement`` the same way for every solver, merges everything with the
+model and stamps the provenance (``plugin``, ``solver``, ``solver_version``,
+``solver_options``, ``wall_time_s``, hashes, a history line).
 """
 from __future__ import annotations
 
+import difflib
 import importlib
+import math
 from dataclasses import dataclass, field
 from typing import Any, Callable, Mapping, Sequence
 
@@ -32,38 +37,110 @@ hookimpl = pluggy.HookimplMarker(PROJECT)
 
 _TRUE = {"1", "true", "yes", "on"}
 _FALSE = {"0", "false", "no", "off"}
+#: The word that asks for an option's automatic value (an option whose default is None).
+AUTO = "auto"
+_TYPES = (bool, int, float, str)
 
 
 @dataclass(frozen=True)
 class Option:
-    """One option a solver/comparator/plotter accepts (``--option name=value``)."""
+    """One option a solver, comparator or plotter accepts (``--option name=value``).
+
+    ``type`` is the type of one value: bool, int, float or str. Rules, checked by
+    the core once for every call (:func:`resolve_options`):
+
+    - ``choices``: the value must be one of these;
+    - ``above`` / ``at_least`` / ``below`` / ``at_most``: bounds (strict / inclusive);
+    - ``default=None`` makes the option *automatic*: ``auto`` (or None) lets the
+      plugin choose, and ``help`` must say how;
+    - ``many=True``: a list of values (comma-separated on the command line), each
+      obeying the rules; resolved as a tuple.
+    """
 
     name: str
     type: type
     default: Any
     help: str = ""
     choices: tuple | None = None
+    above: float | None = None
+    at_least: float | None = None
+    below: float | None = None
+    at_most: float | None = None
+    many: bool = False
 
-    def parse(self, value: Any) -> Any:
-        """Convert ``value`` (a string from the CLI or a Python value) to ``type``."""
+    def __post_init__(self):
+        if self.type not in _TYPES:
+            raise PluginError(f"option {self.name!r}: type must be one of bool, int, float, str, not {self.type!r}")
+
+    @property
+    def auto(self) -> bool:
+        """True when the option has an automatic value (its default is None)."""
+        return self.default is None
+
+    def rule(self) -> str:
+        """The option's rules in words, e.g. ``> 0 and < 1`` (empty when there are none)."""
+        parts = [f"{sign} {bound:g}" for sign, bound in (
+            (">", self.above), (">=", self.at_least), ("<", self.below), ("<=", self.at_most)) if bound is not None]
+        if self.choices is not None:
+            parts.append("one of " + ", ".join(map(str, self.choices)))
+        return " and ".join(parts)
+
+    def usage(self) -> str:
+        """``<float> > 0 and < 1 (default 1e-09)``: what the command line accepts."""
+        kind = f"{self.type.__name__}[,{self.type.__name__}...]" if self.many else self.type.__name__
+        rule = f" {self.rule()}" if self.rule() else ""
+        shown = AUTO if self.auto else ",".join(map(str, self.default)) if self.many else repr(self.default)
+        return f"<{kind}>{rule} (default {shown})"
+
+    def parse(self, value: Any, owner: str = "") -> Any:
+        """``value`` (a string from the command line or a Python value) converted and checked.
+
+        Raises :class:`PluginError` naming the owner, the option, the value and the rule broken.
+        """
+        where = f"{owner}: option {self.name!r}" if owner else f"option {self.name!r}"
+        if value is None or (isinstance(value, str) and value.strip().lower() == AUTO):
+            if self.auto:
+                return None
+            raise PluginError(f"{where}: has no automatic value; give a {self.type.__name__}")
+        if self.many:
+            items = [v for v in value.split(",") if v.strip()] if isinstance(value, str) else list(value)
+            return tuple(self._one(item, where) for item in items)
+        return self._one(value, where)
+
+    def _one(self, value: Any, where: str) -> Any:
         try:
             if self.type is bool and isinstance(value, str):
                 low = value.strip().lower()
                 if low not in _TRUE | _FALSE:
                     raise ValueError(value)
                 parsed = low in _TRUE
+            elif self.type is int and isinstance(value, float) and not value.is_integer():
+                raise ValueError(value)
+            elif self.type is int and isinstance(value, str):
+                parsed = int(float(value)) if float(value).is_integer() else int(value)
             else:
-                parsed = self.type(value)
-        except (TypeError, ValueError):
-            raise PluginError(
-                f"option {self.name!r}: cannot read {value!r} as {self.type.__name__}"
-            ) from None
-        if self.choices is not None and parsed not in self.choices:
-            raise PluginError(
-                f"option {self.name!r}: {parsed!r} is not one of "
-                + ", ".join(map(repr, self.choices))
-            )
+                parsed = self.type(value.strip() if isinstance(value, str) and self.type is not str else value)
+        except (TypeError, ValueError, OverflowError):
+            raise PluginError(f"{where} = {value!r}: not a{'n' if self.type is int else ''} {self.type.__name__}") \
+                from None
+        if self.type in (int, float) and not math.isfinite(parsed):
+            raise PluginError(f"{where} = {value!r}: must be finite")
+        broken = self._broken_rule(parsed)
+        if broken:
+            raise PluginError(f"{where} = {parsed!r}: must be {broken}")
         return parsed
+
+    def _broken_rule(self, value) -> str:
+        if self.choices is not None and value not in self.choices:
+            return "one of " + ", ".join(map(repr, self.choices))
+        if self.type in (int, float) and any((
+            self.above is not None and not value > self.above,
+            self.at_least is not None and not value >= self.at_least,
+            self.below is not None and not value < self.below,
+            self.at_most is not None and not value <= self.at_most,
+        )):
+            return self.rule()
+        return ""
 
 
 def parse_option_pairs(pairs: Sequence[str]) -> dict[str, str]:
@@ -77,17 +154,26 @@ def parse_option_pairs(pairs: Sequence[str]) -> dict[str, str]:
     return options
 
 
-def resolve_options(
-    owner: str, declared: Sequence[Option], given: Mapping[str, Any]
-) -> dict[str, Any]:
-    """Defaults overlaid by ``given``; unknown names raise a message listing the valid ones."""
+def unknown_name_message(kind: str, name: str, valid: Sequence[str]) -> str:
+    """``unknown option 'tolerence' (did you mean 'tolerance'?); valid: ...``: one message style for every lookup."""
+    guess = difflib.get_close_matches(name, list(valid), n=1)
+    hint = f" (did you mean {guess[0]!r}?)" if guess else ""
+    return f"unknown {kind} {name!r}{hint}; valid {kind}s: {', '.join(sorted(valid)) or '(none)'}"
+
+
+def resolve_options(owner: str, declared: Sequence[Option], given: Mapping[str, Any]) -> dict[str, Any]:
+    """The options of one call: defaults overlaid by ``given``, every value parsed and checked.
+
+    The only place option rules are applied; an unknown name, a value of the
+    wrong type or outside its rules raises one :class:`PluginError` naming
+    ``owner`` and the option.
+    """
     by_name = {o.name: o for o in declared}
-    unknown = sorted(set(given) - set(by_name))
-    if unknown:
-        valid = ", ".join(sorted(by_name)) or "(none)"
-        raise PluginError(f"{owner}: unknown option(s) {', '.join(unknown)}; valid options: {valid}")
+    for name in given:
+        if name not in by_name:
+            raise PluginError(f"{owner}: {unknown_name_message('option', name, list(by_name))}")
     resolved = {o.name: o.default for o in declared}
-    resolved.update({k: by_name[k].parse(v) for k, v in given.items()})
+    resolved.update({name: by_name[name].parse(value, owner) for name, value in given.items()})
     return resolved
 
 
@@ -102,24 +188,55 @@ def lazy(target: str) -> Callable[..., Any]:
     if not module_name or not attribute:
         raise PluginError(f"lazy target {target!r} is not of the form 'package.module:function'")
 
+    def resolve() -> Callable[..., Any]:
+        return getattr(importlib.import_module(module_name), attribute)
+
     def call(*args: Any, **kwargs: Any) -> Any:
-        return getattr(importlib.import_module(module_name), attribute)(*args, **kwargs)
+        return resolve()(*args, **kwargs)
 
     call.__name__ = call.__qualname__ = attribute
     call.__module__ = module_name
     call.__doc__ = f"Calls {target} (imported on first use)."
+    call.resolve = resolve  # type: ignore[attr-defined]  # the target itself: imports it now
     return call
+
+
+def resolved(function: Callable[..., Any]) -> Callable[..., Any]:
+    """The function a :func:`lazy` callable stands for (imported now); any other callable as it is."""
+    resolve = getattr(function, "resolve", None)
+    return resolve() if callable(resolve) else function
+
+
+@dataclass(frozen=True)
+class Variant:
+    """A named set of options a solver declares worth running on its own (e.g. each LP backend)."""
+
+    label: str
+    options: Mapping[str, Any] = field(default_factory=dict)
 
 
 @dataclass(frozen=True)
 class Solver:
-    """A named solver: ``solve(model, options, progress) -> result variables``."""
+    """A named solver: ``solve(model, options, progress) -> primary result variables``.
+
+    ``version``: None (the default) records the distribution's version plus a
+    digest of the plugin package's code, so that any change of the code changes
+    the recorded ``solver_version`` (and a sweep recomputes). ``variants``: option
+    sets the gallery runs side by side. ``gallery``: whether ``masonryfw gallery``
+    runs it by default (a failure analysis with something to draw).
+
+    Interruption: a solve that catches ``KeyboardInterrupt`` returns what it has
+    computed with the attribute ``interrupted = 1``; with nothing to return it
+    lets the ``KeyboardInterrupt`` propagate.
+    """
 
     name: str
     summary: str
     solve: Callable[[xr.Dataset, Mapping[str, Any], ProgressCallback], xr.Dataset]
-    version: str
+    version: str | None = None
     options: tuple[Option, ...] = field(default_factory=tuple)
+    variants: tuple[Variant, ...] = field(default_factory=tuple)
+    gallery: bool = True
 
 
 @dataclass(frozen=True)
@@ -129,7 +246,7 @@ class Comparator:
     name: str
     summary: str
     compare: Callable[[xr.Dataset, xr.Dataset, Mapping[str, Any]], xr.Dataset]
-    version: str
+    version: str | None = None
     options: tuple[Option, ...] = field(default_factory=tuple)
 
 
@@ -143,7 +260,7 @@ class Plotter:
     name: str
     summary: str
     plot: Callable[[Sequence[xr.Dataset], Any, Mapping[str, Any]], None]
-    version: str
+    version: str | None = None
     options: tuple[Option, ...] = field(default_factory=tuple)
 
 

@@ -23,12 +23,13 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
+from .dofs import upgrade
 from .errors import MasonryError, ModelError
-from .geometry import derive_geometry
 from .geometry import DERIVED_GEOMETRY_VARIABLES
 from .schema import load_schema, variable_attrs
 
 CONVENTIONS = "CF-1.11"
+UGRID = "UGRID-1.0"
 COMPRESSION = {"zlib": True, "complevel": 4, "shuffle": True}
 
 _NODE_AXES = {"node_x": "X", "node_y": "Y"}
@@ -154,11 +155,12 @@ def _netcdf_problem(path: Path) -> str | None:
 
 
 def open_dataset(path: str | os.PathLike) -> xr.Dataset:
-    """Read a masonryfw netCDF file (model, result or comparison) wholly into memory.
+    """Read a masonryfw netCDF file (model, result, comparison or sweep) wholly into memory.
 
     The file is closed before returning. ``ds.encoding["source"]`` holds its
     absolute path and ``ds.encoding["sha256"]`` the hash of its bytes. Times are
-    not decoded: the format holds plain SI numbers only.
+    not decoded: the format holds plain SI numbers only. A file of an older
+    format version is upgraded in memory (:func:`masonryfw.dofs.upgrade`).
     """
     file = Path(path)
     try:
@@ -176,46 +178,10 @@ def open_dataset(path: str | os.PathLike) -> xr.Dataset:
             f"{file}: has a netCDF signature but cannot be read ({type(exc).__name__}: {exc}); "
             "is it truncated or damaged?"
         ) from exc
+    ds = upgrade(ds)
     ds.encoding["source"] = str(file.resolve())
     ds.encoding["sha256"] = digest
     return ds
-
-
-def _bundled_model(name: str) -> xr.Dataset:
-    from .builder import build
-    from .datasets import bundled_cases, bundled_spec_path
-
-    cases = list(bundled_cases())
-    if name not in cases:
-        raise ModelError(
-            f"{name}: no such file, and not a bundled case; bundled cases: {', '.join(cases) or '(none)'}"
-        )
-    return build(bundled_spec_path(name))
-
-
-def open_model(path_or_name: str | os.PathLike, *, validate: bool = True) -> xr.Dataset:
-    """A model (or a result, which holds its model) from a file or a bundled case name.
-
-    With ``validate`` every problem found by :func:`masonryfw.checks.check` is
-    raised at once in one :class:`ModelError`. Derived geometry stored in the
-    file is dropped and recomputed from the vertices.
-    """
-    from .checks import check
-
-    where = str(path_or_name)
-    if Path(path_or_name).exists():
-        ds = open_dataset(path_or_name)
-    else:
-        ds = _bundled_model(where)
-    ds = ds.drop_vars([v for v in DERIVED_GEOMETRY_VARIABLES if v in ds.variables])
-    if validate:
-        problems = check(ds)
-        if problems:
-            raise ModelError(f"{where}: {len(problems)} problem(s)", problems)
-    missing = [v for v in _GEOMETRY_VARIABLES if v not in ds.variables]
-    if missing:
-        raise ModelError(f"{where}: not a model: missing variable(s) {', '.join(missing)}")
-    return derive_geometry(ds)
 
 
 # ---------------------------------------------------------------- writing
@@ -246,6 +212,12 @@ def _as_int8_flags(name: str, values: np.ndarray) -> np.ndarray:
     return values.astype(np.int8)
 
 
+def conventions(ds: xr.Dataset) -> str:
+    """``CF-1.11``, plus ``UGRID-1.0`` when the dataset holds a UGRID mesh topology."""
+    ugrid = any(v.attrs.get("cf_role") == "mesh_topology" for v in ds.variables.values())
+    return f"{CONVENTIONS} {UGRID}" if ugrid else CONVENTIONS
+
+
 def cf_normalized(ds: xr.Dataset) -> xr.Dataset:
     """``ds`` in the form :func:`save` writes it (the caller's dataset is not changed).
 
@@ -256,7 +228,7 @@ def cf_normalized(ds: xr.Dataset) -> xr.Dataset:
     """
     schema_variables = load_schema("result")["variables"]
     out = ds.copy(deep=False)
-    out.attrs.setdefault("Conventions", CONVENTIONS)
+    out.attrs["Conventions"] = conventions(out)
     if all(v in out.variables for v in _GEOMETRY_VARIABLES) and "block_geometry" not in out.variables:
         out = out.assign(block_geometry=xr.Variable((), np.int32(0)))
     coords, data_vars = {}, {}  # replaced in one assignment each: every xarray assignment is a merge
@@ -277,13 +249,13 @@ def cf_normalized(ds: xr.Dataset) -> xr.Dataset:
 
 
 def _netcdf_encoding(ds: xr.Dataset) -> dict[str, dict]:
-    """zlib (level 4, shuffle) on every non-scalar numeric variable; no integer fill values,
-    which would make readers decode integers (flags, indices) to floats."""
+    """zlib (level 4, shuffle) on every non-scalar numeric variable; no fill values on integers,
+    which would make readers decode integers (flags, indices) to floats, nor on coordinates (CF 2.5.1)."""
     encoding = {}
     for name, variable in ds.variables.items():
         kind = variable.dtype.kind
         entry = dict(COMPRESSION) if kind in "biuf" and variable.ndim > 0 else {}
-        if kind in "biu":
+        if kind in "biu" or name in ds.coords:
             entry["_FillValue"] = None
         encoding[name] = entry
     return encoding
@@ -327,7 +299,23 @@ def _writable_target(path: str | os.PathLike, refusal: str | None) -> Path:
         raise ModelError(f"{path}: cannot write: is a directory")
     if refusal:
         raise ModelError(f"{path}: refusing to overwrite {refusal}; write to another path")
+    if not os.access(target.parent, os.W_OK | os.X_OK):
+        raise ModelError(f"{path}: cannot write: no permission to create files in {target.parent}")
     return target
+
+
+def check_output_path(path: str | os.PathLike, inputs=(), suffixes: tuple[str, ...] = ()) -> Path:
+    """Raise (before any work) when ``path`` cannot be written; return it absolute.
+
+    Refused: a missing or unwritable folder, a directory, one of ``inputs``
+    (through links and relative paths), a suffix not among ``suffixes`` (when given).
+    """
+    suffix = Path(path).suffix.lower()
+    if suffixes and suffix not in suffixes:
+        raise MasonryError(f"{path}: unknown file type {suffix or '(none)'!r}; use one of {', '.join(suffixes)}")
+    target = Path(path).resolve()
+    refusal = next((f"the input {p}" for p in inputs if p and _same_file(target, Path(p))), None)
+    return _writable_target(path, refusal)
 
 
 def _write_atomically(target: Path, write, shown: str | os.PathLike) -> Path:
@@ -376,14 +364,8 @@ FIGURE_FORMATS = (".png", ".svg", ".pdf")
 
 def save_figure(figure, path: str | os.PathLike, *, protect=(), dpi: float | None = None) -> Path:
     """Write a matplotlib ``figure`` to ``path`` (.png, .svg or .pdf) atomically; never onto ``protect``."""
-    suffix = Path(path).suffix.lower()
-    if suffix not in FIGURE_FORMATS:
-        raise MasonryError(
-            f"{path}: unknown image type {suffix or '(none)'!r}; use one of {', '.join(FIGURE_FORMATS)}"
-        )
-    target = Path(path).resolve()
-    refusal = next((f"the input {p}" for p in protect if _same_file(target, Path(p))), None)
-    target = _writable_target(path, refusal)
+    target = check_output_path(path, protect, FIGURE_FORMATS)
+    suffix = target.suffix.lower()
     return _write_atomically(
         target, lambda temporary: figure.savefig(temporary, format=suffix[1:], dpi=dpi or "figure"), path
     )

@@ -8,11 +8,16 @@ name; the same name contributed twice is an error naming both plugins.
 """
 from __future__ import annotations
 
+import functools
+import hashlib
+import importlib.util
 import json
+import sys
 import time
 import warnings
 from dataclasses import dataclass
 from importlib.metadata import entry_points
+from pathlib import Path
 from typing import Any, Mapping, Sequence
 
 import click
@@ -20,12 +25,15 @@ import pluggy
 import xarray as xr
 
 from .checks import check
+from .dofs import block_motion
 from .errors import MasonryError, ModelError, PluginError, SolveError
-from .geometry import derive_geometry
-from .hookspecs import PROJECT, Comparator, MasonryfwSpec, Plotter, Solver, resolve_options
-from .io import DERIVED_GEOMETRY_VARIABLES, add_history, content_sha256
+from .hookspecs import PROJECT, Comparator, MasonryfwSpec, Plotter, Solver, resolve_options, unknown_name_message
+from .hookspecs import resolved as resolved_function
+from .io import CONVENTIONS, add_history, content_sha256
+from .model import checked_model
 from .progress import ProgressCallback, no_progress
-from .schema import FORMAT_VERSION, load_schema
+from .schema import FORMAT_VERSION
+from .semantics import DERIVED_RESULT_VARIABLES, FLOW_RULES, ROTATIONS, derived_variables
 
 #: record kind -> (hook name, record type)
 _HOOKS = {
@@ -161,8 +169,13 @@ def _lookup(kind: str, name: str | None) -> _Contribution:
             return next(iter(named.values()))
         raise PluginError(f"several {kind}s are installed ({', '.join(sorted(named))}); choose one by name")
     if name not in named:
-        raise PluginError(f"unknown {kind} {name!r}; installed {kind}s: {', '.join(sorted(named))}")
+        raise PluginError(unknown_name_message(kind, name, list(named)))
     return named[name]
+
+
+def installed_solvers() -> list[Solver]:
+    """Every installed solver record, in name order."""
+    return [item.record for _, item in sorted(_by_name("solver").items())]
 
 
 def get_solver(name: str) -> Solver:
@@ -207,9 +220,11 @@ def installed_plugins() -> list[PluginInfo]:
 
 
 def _plugin_version(item: _Contribution) -> str:
-    """The contributing distribution's version; the record's own version for a plugin registered by hand."""
+    """The contributing distribution's version (the masonryfw version for a plugin registered by hand)."""
+    from . import __version__
+
     dist = _distributions.get(item.plugin)
-    return dist[1] if dist else item.record.version
+    return dist[1] if dist else __version__
 
 
 def _problem_list(problems) -> str:
@@ -223,9 +238,9 @@ def _require_valid_input(ds: xr.Dataset, what: str, kind: str) -> None:
         raise ModelError(f"{what} is invalid ({len(problems)} problem(s))", problems)
 
 
-def _require_valid_output(ds: xr.Dataset, what: str, error: type[MasonryError]) -> None:
+def _require_valid_output(ds: xr.Dataset, what: str, error: type[MasonryError], model_checked: bool = False) -> None:
     """Raise ``error`` listing every problem of a dataset a plugin produced."""
-    problems = check(ds)
+    problems = check(ds, model_checked=model_checked)
     if problems:
         raise error(f"{what} is invalid ({len(problems)} problem(s)):\n{_problem_list(problems)}")
 
@@ -262,27 +277,83 @@ def _merge_result(kind: str, name: str, base: xr.Dataset, reserved: xr.Dataset, 
         raise error(f"{kind} {name} returned variables that do not fit its input: {exc}") from exc
 
 
-#: CF attributes describing a dataset that a model keeps when taken out of a result.
-_DESCRIPTIVE_ATTRIBUTES = ("comment", "institution", "references", "source")
+def _package_files(module_name: str) -> tuple[Path, list[Path]]:
+    """The folder and the ``.py`` files of the top-level package of ``module_name`` (or of the module alone)."""
+    top = module_name.split(".")[0]
+    try:
+        spec = importlib.util.find_spec(top)
+    except (ImportError, ValueError):
+        spec = None
+    if spec is not None and spec.submodule_search_locations:
+        root = Path(next(iter(spec.submodule_search_locations)))
+        return root, sorted(root.rglob("*.py"))
+    module = sys.modules.get(module_name) or sys.modules.get(top)
+    origin = getattr(module, "__file__", None) or (spec.origin if spec is not None else None)
+    if origin and Path(origin).is_file():
+        return Path(origin).parent, [Path(origin)]
+    return Path("."), []
 
 
-def model_part(ds: xr.Dataset) -> xr.Dataset:
-    """The model a dataset holds: a model as is; for a result, its model variables and attributes.
+@functools.lru_cache(maxsize=None)
+def code_digest(module_name: str) -> str:
+    """First 12 hex digits of the SHA-256 of the code of the package holding ``module_name``.
 
-    What a solver added (result variables, the solver's and the plugin's
-    attributes) is dropped, so that solving a result anew attributes nothing of
-    the old solve to the new solver. Encoding (source file, file hash) is kept.
+    Every ``.py`` file of the package in sorted order, by its path relative to
+    the package and its bytes: the same code gives the same digest wherever it
+    is installed, and any edit changes it.
     """
-    if ds.attrs.get("masonryfw_format") != "result":
-        return ds
-    schema = load_schema("model")
-    keep_vars = set(schema["variables"]) | set(DERIVED_GEOMETRY_VARIABLES)
-    keep_attrs = set(schema["global_attributes"]) | set(_DESCRIPTIVE_ATTRIBUTES)
-    model = ds.drop_vars([name for name in ds.variables if name not in keep_vars])
-    model.attrs = {k: v for k, v in ds.attrs.items() if k in keep_attrs}
-    model.attrs["masonryfw_format"] = "model"
-    model.encoding = dict(ds.encoding)
-    return model
+    root, files = _package_files(module_name)
+    digest = hashlib.sha256()
+    for path in files:
+        digest.update(path.relative_to(root).as_posix().encode())
+        digest.update(path.read_bytes())
+    return digest.hexdigest()[:12]
+
+
+def core_version() -> str:
+    """masonryfw's version plus a digest of the core's code (what derives the comparable fields)."""
+    from . import __version__
+
+    return f"{__version__}+{code_digest(__name__)}"
+
+
+def record_version(item: _Contribution, function) -> str:
+    """The recorded version of a record: its declared version (else its distribution's) plus its code's digest.
+
+    Any change of the plugin's code changes it, so a store keyed on it never
+    returns the result of older code.
+    """
+    base = item.record.version or _plugin_version(item)
+    return f"{base}+{code_digest(function.__module__)}"
+
+
+def solver_version(name: str) -> str:
+    """The version :func:`solve` records for the solver called ``name`` (see :func:`record_version`)."""
+    item = _lookup("solver", name)
+    return record_version(item, item.record.solve)
+
+
+def _derive_comparable_fields(name: str, model: xr.Dataset, produced: xr.Dataset) -> xr.Dataset:
+    """``produced`` with the fields :mod:`.semantics` derives from its ``block_displacement``."""
+    if "block_displacement" not in produced:
+        return produced
+    derived_too = sorted(set(produced.data_vars) & set(DERIVED_RESULT_VARIABLES))
+    if derived_too:
+        raise SolveError(
+            f"solver {name} returned {', '.join(derived_too)} with block_displacement; the core derives "
+            "them from block_displacement (docs/format.md): return only the primary fields"
+        )
+    for attribute, choices in (("rotations", ROTATIONS), ("flow_rule", FLOW_RULES)):
+        if produced.attrs.get(attribute) not in choices:
+            raise SolveError(
+                f"solver {name} returned block_displacement without the attribute {attribute!r} "
+                f"(one of {', '.join(choices)}; docs/format.md)"
+            )
+    if "block_rotation" not in produced:
+        raise SolveError(f"solver {name} returned block_displacement without block_rotation (docs/format.md)")
+    derived = derived_variables(model, block_motion(produced), produced.attrs["rotations"],
+                                produced.attrs["flow_rule"])
+    return produced.assign(derived)
 
 
 def solve(
@@ -293,36 +364,41 @@ def solve(
 ) -> xr.Dataset:
     """Run the solver called ``plugin`` on ``model`` and return the result dataset.
 
-    Options are validated against the solver's declared options; the model is
-    checked (every problem raises one :class:`ModelError`) and given its derived
-    geometry. The result holds the model's variables, the solver's variables and
-    the provenance attributes of FORMAT.md, and passes :func:`masonryfw.check`.
-    A result may be given: its model is solved (see :func:`model_part`).
+    The model is checked unless it already is (:func:`masonryfw.checked_model`;
+    every problem raises one :class:`ModelError`); the options are resolved and
+    checked against the solver's declared rules. The result holds the model's
+    variables, the solver's primary variables, the comparable fields the core
+    derives from ``block_displacement`` (:mod:`masonryfw.semantics`) and the
+    provenance attributes of docs/format.md. A result may be given: its model is
+    solved. ``wall_time_s`` leaves out the ``compile_time_s`` a solver reports.
+    A ``KeyboardInterrupt`` the solver lets through propagates (nothing computed).
     """
-    if not isinstance(model, xr.Dataset):
-        raise TypeError(f"solve needs an xarray.Dataset model, got {type(model).__name__}")
-    model = model_part(model)
+    model = checked_model(model)
     item = _lookup("solver", plugin)
     solver: Solver = item.record
     resolved = resolve_options(f"solver {solver.name!r}", solver.options, dict(options or {}))
-    _require_valid_input(model, f"model {model.attrs.get('title', '')!r}", kind="model")
-    geometric = derive_geometry(model)
+    function = _call_plugin("solver", solver.name, resolved_function, solver.solve)  # imported before the clock
 
     start = time.perf_counter()
-    produced = _call_plugin("solver", solver.name, solver.solve, geometric, resolved, progress or no_progress)
+    produced = _call_plugin("solver", solver.name, function, model, resolved, progress or no_progress)
     wall_time = time.perf_counter() - start
+    if not isinstance(produced, xr.Dataset):
+        raise SolveError(f"solver {solver.name} returned {type(produced).__name__}, not an xarray.Dataset")
+    produced = _derive_comparable_fields(solver.name, model, produced)
 
-    result = _merge_result("solver", solver.name, model, geometric, produced)
-    result.attrs = {**model.attrs, **getattr(produced, "attrs", {})}
+    result = _merge_result("solver", solver.name, model, model, produced)
+    compile_time = float(produced.attrs.get("compile_time_s", 0.0))
+    result.attrs = {**model.attrs, **produced.attrs}
     result.attrs.update(
         masonryfw_format="result",
         masonryfw_format_version=FORMAT_VERSION,
         plugin=item.plugin,
         plugin_version=_plugin_version(item),
         solver=solver.name,
-        solver_version=solver.version,
-        solver_options=json.dumps(resolved, sort_keys=True, default=str),
-        wall_time_s=float(wall_time),
+        solver_version=record_version(item, solver.solve),
+        core_version=core_version(),
+        solver_options=options_json(resolved),
+        wall_time_s=float(wall_time - compile_time),
         title=model.attrs.get("title", ""),
         model_sha256=content_sha256(model),
     )
@@ -333,8 +409,13 @@ def solve(
     result = add_history(
         result, f"solve: solver {solver.name} (plugin {item.plugin}) options {result.attrs['solver_options']}"
     )
-    _require_valid_output(result, f"the result of solver {solver.name}", _failure("solver"))
+    _require_valid_output(result, f"the result of solver {solver.name}", _failure("solver"), model_checked=True)
     return result
+
+
+def options_json(options: Mapping[str, Any]) -> str:
+    """Resolved options as canonical JSON (sorted keys, tuples as lists): how results and stores record them."""
+    return json.dumps(options, sort_keys=True, default=str)
 
 
 def _input_hash(ds: xr.Dataset) -> str:
@@ -351,7 +432,7 @@ def compare(
     """Compare two results with the comparator called ``comparator`` (default: the only one installed).
 
     Returns a ``comparison`` dataset: the comparator's variables plus the
-    attributes ``schemas/comparison-1.json`` requires. ``input_a_sha256`` /
+    attributes ``schemas/comparison-2.json`` requires. ``input_a_sha256`` /
     ``input_b_sha256`` are the files' hashes when the results were read from
     files, otherwise their content hashes.
     """
@@ -365,15 +446,15 @@ def compare(
     title_a, title_b = a.attrs.get("title", ""), b.attrs.get("title", "")
     comparison.attrs = {
         **getattr(produced, "attrs", {}),
-        "Conventions": "CF-1.11",
+        "Conventions": CONVENTIONS,
         "masonryfw_format": "comparison",
         "masonryfw_format_version": FORMAT_VERSION,
         "title": title_a if title_a == title_b else f"{title_a} vs {title_b}",
         "comparator": record.name,
-        "comparator_version": record.version,
+        "comparator_version": record_version(item, record.compare),
         "plugin": item.plugin,
         "plugin_version": _plugin_version(item),
-        "comparator_options": json.dumps(resolved, sort_keys=True, default=str),
+        "comparator_options": options_json(resolved),
         "input_a_sha256": _input_hash(a),
         "input_b_sha256": _input_hash(b),
         "input_a_solver": str(a.attrs.get("solver", "")),

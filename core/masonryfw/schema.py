@@ -11,7 +11,9 @@ from importlib import resources
 
 from .errors import ModelError
 
-FORMAT_VERSION = 1
+FORMAT_VERSION = 2
+#: Versions this code reads: older ones are upgraded in memory on reading (:func:`masonryfw.dofs.upgrade`).
+READABLE_VERSIONS = (1, 2)
 KINDS = ("model", "result", "comparison", "sweep")
 
 

@@ -12,10 +12,11 @@ import importlib
 import masonryfw as mf
 
 from .commands import COMMANDS
-from .records import COMPARATOR, PLOTTERS, __version__
+from .records import COMPARATOR, PLOTTERS
 
-#: The Python API, imported on first access (PEP 562) so registering stays cheap.
-_PUBLIC = {"compare": "comparison", "export_vtk": "export"}
+#: The Python API beyond ``masonryfw.compare`` / ``masonryfw.render``, imported on first access (PEP 562)
+#: so registering stays cheap.
+_PUBLIC = {"export_vtk": "export"}
 __all__ = sorted(_PUBLIC)
 
 

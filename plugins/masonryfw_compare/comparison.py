@@ -26,14 +26,7 @@ import xarray as xr
 import masonryfw as mf
 
 from . import scores
-from .records import COMPARE_OPTIONS
-from .shapes import (
-    block_polar_moment,
-    distance_to_points,
-    distance_to_segments,
-    segment_samples,
-    with_geometry,
-)
+from .shapes import distance_to_points, distance_to_segments, segment_samples
 
 # Option names under which solvers record their numerical backend (la: "solver").
 BACKEND_OPTION_NAMES = ("solver", "backend", "method")
@@ -42,16 +35,6 @@ GEOMETRY_VARIABLES = (
     "node_x", "node_y", "block_node_count", "block_role",
     "interface_blocks", "interface_x", "interface_y",
 )
-
-
-def resolve(options: Mapping[str, Any]) -> dict[str, Any]:
-    """Defaults overlaid by ``options``; an unknown name or a bad threshold is a PluginError."""
-    resolved = mf.resolve_options("comparator 'crack'", COMPARE_OPTIONS, options)
-    if not 0.0 <= resolved["threshold"] < 1.0:
-        raise mf.PluginError(
-            f"comparator 'crack': option 'threshold' must lie in [0, 1), got {resolved['threshold']!r}"
-        )
-    return resolved
 
 
 def _first_difference(a: np.ndarray, b: np.ndarray) -> int | None:
@@ -104,12 +87,6 @@ def ensure_same_model(a: xr.Dataset, b: xr.Dataset) -> None:
             raise _different_models(a, b, f"{name} differs at {at} ({va.ravel()[where].item()!r} vs {vb.ravel()[where].item()!r})")
 
 
-def masonry_blocks(geo: xr.Dataset) -> np.ndarray:
-    """Mask of the units and lintels (support blocks are boundary conditions, not masonry)."""
-    role = mf.flags("block_role")
-    return np.isin(geo.block_role.values, [role["unit"], role["lintel"]])
-
-
 def interface_scores(a: xr.Dataset, b: xr.Dataset, length: np.ndarray, threshold: float) -> dict:
     """Scores on ``crack_indicator``: thresholded set scores and the threshold-free ones."""
     if "crack_indicator" not in a or "crack_indicator" not in b:
@@ -134,11 +111,10 @@ def mechanism_scores(a: xr.Dataset, b: xr.Dataset, geo: xr.Dataset, masonry: np.
     if "block_displacement" not in a or "block_displacement" not in b:
         return {}
     area = geo.block_area.values
-    polar = block_polar_moment(geo.node_x.values, geo.node_y.values, geo.block_node_count.values)
+    polar = mf.polar_moment(geo.node_x.values, geo.node_y.values, geo.block_node_count.values)
     return {
         "mechanism_cosine": scores.rigid_field_cosine(
-            a.block_displacement.values[masonry], b.block_displacement.values[masonry],
-            area[masonry], polar[masonry],
+            mf.block_motion(a)[masonry], mf.block_motion(b)[masonry], area[masonry], polar[masonry],
         )
     }
 
@@ -234,13 +210,12 @@ def comparison_variables(values: Mapping[str, float | int | None]) -> xr.Dataset
     return xr.Dataset(data)
 
 
-def compare(a: xr.Dataset, b: xr.Dataset, options: Mapping[str, Any] | None = None) -> xr.Dataset:
+def compare(a: xr.Dataset, b: xr.Dataset, options: Mapping[str, Any]) -> xr.Dataset:
     """Score result ``b`` against result ``a`` (same model); returns the score variables."""
-    opts = resolve(options or {})
     ensure_same_model(a, b)
-    geo = with_geometry(a[list(GEOMETRY_VARIABLES)])
-    masonry = masonry_blocks(geo)
-    threshold = opts["threshold"]
+    geo = mf.derive_geometry(a[list(GEOMETRY_VARIABLES)])
+    masonry = mf.masonry_blocks(geo.block_role.values)
+    threshold = options["threshold"]
     size = mf.model_scale(geo.node_x.values, geo.node_y.values)
     values: dict[str, float | int | None] = {"length_scale": size}
     values.update(multiplier_values(a, b))

@@ -26,7 +26,7 @@ import xarray as xr
 
 import masonryfw as mf
 
-from .shapes import padded_block_nodes, rigid_point_motion, with_geometry
+from .shapes import padded_block_nodes, vertex_motion
 
 JOINT_POINT_VARIABLES = ("interface_opening", "interface_slip", "interface_normal_force", "interface_shear_force")
 JOINT_CELL_VARIABLES = ("interface_kind", "interface_state", "crack_indicator")
@@ -82,7 +82,7 @@ def _write(mesh, path: Path) -> Path:
 def blocks_mesh(ds: xr.Dataset):
     """Blocks as polygons with their role, macro-block and motion."""
     meshio = _meshio()
-    geo = with_geometry(ds)
+    geo = mf.derive_geometry(ds)
     counts = geo.block_node_count.values.astype(np.int64)
     cells, order = _grouped_cells(padded_block_nodes(counts), counts)
     cell_data = {
@@ -93,13 +93,10 @@ def blocks_mesh(ds: xr.Dataset):
     if "macro_block" in ds:
         cell_data["macro_block"] = _split(_as_vtk(ds.macro_block.values), order)
     if "block_displacement" in ds:
-        u = ds.block_displacement.values.astype(float)
+        u = mf.block_motion(ds)
         cell_data["centroid_displacement"] = _split(np.column_stack([u[:, 0], u[:, 1], np.zeros(len(u))]), order)
         cell_data["rotation"] = _split(u[:, 2], order)
-        ux, uy = rigid_point_motion(
-            u, geo.block_centroid_x.values, geo.block_centroid_y.values,
-            geo.node_x.values, geo.node_y.values, mf.node_block(counts),
-        )
+        ux, uy = vertex_motion(geo, u, str(ds.attrs.get("rotations", "small")))
         point_data["displacement"] = _points(ux, uy)
     return meshio.Mesh(_points(geo.node_x.values, geo.node_y.values), cells, point_data=point_data, cell_data=cell_data)
 
@@ -152,21 +149,36 @@ def _multiblock(pieces: list[tuple[str, Path]]) -> str:
     )
 
 
-def export_vtk(ds: xr.Dataset, path: str | os.PathLike) -> list[Path]:
-    """Write the VTK files of a result (see the module docstring); returns the paths written."""
+#: The pieces of an export: name, file suffix, whether a result has it, how it is built.
+PIECES = (
+    ("blocks", "", lambda ds: True, blocks_mesh),
+    ("joints", "_joints", lambda ds: ds.sizes.get("interface", 0) > 0, joints_mesh),
+    ("mesh", "_mesh", lambda ds: "mesh_face_nodes" in ds, continuum_mesh),
+    ("plastic_points", "_qp", lambda ds: "qp_failure" in ds, plastic_points),
+)
+
+
+def export_paths(ds: xr.Dataset, path: str | os.PathLike) -> list[Path]:
+    """The files :func:`export_vtk` writes for ``ds`` at ``path`` (a ``.vtu`` name), the ``.vtm`` index last."""
     path = Path(path)
     if path.suffix.lower() != ".vtu":
         raise mf.MasonryError(f"VTK export file {str(path)!r}: the name must end in .vtu")
-    path.parent.mkdir(parents=True, exist_ok=True)
     stem = path.with_suffix("")
-    pieces = [("blocks", _write(blocks_mesh(ds), path))]
-    if ds.sizes.get("interface", 0) > 0:
-        pieces.append(("joints", _write(joints_mesh(ds), Path(f"{stem}_joints.vtu"))))
-    if "mesh_face_nodes" in ds:
-        pieces.append(("mesh", _write(continuum_mesh(ds), Path(f"{stem}_mesh.vtu"))))
-    if "qp_failure" in ds:
-        pieces.append(("plastic_points", _write(plastic_points(ds), Path(f"{stem}_qp.vtu"))))
-    index = path.with_suffix(".vtm")
+    pieces = [Path(f"{stem}{suffix}.vtu") for _, suffix, present, _ in PIECES if present(ds)]
+    return pieces + [path.with_suffix(".vtm")]
+
+
+def export_vtk(ds: xr.Dataset, path: str | os.PathLike) -> list[Path]:
+    """Write the VTK files of a result (see the module docstring); returns the paths written.
+
+    Every target is checked (folder, not an input) before anything is written.
+    """
+    paths = export_paths(ds, path)
+    for target in paths:
+        mf.check_output_path(target, [ds.encoding.get("source")])
+    present = [(name, build) for name, _, has, build in PIECES if has(ds)]
+    pieces = [(name, _write(build(ds), target)) for (name, build), target in zip(present, paths)]
+    index = paths[-1]
     temporary = index.with_name(f".{index.name}.{os.getpid()}.tmp")
     temporary.write_text(_multiblock(pieces))
     os.replace(temporary, index)

@@ -25,7 +25,6 @@ import masonryfw as mf
 from .comparison import solver_label
 from .records import DEFAULT_THRESHOLD
 
-METHODS = ("la", "fdem", "jmm")
 GALLERY_DPI = 110
 IDENTICAL_COSINE_GAP = 1e-3
 SKIPPED = "skipped (--skip)"
@@ -65,6 +64,22 @@ class CaseOutcome:
     seconds: dict[str, float]
 
 
+def installed_methods() -> dict[str, mf.Solver]:
+    """Every installed solver by name, in name order."""
+    return {record.name: record for record in mf.installed_solvers()}
+
+
+def gallery_methods() -> list[str]:
+    """The installed solvers that run in the gallery by default (their record's ``gallery``)."""
+    return [name for name, record in installed_methods().items() if record.gallery]
+
+
+def _known_method(method: str, what: str) -> None:
+    installed = installed_methods()
+    if method not in installed:
+        raise mf.PluginError(f"{what}: {mf.unknown_name_message('method', method, list(installed))}")
+
+
 def parse_method_options(pairs: list[str] | tuple[str, ...]) -> dict[str, dict[str, str]]:
     """``["jmm.mesh_size=0.05", ...]`` as ``{"jmm": {"mesh_size": "0.05"}}`` (values are parsed by the solver)."""
     options: dict[str, dict[str, str]] = {}
@@ -73,8 +88,7 @@ def parse_method_options(pairs: list[str] | tuple[str, ...]) -> dict[str, dict[s
         method, dot, name = key.strip().partition(".")
         if not sep or not dot or not name:
             raise mf.PluginError(f"gallery option {pair!r} is not METHOD.KEY=VALUE (e.g. jmm.max_steps=40)")
-        if method not in METHODS:
-            raise mf.PluginError(f"gallery option {pair!r}: method {method!r} is not one of {', '.join(METHODS)}")
+        _known_method(method, f"gallery option {pair!r}")
         options.setdefault(method, {})[name] = value
     return options
 
@@ -84,46 +98,41 @@ def parse_skips(pairs: list[str] | tuple[str, ...]) -> set[tuple[str, str]]:
     skips = set()
     for pair in pairs:
         method, sep, case = pair.partition(":")
-        if not sep or method not in METHODS or not case:
-            raise mf.PluginError(f"gallery skip {pair!r} is not METHOD:CASE with METHOD one of {', '.join(METHODS)}")
+        if not sep or not case:
+            raise mf.PluginError(f"gallery skip {pair!r} is not METHOD:CASE (e.g. jmm:facade-3)")
+        _known_method(method, f"gallery skip {pair!r}")
         skips.add((method, case))
     return skips
 
 
-def planned_runs(
-    methods: list[str] | tuple[str, ...] | None = None, options: dict[str, dict[str, str]] | None = None
-) -> tuple[list[Run], list[str]]:
-    """The runs of the chosen (default: every installed) methods among METHODS and the missing ones.
+def planned_runs(methods: list[str] | tuple[str, ...] | None = None,
+                 options: dict[str, dict[str, str]] | None = None) -> list[Run]:
+    """The runs of the chosen methods (default: the installed gallery solvers), in the order given.
 
-    la runs once per LP backend unless ``options["la"]`` names one (``la.solver=highs``).
-    Every method's options are checked against the solver's declared options here,
-    before any wall is solved, so a misspelt name fails at once.
+    A solver that declares variants (la: one per LP backend) runs once per
+    variant, unless the given options set one of the variants' options
+    (``la.solver=highs``). Every method's options are checked against the
+    solver's declared rules here, before any wall is solved, so a misspelt name
+    fails at once.
     """
-    chosen = list(dict.fromkeys(methods or METHODS))
-    unknown = [m for m in chosen if m not in METHODS]
-    if unknown:
-        raise mf.PluginError(f"gallery method(s) {', '.join(unknown)}: not one of {', '.join(METHODS)}")
+    chosen = list(dict.fromkeys(methods or gallery_methods()))
+    for method in chosen:
+        _known_method(method, "gallery --method")
     options = options or {}
     unused = sorted(set(options) - set(chosen))
     if unused:
         raise mf.PluginError(f"gallery options given for {', '.join(unused)}, which is not among the methods run")
-    runs, missing = [], []
+    installed = installed_methods()
+    runs = []
     for name in chosen:
-        try:
-            solver = mf.get_solver(name)
-        except mf.PluginError:
-            missing.append(name)
-            continue
-        given = options.get(name, {})
-        mf.resolve_options(name, solver.options, given)
-        if name == "la" and "solver" not in given:
-            backends = next(o.choices for o in solver.options if o.name == "solver")  # as the plugin declares them
-            runs += [Run(f"la ({backend})", "la", {**given, "solver": backend}) for backend in backends]
-        elif name == "la":
-            runs.append(Run(f"la ({given['solver']})", "la", dict(given)))
+        solver, given = installed[name], options.get(name, {})
+        mf.resolve_options(f"solver {name!r}", solver.options, given)
+        varied = {key for variant in solver.variants for key in variant.options}
+        if solver.variants and not varied & set(given):
+            runs += [Run(f"{name} ({v.label})", name, {**given, **v.options}) for v in solver.variants]
         else:
             runs.append(Run(name, name, dict(given)))
-    return runs, missing
+    return runs
 
 
 def method_of(label: str) -> str:
@@ -193,17 +202,17 @@ def _cell(comparison: xr.Dataset, name: str | None, number: str) -> str:
 def headline(result: xr.Dataset) -> str:
     """A method's own number: the collapse multiplier alpha (la) or the reaction drop 1 - R_min/R_dead (fdem, jmm).
 
-    R_dead is the moving support's reaction after gravity (step 0), R_min the
-    smallest reaction of the settlement history. A run that stopped for another
-    reason than a reaction plateau says why (its drop may still be growing).
+    From the core's key numbers (:func:`masonryfw.key_numbers`). A run that
+    stopped for another reason than a reaction plateau says why (its drop may
+    still be growing).
     """
-    if "collapse_multiplier" in result:
-        return f"alpha {float(result.collapse_multiplier.values):.4f}"
-    if "step_reaction" in result and result.step_reaction.size > 1:
-        reaction = result.step_reaction.values
-        reason = str(result.attrs.get(f"{result.attrs.get('solver', '')}_stop_reason", ""))
+    numbers = {n.name: n.value for n in mf.key_numbers(result)}
+    if "alpha" in numbers:
+        return f"alpha {numbers['alpha']:.4f}"
+    if "minimum_reaction" in numbers and numbers.get("dead_reaction"):
+        reason = str(result.attrs.get("stop_reason", ""))
         note = f" ({reason})" if reason and "plateau" not in reason else ""
-        return f"drop {1.0 - reaction.min() / reaction[0]:.3f}{note}"
+        return f"drop {1.0 - numbers['minimum_reaction'] / numbers['dead_reaction']:.3f}{note}"
     return "-"
 
 
@@ -258,8 +267,8 @@ Regenerated, together with the pictures in `docs/gallery/`, by one command:
 
     {command}
 
-Every bundled wall is solved by every chosen method (`--method`, default all
-installed among la, fdem, jmm) with the options named on that command line
+Every bundled wall is solved by every chosen method (`--method`, default every
+installed solver that declares itself a gallery method) with the options named on that command line
 (`--option METHOD.KEY=VALUE`; the others are the solvers' defaults, see
 `masonryfw plugins`); `--skip METHOD:CASE` leaves a method out on a wall. Each
 method's first run is scored against every other method's (the main table), and
@@ -354,20 +363,15 @@ def gallery_command_line(
     return shlex.join(words)
 
 
-def agreement_markdown(
-    outcomes: list[CaseOutcome], runs: list[Run], missing: list[str], command: str = DEFAULT_COMMAND,
-    notes: str = "",
-) -> str:
+def agreement_markdown(outcomes: list[CaseOutcome], runs: list[Run], command: str = DEFAULT_COMMAND,
+                       notes: str = "") -> str:
     """The whole of docs/agreement.md (``notes``: hand-written markdown put in as its Discussion section)."""
     parts = [INTRODUCTION.format(threshold=DEFAULT_THRESHOLD, command=command)]
     installed = sorted({r.solver for r in runs})
     parts.append("## Status\n")
-    parts.append(
-        f"Methods run: {', '.join(installed) or 'none'}."
-        + (f" Not installed or not chosen (skipped): {', '.join(missing)}." if missing else "")
-    )
-    options = {r.solver: {k: v for k, v in r.options.items() if not (r.solver == "la" and k == "solver")}
-               for r in runs}
+    parts.append(f"Methods run: {', '.join(installed) or 'none'}.")
+    varied = {key for r in runs for v in installed_methods()[r.solver].variants for key in v.options}
+    options = {r.solver: {k: v for k, v in r.options.items() if k not in varied} for r in runs}
     given = "; ".join(f"{m}: `{json.dumps(o)}`" for m, o in options.items() if o)
     parts.append(f"\nSolver options other than the defaults: {given or 'none'}.")
     if len(installed) < 2:
@@ -424,13 +428,14 @@ def run_gallery(
     if unknown_skips:
         raise mf.MasonryError(
             f"--skip names unknown case(s) {', '.join(unknown_skips)}; bundled cases: {', '.join(bundled)}")
-    runs, missing = planned_runs(methods, parse_method_options(options))
-    for name in missing:
-        echo(f"skipping {name}: solver not installed")
+    runs = planned_runs(methods, parse_method_options(options))
     if not runs:
-        raise mf.PluginError(f"none of the solvers {', '.join(METHODS)} is installed")
+        raise mf.PluginError("no gallery solver is installed")
     notes_text = notes.read_text() if notes is not None else ""
-    output.mkdir(parents=True, exist_ok=True)
+    mf.check_output_path(agreement)
+    if not output.is_dir():
+        mf.check_output_path(output)  # its folder exists and is writable: the gallery folder is made in it
+    output.mkdir(exist_ok=True)
     written, outcomes = [], []
     for case in cases or list(bundled):
         echo(f"{case}:")
@@ -439,8 +444,7 @@ def run_gallery(
         figure = case_figure(outcome, output / f"{case}.png")
         if figure is not None:
             written.append(figure)
-    agreement.parent.mkdir(parents=True, exist_ok=True)
     temporary = agreement.with_name(f".{agreement.name}.tmp")
-    temporary.write_text(agreement_markdown(outcomes, runs, missing, command, notes_text))
+    temporary.write_text(agreement_markdown(outcomes, runs, command, notes_text))
     temporary.replace(agreement)
     return written + [agreement]

@@ -17,15 +17,8 @@ from matplotlib.lines import Line2D
 
 import masonryfw as mf
 
-from .comparison import compare, masonry_blocks, solver_label
-from .shapes import (
-    deformed_nodes,
-    deformed_points,
-    interface_relative_motion,
-    largest_vertex_motion,
-    padded_block_nodes,
-    with_geometry,
-)
+from .comparison import solver_label
+from .shapes import deformed_nodes, deformed_points, largest_vertex_motion, padded_block_nodes
 
 # Default amplification: the largest vertex displacement drawn as this share of the model size.
 DRAWN_MOTION_SHARE = 0.10
@@ -72,7 +65,7 @@ def _block_verts(geo: xr.Dataset, x: np.ndarray, y: np.ndarray) -> np.ndarray:
 
 
 def _supports(geo: xr.Dataset) -> np.ndarray:
-    return ~masonry_blocks(geo)
+    return mf.support_blocks(geo.block_role.values)
 
 
 def _draw_blocks(ax, geo, x, y, facecolors, *, edge="0.3", width=0.3, zorder=1) -> None:
@@ -122,8 +115,8 @@ def draw_mechanism(datasets: Sequence[xr.Dataset], ax, options: Mapping[str, Any
     """The wall in its amplified deformed configuration, blocks coloured by macro-block, cracks heavy."""
     ds = _single(datasets, "mechanism")
     _require(ds, ["block_displacement"], "mechanism", "block displacements (a discrete la or fdem result)")
-    geo = with_geometry(ds)
-    u = ds.block_displacement.values
+    geo = mf.derive_geometry(ds)
+    u = mf.block_motion(ds)
     amplification = options["amplification"] or default_amplification(geo, u)
     _draw_outline(ax, geo)
     x, y = deformed_nodes(geo, u, amplification)
@@ -141,38 +134,18 @@ def draw_mechanism(datasets: Sequence[xr.Dataset], ax, options: Mapping[str, Any
     _finish(ax, ds)
 
 
-def joint_states(ds: xr.Dataset, geo: xr.Dataset, threshold: float) -> np.ndarray:
-    """``interface_state`` flags: stored, else classified from opening/slip (stored or from block motion).
-
-    A joint opens (slides) where its largest opening (|slip|) exceeds ``threshold``
-    times the largest relative motion of any joint.
-    """
-    if "interface_state" in ds:
-        return ds.interface_state.values.astype(np.int64)
-    if "interface_opening" in ds and "interface_slip" in ds:
-        opening, slip = ds.interface_opening.values, ds.interface_slip.values
-    else:
-        opening, slip = interface_relative_motion(geo, ds.block_displacement.values)
-    largest = max(np.max(opening, initial=0.0), np.max(np.abs(slip), initial=0.0))
-    if largest <= 0:
-        return np.zeros(geo.sizes["interface"], dtype=np.int64)
-    opens = opening.max(axis=1) > threshold * largest
-    slides = np.abs(slip).max(axis=1) > threshold * largest
-    flag = mf.flags("interface_state")
-    return np.where(opens, flag["open"], 0) + np.where(slides, flag["slide"], 0)
-
-
 def draw_cracks(datasets: Sequence[xr.Dataset], ax, options: Mapping[str, Any]) -> None:
-    """Joints coloured by how they fail: opening, sliding, or both, over the undeformed wall."""
+    """Joints coloured by how they fail (opening, sliding, or both) over the undeformed wall.
+
+    A joint is drawn where its ``crack_indicator`` exceeds ``threshold`` (as the
+    comparison counts cracks); its state is the core's definition with that
+    threshold (:func:`masonryfw.states_at`).
+    """
     ds = _single(datasets, "cracks")
-    if not ({"interface_state", "block_displacement"} & set(ds.variables)
-            or {"interface_opening", "interface_slip"} <= set(ds.variables)):
-        raise mf.MasonryError(
-            "result has no interface_state, interface_opening/interface_slip or block_displacement: "
-            "the cracks plot needs a discrete (la or fdem) result"
-        )
-    geo = with_geometry(ds)
-    state = joint_states(ds, geo, options["threshold"])
+    _require(ds, ["interface_opening", "interface_slip"], "cracks",
+             "the relative motion at the joints (a result with block displacements: la, fdem)")
+    geo = mf.derive_geometry(ds)
+    state = mf.states_at(ds, options["threshold"])
     _draw_blocks(ax, geo, geo.node_x.values, geo.node_y.values, np.array(["0.93"] * geo.sizes["block"], dtype=object))
     segments = _segments(geo.interface_x.values, geo.interface_y.values)
     flag = mf.flags("interface_state")
@@ -222,7 +195,7 @@ def draw_forces(datasets: Sequence[xr.Dataset], ax, options: Mapping[str, Any]) 
         ds, ["interface_normal_force", "interface_shear_force"], "forces",
         "contact forces (a limit analysis la result)",
     )
-    geo = with_geometry(ds)
+    geo = mf.derive_geometry(ds)
     _draw_blocks(ax, geo, geo.node_x.values, geo.node_y.values, np.array(["0.93"] * geo.sizes["block"], dtype=object))
     px, py, magnitude, segments = thrust_segments(
         geo, ds.interface_normal_force.values, ds.interface_shear_force.values, options["scale"]
@@ -247,7 +220,7 @@ def draw_plastic(datasets: Sequence[xr.Dataset], ax, options: Mapping[str, Any])
     """Plastic quadrature points over the mesh: blue tensile, grey shear, navy both."""
     ds = _single(datasets, "plastic")
     _require(ds, ["qp_failure", "qp_x", "qp_y"], "plastic", "a continuum (jmm) result")
-    _draw_outline(ax, with_geometry(ds))
+    _draw_outline(ax, mf.derive_geometry(ds))
     if "mesh_face_nodes" in ds:
         ax.add_collection(PolyCollection(list(_mesh_faces(ds)), facecolors="none", edgecolors="0.9", linewidths=0.3))
     failure = ds.qp_failure.values
@@ -286,7 +259,7 @@ def panel_kind(ds: xr.Dataset) -> str:
 
 def draw_indicator(ds: xr.Dataset, ax, threshold: float) -> None:
     """Joints with ``crack_indicator > threshold`` drawn heavy over the undeformed wall."""
-    geo = with_geometry(ds)
+    geo = mf.derive_geometry(ds)
     _draw_blocks(ax, geo, geo.node_x.values, geo.node_y.values, np.array(["0.93"] * geo.sizes["block"], dtype=object))
     cracked = ds.crack_indicator.values > threshold
     ax.add_collection(LineCollection(
@@ -323,7 +296,7 @@ def draw_compare(datasets: Sequence[xr.Dataset], ax, options: Mapping[str, Any])
         raise mf.MasonryError(f"the compare plot needs two or more results of one model, got {len(datasets)}")
     kinds = [panel_kind(ds) for ds in datasets]
     captions = ["reference"] + [
-        score_caption(compare(datasets[0], ds, {"threshold": options["threshold"]})) for ds in datasets[1:]
+        score_caption(mf.compare(datasets[0], ds, "crack", {"threshold": options["threshold"]})) for ds in datasets[1:]
     ]
     for panel, ds, kind, caption in zip(panel_axes(ax, len(datasets)), datasets, kinds, captions):
         if kind == "mechanism":

@@ -7,17 +7,18 @@ from __future__ import annotations
 
 import masonryfw as mf
 
-__version__ = mf.__version__
-
 DEFAULT_THRESHOLD = 0.1
 THRESHOLD_OPTION = mf.Option(
     "threshold",
     float,
     DEFAULT_THRESHOLD,
-    "a joint counts as cracked where crack_indicator > threshold (0 <= threshold < 1)",
+    "a joint counts as cracked where crack_indicator > threshold",
+    at_least=0.0,
+    below=1.0,
 )
 AMPLIFICATION_OPTION = mf.Option(
-    "amplification", float, 0.0, "displacement amplification; 0 = the largest motion drawn as 10 % of the model size"
+    "amplification", float, None, "displacement amplification; auto: the largest motion drawn as 10 % of the model size",
+    above=0.0,
 )
 COMPARE_OPTIONS = (THRESHOLD_OPTION,)
 
@@ -26,13 +27,12 @@ COMPARATOR = mf.Comparator(
     summary="crack-pattern agreement: F1/Jaccard, overlap, Spearman, macro-block ARI, "
     "mechanism cosine, failure-locus distance",
     compare=mf.lazy("masonryfw_compare.comparison:compare"),
-    version=__version__,
     options=COMPARE_OPTIONS,
 )
 
 
 def _plotter(name: str, summary: str, options: tuple = ()) -> mf.Plotter:
-    return mf.Plotter(name, summary, mf.lazy(f"masonryfw_compare.plotting:draw_{name}"), __version__, options)
+    return mf.Plotter(name, summary, mf.lazy(f"masonryfw_compare.plotting:draw_{name}"), options=options)
 
 
 PLOTTERS = {
@@ -42,9 +42,9 @@ PLOTTERS = {
                  (AMPLIFICATION_OPTION, THRESHOLD_OPTION)),
         _plotter("cracks", "joints that open, slide or both, in colours", (THRESHOLD_OPTION,)),
         _plotter("forces", "contact forces at collapse as thrust segments",
-                 (mf.Option("scale", float, 1.0, "largest segment, in median interface lengths"),)),
+                 (mf.Option("scale", float, 1.0, "largest segment, in median interface lengths", above=0.0),)),
         _plotter("plastic", "plastic quadrature points over the mesh (continuum results)",
-                 (mf.Option("marker_size", float, 4.0, "marker area [pt^2]"),)),
+                 (mf.Option("marker_size", float, 4.0, "marker area [pt^2]", above=0.0),)),
         _plotter("history", "reaction on the moving support against settlement"),
         _plotter("compare", "two or more results side by side with their scores",
                  (AMPLIFICATION_OPTION, THRESHOLD_OPTION)),

@@ -1,9 +1,7 @@
 """Geometry the comparison and the pictures need, vectorised over all blocks/interfaces.
 
-Rigid-block kinematics follow docs/architecture.md: a block moves with the
-centroid displacement ``(ux, uy)`` and the rotation ``rz`` about its centroid;
-the relative motion at an interface end is side 1 minus side 0, ``opening = dv . n``
-and ``slip = dv . t``.
+What block results mean (relative motion, states, macro-blocks, polar moments)
+is the core's (:mod:`masonryfw.semantics`); here are only drawing and distance helpers.
 """
 from __future__ import annotations
 
@@ -19,11 +17,6 @@ import masonryfw as mf
 SAMPLES_PER_SEGMENT = 16
 
 
-def with_geometry(ds: xr.Dataset) -> xr.Dataset:
-    """``ds`` with the derived geometry (areas, centroids, interface frames) recomputed."""
-    return mf.derive_geometry(ds)
-
-
 def padded_block_nodes(block_node_count: np.ndarray) -> np.ndarray:
     """(block, max_count) node indices; short polygons repeat their last vertex.
 
@@ -34,81 +27,6 @@ def padded_block_nodes(block_node_count: np.ndarray) -> np.ndarray:
     start = mf.block_offsets(counts)[:-1]
     columns = np.arange(counts.max(initial=1))
     return start[:, None] + np.minimum(columns[None, :], counts[:, None] - 1)
-
-
-def block_polar_moment(node_x, node_y, block_node_count) -> np.ndarray:
-    """Polar second moment of area of every block about its own centroid [m4].
-
-    Shoelace sums in coordinates local to each block's first vertex (full
-    precision far from the origin), moved to the centroid with the parallel-axis
-    theorem. For a b x h rectangle: A (b^2 + h^2) / 12.
-    """
-    x = np.asarray(node_x, dtype=float)
-    y = np.asarray(node_y, dtype=float)
-    counts = np.asarray(block_node_count, dtype=np.int64)
-    start = mf.block_offsets(counts)[:-1]
-    owner = mf.node_block(counts)
-    xs, ys = x - x[start][owner], y - y[start][owner]
-    following = np.arange(x.size) + 1
-    following[start + counts - 1] = start
-    xn, yn = xs[following], ys[following]
-    cross = xs * yn - xn * ys
-    area = 0.5 * np.add.reduceat(cross, start)
-    sx = np.add.reduceat((xs + xn) * cross, start) / 6.0  # first moments (area * centroid)
-    sy = np.add.reduceat((ys + yn) * cross, start) / 6.0
-    ixx = np.add.reduceat((ys * ys + ys * yn + yn * yn) * cross, start) / 12.0
-    iyy = np.add.reduceat((xs * xs + xs * xn + xn * xn) * cross, start) / 12.0
-    return ixx + iyy - (sx * sx + sy * sy) / area
-
-
-def rigid_point_motion(displacement, centroid_x, centroid_y, px, py, owner):
-    """Linearised rigid motion ``u_c + rz x (p - c)`` of points ``p`` carried by block ``owner``."""
-    u = np.asarray(displacement, dtype=float)[owner]
-    dx = np.asarray(px) - np.asarray(centroid_x)[owner]
-    dy = np.asarray(py) - np.asarray(centroid_y)[owner]
-    return u[..., 0] - u[..., 2] * dy, u[..., 1] + u[..., 2] * dx
-
-
-def deformed_points(geo: xr.Dataset, displacement, amplification: float, px, py, owner):
-    """Points ``p`` carried by blocks ``owner`` after the rigid motion ``amplification * displacement``.
-
-    The rotation is applied exactly (not linearised), so amplified blocks keep
-    their shape.
-    """
-    cx, cy = geo.block_centroid_x.values[owner], geo.block_centroid_y.values[owner]
-    u = amplification * np.asarray(displacement, dtype=float)[owner]
-    cos, sin = np.cos(u[..., 2]), np.sin(u[..., 2])
-    dx, dy = np.asarray(px) - cx, np.asarray(py) - cy
-    return cx + u[..., 0] + cos * dx - sin * dy, cy + u[..., 1] + sin * dx + cos * dy
-
-
-def deformed_nodes(geo: xr.Dataset, displacement, amplification: float):
-    """Block vertices after the rigid motion ``amplification * displacement``."""
-    owner = mf.node_block(geo.block_node_count.values)
-    return deformed_points(geo, displacement, amplification, geo.node_x.values, geo.node_y.values, owner)
-
-
-def largest_vertex_motion(geo: xr.Dataset, displacement) -> float:
-    """Largest (linearised) displacement of any block vertex [m]."""
-    owner = mf.node_block(geo.block_node_count.values)
-    ux, uy = rigid_point_motion(
-        displacement, geo.block_centroid_x.values, geo.block_centroid_y.values,
-        geo.node_x.values, geo.node_y.values, owner,
-    )
-    return float(np.max(np.hypot(ux, uy), initial=0.0))
-
-
-def interface_relative_motion(geo: xr.Dataset, displacement):
-    """Opening and slip (interface, end) implied by rigid block displacements."""
-    blocks = geo.interface_blocks.values.astype(np.int64)
-    px, py = geo.interface_x.values, geo.interface_y.values
-    cx, cy = geo.block_centroid_x.values, geo.block_centroid_y.values
-    u0x, u0y = rigid_point_motion(displacement, cx, cy, px, py, blocks[:, [0, 0]])
-    u1x, u1y = rigid_point_motion(displacement, cx, cy, px, py, blocks[:, [1, 1]])
-    dvx, dvy = u1x - u0x, u1y - u0y
-    nx, ny = geo.interface_normal_x.values[:, None], geo.interface_normal_y.values[:, None]
-    tx, ty = geo.interface_tangent_x.values[:, None], geo.interface_tangent_y.values[:, None]
-    return dvx * nx + dvy * ny, dvx * tx + dvy * ty
 
 
 def segment_samples(x, y, samples: int = SAMPLES_PER_SEGMENT):
@@ -150,3 +68,32 @@ def distance_to_points(px, py, tx, ty) -> np.ndarray:
     """Distance from every point ``p`` to the nearest of the points ``t`` (k-d tree)."""
     distance, _ = cKDTree(np.column_stack([tx, ty])).query(np.column_stack([px, py]))
     return distance
+
+
+def vertex_motion(geo: xr.Dataset, displacement, rotations: str = "small"):
+    """Motion ``(ux, uy)`` of every block vertex under block motions ``displacement`` (block, 3)."""
+    owner = mf.node_block(geo.block_node_count.values)
+    return mf.point_motion(displacement, geo.block_centroid_x.values, geo.block_centroid_y.values,
+                           geo.node_x.values, geo.node_y.values, owner, rotations)
+
+
+def deformed_points(geo: xr.Dataset, displacement, amplification: float, px, py, owner):
+    """Points ``p`` carried by blocks ``owner`` after the rigid motion ``amplification * displacement``.
+
+    The rotation is applied exactly (not linearised), so amplified blocks keep their shape.
+    """
+    ux, uy = mf.point_motion(amplification * np.asarray(displacement, dtype=float), geo.block_centroid_x.values,
+                             geo.block_centroid_y.values, px, py, owner, "finite")
+    return np.asarray(px) + ux, np.asarray(py) + uy
+
+
+def deformed_nodes(geo: xr.Dataset, displacement, amplification: float):
+    """Block vertices after the rigid motion ``amplification * displacement``."""
+    owner = mf.node_block(geo.block_node_count.values)
+    return deformed_points(geo, displacement, amplification, geo.node_x.values, geo.node_y.values, owner)
+
+
+def largest_vertex_motion(geo: xr.Dataset, displacement) -> float:
+    """Largest (linearised) displacement of any block vertex [m]."""
+    ux, uy = vertex_motion(geo, displacement)
+    return float(np.max(np.hypot(ux, uy), initial=0.0))

@@ -17,10 +17,10 @@ import xarray as xr
 import masonryfw as mf
 
 
-def load_resultant(load: np.ndarray, cx: np.ndarray, cy: np.ndarray) -> np.ndarray:
-    """Resultant ``(Fx, Fy, Mz about the origin)`` of loads ``(nblock, 3)`` applied at the centroids."""
+def load_resultant(load: np.ndarray, cx: np.ndarray, cy: np.ndarray) -> tuple[np.ndarray, float]:
+    """Resultant force ``(Fx, Fy)`` and moment about the origin of loads ``(nblock, 3)`` at the centroids."""
     fx, fy, mz = load.T
-    return np.array([fx.sum(), fy.sum(), (mz + cx * fy - cy * fx).sum()])
+    return np.array([fx.sum(), fy.sum()]), float((mz + cx * fy - cy * fx).sum())
 
 
 def solve_statics(model: xr.Dataset, options, progress) -> xr.Dataset:
@@ -30,9 +30,8 @@ def solve_statics(model: xr.Dataset, options, progress) -> xr.Dataset:
     shared by the supports in proportion to their contact length with the wall:
     ``R_s = W * L_s / L_total`` (FORMAT.md, settlement loading).
     """
-    roles = mf.flags("block_role")
-    is_support = np.isin(model.block_role.values, [roles["fixed_support"], roles["moving_support"]])
-    dead, live = model.dead_load.values, model.live_load.values
+    is_support = mf.support_blocks(model.block_role.values)
+    dead, live = mf.block_loads(model, "dead"), mf.block_loads(model, "live")
     cx, cy = model.block_centroid_x.values, model.block_centroid_y.values
     progress(0.0, "load resultants")
     weight = -dead[~is_support, 1].sum()
@@ -45,21 +44,22 @@ def solve_statics(model: xr.Dataset, options, progress) -> xr.Dataset:
     if contact.sum() <= 0:
         raise mf.SolveError("statics: no wall block rests on a support block")
     progress(1.0, "done")
-    return xr.Dataset(
-        {
-            "support_dead_reaction": ("block", weight * contact / contact.sum(), {
-                "units": "N", "long_name": "upward dead reaction of each support, W * L_s / L_total (0 off supports)"}),
-            "masonry_weight": ((), weight, {"units": "N", "long_name": "weight W of the units and lintels"}),
-            "total_dead_load": ("dof", load_resultant(dead, cx, cy), {
-                "units": "N, N, N m", "long_name": "resultant of the dead loads, moment about the origin"}),
-            "total_live_load": ("dof", load_resultant(live, cx, cy), {
-                "units": "N, N, N m", "long_name": "resultant of the live loads, moment about the origin"}),
-        }
-    )
+    variables = {
+        "support_dead_reaction": ("block", weight * contact / contact.sum(), {
+            "units": "N", "long_name": "upward dead reaction of each support, W * L_s / L_total (0 off supports)"}),
+        "masonry_weight": ((), weight, {"units": "N", "long_name": "weight W of the units and lintels"}),
+    }
+    for which, load in (("dead", dead), ("live", live)):
+        force, moment = load_resultant(load, cx, cy)
+        variables[f"total_{which}_force"] = ("axis", force, {
+            "units": "N", "long_name": f"resultant force (x, y) of the {which} loads"})
+        variables[f"total_{which}_moment"] = ((), moment, {
+            "units": "N m", "long_name": f"resultant moment of the {which} loads about the origin"})
+    return xr.Dataset(variables)
 
 
 @mf.hookimpl
 def masonryfw_solvers():
     """The records this plugin contributes (called once per lookup)."""
     summary = "load resultants and support dead reactions (no failure analysis)"
-    return [mf.Solver("statics", summary, solve_statics, "1.0")]
+    return [mf.Solver("statics", summary, solve_statics, gallery=False)]

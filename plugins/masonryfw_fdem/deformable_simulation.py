@@ -1,4 +1,4 @@
-"""The time loop of the deformable mode: the rigid mode's phases (:mod:`.simulation`) on nodes.
+"""The state of the deformable mode, stepped by the rigid mode's phases (:mod:`.simulation`) on nodes.
 
 The state carries the node positions and velocities; ``pos`` (block, 3) is kept as the rigid-body
 fit of every block's nodes after each chunk, which is what the post-processing and the
@@ -10,9 +10,9 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from . import deformable, kernels, simulation
+from . import deformable, kernels
 from .scene import Scene, face_properties
-from .simulation import Controls, History, State
+from .simulation import Controls, State
 
 
 @dataclass
@@ -90,22 +90,3 @@ def initial_state(scene: Scene, controls: Controls, mesh: deformable.Mesh, load:
         node_load=deformable.nodal_load(mesh, scene, load))
     state.detect(scene, controls, first=True)
     return state
-
-
-def run(scene: Scene, controls: Controls, mesh: deformable.Mesh, load: np.ndarray,
-        progress) -> tuple[DeformableState, History]:
-    """Gravity, then settlement (as :func:`.simulation.run`)."""
-    state = initial_state(scene, controls, mesh, load)
-    history = History()
-    try:
-        simulation.gravity_phase(scene, controls, state, load, history, progress)
-        if controls.target > 0 and scene.moving.any():
-            simulation.settlement_phase(scene, controls, state, load, history, progress)
-    except KeyboardInterrupt:
-        state.interrupted = True
-        state.stop_reason = "interrupted"
-        out = np.zeros(6)
-        state.advance_chunk(scene, controls, 0, 0.0, 0.0, out)
-        phase = simulation.SETTLEMENT_PHASE if state.settlement_start > 0 else simulation.GRAVITY_PHASE
-        history.add(phase, state.acc, out)
-    return state, history

@@ -1,93 +1,28 @@
-"""From the final block positions and contact forces to the FORMAT.md result variables.
+"""From the final block positions and contact forces to the primary result variables.
 
-Joint motion comes from rigid kinematics: at each end point of a model
-interface, the displacement of side 1 minus that of side 0 (finite rotations),
-projected on the interface's normal (opening, >= 0 opens) and tangent (slip).
-That is the same quantity the limit analysis reports, so the two compare directly.
-
-States: ``intact`` when both ends move less than ``threshold``; ``open`` when
-only the opening exceeds it; ``slide`` when only the slip does; ``open_slide``
-when both do (dry Coulomb joints have no dilatancy here, unlike the LA's
-associative flow). ``crack_indicator``: the joint's largest end motion over the
-largest of all masonry joints, 0 below the threshold and on joints between two supports.
+The comparable fields (opening and slip at the model's interface ends with
+finite rotations, joint states, crack indicator, macro-blocks) are derived by the
+core (:mod:`masonryfw.semantics`), as for every solver: the same quantities the
+limit analysis reports, so the two compare directly.
 """
 from __future__ import annotations
 
 import numpy as np
-import scipy.sparse as sp
-import xarray as xr
-from scipy.sparse.csgraph import connected_components
 
 import masonryfw as mf
 
 from .kernels import face_frames
-from .scene import DRIVEN_ROLES, Scene
-
-STATE = mf.flags("interface_state")
+from .scene import Scene
 
 
 def block_displacement(scene: Scene, pos: np.ndarray) -> np.ndarray:
-    """(block, dof) displacement of the centroids [m, m, rad]."""
+    """(block, 3) displacement of the centroids [m, m] and rotation [rad]."""
     u = pos - scene.pos0
     return u * np.array([scene.scales.length, scene.scales.length, 1.0])
 
 
-def point_displacement(model: xr.Dataset, u: np.ndarray, blocks: np.ndarray, x: np.ndarray, y: np.ndarray):
-    """Displacement of material points (x, y) of ``blocks`` under the rigid motions ``u`` (finite rotation)."""
-    cx = model.block_centroid_x.values[blocks]
-    cy = model.block_centroid_y.values[blocks]
-    theta = u[blocks, 2]
-    c, s = np.cos(theta), np.sin(theta)
-    rx, ry = x - cx, y - cy
-    return u[blocks, 0] + (c - 1) * rx - s * ry, u[blocks, 1] + s * rx + (c - 1) * ry
-
-
-def relative_motion(model: xr.Dataset, u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Opening and slip (interface, end) [m] of the final displacement ``u``."""
-    sides = model.interface_blocks.values.astype(np.int64)
-    x, y = model.interface_x.values, model.interface_y.values
-    ux0, uy0 = point_displacement(model, u, sides[:, [0, 0]], x, y)
-    ux1, uy1 = point_displacement(model, u, sides[:, [1, 1]], x, y)
-    dx, dy = ux1 - ux0, uy1 - uy0
-    nx, ny = model.interface_normal_x.values[:, None], model.interface_normal_y.values[:, None]
-    tx, ty = model.interface_tangent_x.values[:, None], model.interface_tangent_y.values[:, None]
-    return dx * nx + dy * ny, dx * tx + dy * ty
-
-
-def masonry_joints(model: xr.Dataset) -> np.ndarray:
-    role = model.block_role.values[model.interface_blocks.values.astype(np.int64)]
-    return ~np.isin(role, DRIVEN_ROLES).all(axis=1)
-
-
-def interface_states(opening: np.ndarray, slip: np.ndarray, threshold: float) -> np.ndarray:
-    opens = opening.max(axis=1) > threshold
-    slips = np.abs(slip).max(axis=1) > threshold
-    state = np.full(opening.shape[0], STATE["intact"], dtype=np.int8)
-    state[opens & ~slips] = STATE["open"]
-    state[slips & ~opens] = STATE["slide"]
-    state[opens & slips] = STATE["open_slide"]
-    return state
-
-
-def crack_indicator(motion: np.ndarray, masonry: np.ndarray, threshold: float) -> np.ndarray:
-    largest = motion[masonry].max(initial=0.0)
-    if largest <= 0:
-        return np.zeros_like(motion)
-    indicator = np.where(masonry & (motion > threshold), motion / largest, 0.0)
-    return np.minimum(indicator, 1.0)
-
-
-def macro_blocks(n_block: int, interface_blocks: np.ndarray, state: np.ndarray) -> np.ndarray:
-    """Connected components through intact interfaces, labelled in order of their lowest block."""
-    edges = interface_blocks[state == STATE["intact"]].astype(np.int64)
-    graph = sp.coo_matrix((np.ones(len(edges)), (edges[:, 0], edges[:, 1])), shape=(n_block, n_block))
-    _, labels = connected_components(graph, directed=False)
-    _, first = np.unique(labels, return_index=True)
-    return np.argsort(np.argsort(first))[labels]
-
-
-def interface_forces(model: xr.Dataset, scene: Scene, faces: np.ndarray, props: np.ndarray,
-                     normal: np.ndarray, shear: np.ndarray, pos: np.ndarray):
+def interface_forces(scene: Scene, faces: np.ndarray, props: np.ndarray, normal: np.ndarray, shear: np.ndarray,
+                     pos: np.ndarray):
     """Contact forces of the face pairs mapped onto the model's interface ends [N].
 
     Each face pair that belongs to a model interface (``props[:, 3]``) gives its
@@ -95,6 +30,7 @@ def interface_forces(model: xr.Dataset, scene: Scene, faces: np.ndarray, props: 
     current configuration); normal = force on side 1 along the interface normal
     (compression positive), shear = along its tangent.
     """
+    model = scene.model
     n_interface = model.sizes["interface"]
     normal_out = np.zeros((n_interface, 2))
     shear_out = np.zeros((n_interface, 2))
@@ -113,7 +49,8 @@ def interface_forces(model: xr.Dataset, scene: Scene, faces: np.ndarray, props: 
     # interface end points carried by side 0 into the current configuration
     u = block_displacement(scene, pos)
     ix, iy = model.interface_x.values[owner], model.interface_y.values[owner]
-    dux, duy = point_displacement(model, u, sides[:, [0, 0]], ix, iy)
+    dux, duy = mf.point_motion(u, model.block_centroid_x.values, model.block_centroid_y.values, ix, iy,
+                               sides[:, [0, 0]], "finite")
     ex, ey = (ix + dux) / scene.scales.length, (iy + duy) / scene.scales.length
     # nearest interface end of each contact end: (face, contact end, interface end)
     dist = np.hypot(ex[:, None, :] - px[:, :, None], ey[:, None, :] - py[:, :, None])

@@ -17,7 +17,6 @@ import masonryfw as mf
 
 GRAVITY = 9.81  # m s-2: turns unit weights into masses
 ROLE = mf.flags("block_role")
-DRIVEN_ROLES = (ROLE["fixed_support"], ROLE["moving_support"])
 MAX_NAMED = 8
 
 
@@ -43,6 +42,7 @@ class Scene:
     """Flat non-dimensional arrays of one model (see the module docstring)."""
 
     scales: Scales
+    model: xr.Dataset  # the checked model the scene was built from
     offs: np.ndarray  # (block + 1) node offsets
     lx: np.ndarray  # node coordinates relative to the block centroid
     ly: np.ndarray
@@ -67,17 +67,6 @@ class Scene:
     default_friction: float
 
 
-def polygon_polar_moment(x: np.ndarray, y: np.ndarray, offs: np.ndarray) -> np.ndarray:
-    """Polar second moment of area of every polygon about the origin of its coordinates."""
-    counts = np.diff(offs)
-    idx = np.arange(x.size)
-    nxt = idx + 1
-    nxt[offs[1:] - 1] = offs[:-1]
-    cross = x * y[nxt] - x[nxt] * y
-    terms = cross * (x**2 + x * x[nxt] + x[nxt] ** 2 + y**2 + y * y[nxt] + y[nxt] ** 2) / 12.0
-    return np.add.reduceat(terms, offs[:-1]) * (counts > 0)
-
-
 def check_convex(lx: np.ndarray, ly: np.ndarray, offs: np.ndarray) -> None:
     """Face-pair contact needs convex blocks: raise naming the ones that are not."""
     idx = np.arange(lx.size)
@@ -98,7 +87,7 @@ def build_scene(model: xr.Dataset) -> Scene:
     """The non-dimensional arrays of ``model``; raises ModelError on what the method cannot take."""
     role = model.block_role.values.astype(np.int64)
     n_block = role.size
-    driven = np.isin(role, DRIVEN_ROLES)
+    driven = mf.support_blocks(role)
     moving = role == ROLE["moving_support"]
     offs = mf.block_offsets(model.block_node_count.values)
     area = model.block_area.values
@@ -107,13 +96,13 @@ def build_scene(model: xr.Dataset) -> Scene:
     total = float(weight[~driven].sum())
     if not total > 0:
         raise mf.ModelError("block_unit_weight: the masonry blocks weigh nothing; fdem needs their masses")
+    length = mf.model_scales(model).length
     weightless = np.flatnonzero(~driven & ~(weight > 0))
     if weightless.size:
         raise mf.ModelError(
             f"block(s) {name_list(weightless)}: block_unit_weight * area * thickness is not positive; "
             "a free block needs a mass in fdem"
         )
-    length = mf.model_scale(model.node_x.values, model.node_y.values)
     scales = Scales(length=length, force=total, time=float(np.sqrt(length / GRAVITY)))
 
     cx, cy = model.block_centroid_x.values, model.block_centroid_y.values
@@ -126,8 +115,8 @@ def build_scene(model: xr.Dataset) -> Scene:
     nxt[offs[1:] - 1] = offs[:-1]
     perimeter = np.add.reduceat(np.hypot(lx[nxt] - lx, ly[nxt] - ly), offs[:-1])
     mass_share = weight / total
-    polar = polygon_polar_moment(lx, ly, offs)
-    inertia = mass_share * polar / np.where(area > 0, area / length**2, 1.0)
+    polar = mf.polar_moment(model.node_x.values, model.node_y.values, model.block_node_count.values)
+    inertia = mass_share * polar / np.where(area > 0, area * length**2, 1.0)
     mass = np.stack((mass_share, mass_share, inertia), axis=1)
     mass[driven] = 1.0  # never used: driven blocks follow their imposed motion
 
@@ -136,8 +125,8 @@ def build_scene(model: xr.Dataset) -> Scene:
     direction[:, 2] *= length
     direction[~moving] = 0.0
     load_scale = np.array([total, total, total * length])
-    dead = np.where(driven[:, None], 0.0, model.dead_load.values / load_scale)
-    live = np.where(driven[:, None], 0.0, model.live_load.values / load_scale)
+    dead = np.where(driven[:, None], 0.0, mf.block_loads(model, "dead") / load_scale)
+    live = np.where(driven[:, None], 0.0, mf.block_loads(model, "live") / load_scale)
 
     height = np.maximum.reduceat(ly, offs[:-1]) - np.minimum.reduceat(ly, offs[:-1])
     unit_height = float(np.median(height[~driven]))
@@ -155,6 +144,7 @@ def build_scene(model: xr.Dataset) -> Scene:
     friction = model.interface_friction.values.astype(float)
     return Scene(
         scales=scales,
+        model=model,
         offs=offs.astype(np.int64),
         lx=lx,
         ly=ly,

@@ -246,19 +246,23 @@ def settlement_phase(scene, controls, state, load, history, progress) -> None:
     state.stop_reason = "target settlement"
 
 
-def run(scene: Scene, controls: Controls, load: np.ndarray, progress) -> tuple[State, History]:
-    """Gravity, then settlement; a KeyboardInterrupt returns what was computed (``interrupted``)."""
-    state = initial_state(scene, controls)
+def run(scene: Scene, controls: Controls, state: State, load: np.ndarray, progress) -> History:
+    """Gravity, then settlement, from ``state`` (rigid or deformable); returns the history.
+
+    A KeyboardInterrupt keeps what was computed (``state.interrupted``, the state
+    reached evaluated as a last record); one before the first record propagates.
+    """
     history = History()
     try:
         gravity_phase(scene, controls, state, load, history, progress)
         if controls.target > 0 and scene.moving.any():
             settlement_phase(scene, controls, state, load, history, progress)
     except KeyboardInterrupt:
+        if not history.rows:
+            raise
         state.interrupted = True
         state.stop_reason = "interrupted"
-        out = np.zeros(6)
-        advance(scene, controls, state, load, 0, 0.0, 0.0, out)  # evaluate the state reached
+        out = chunk(scene, controls, state, load, 0, 0.0, 0.0)  # evaluate the state reached
         phase = SETTLEMENT_PHASE if state.settlement_start > 0 else GRAVITY_PHASE
         history.add(phase, state.acc, out)
-    return state, history
+    return history

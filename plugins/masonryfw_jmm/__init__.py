@@ -1,16 +1,15 @@
-"""``jmm``: continuum FE with the Jointed Masonry Model (paper section 2.3), settlement to failure.
+"""``jmm`` and ``jmm-limit``: continuum FE with the Jointed Masonry Model (paper section 2.3).
 
-Registration only (scikit-fem is imported when a solve starts); the method lives in :mod:`.material` (the JMM return mapping),
-:mod:`.mesh`, :mod:`.fem`, :mod:`.problem`, :mod:`.newton`, :mod:`.solver` and
-:mod:`.cracks`.
+Registration only (scikit-fem is imported when a solve starts); the method lives in
+:mod:`.material` (the JMM return mapping), :mod:`.mesh`, :mod:`.fem`, :mod:`.problem`,
+:mod:`.newton`, :mod:`.solver` (incremental settlement) and :mod:`.limit` (the static
+limit LP on the same mesh), and :mod:`.cracks`.
 """
 from __future__ import annotations
 
 import masonryfw as mf
 
-from .options import OPTIONS
-
-__version__ = "0.1.0"
+from .options import INCREMENTAL_OPTIONS, LIMIT_OPTIONS
 
 
 @mf.hookimpl
@@ -19,9 +18,16 @@ def masonryfw_solvers():
         mf.Solver(
             name="jmm",
             summary="continuum FE, Jointed Masonry Model (anisotropic Coulomb + cut-off on bed/head planes): "
-                    "settlement to the reaction plateau, plastic points",
+                    "gravity, then settlement steps (Newton) to the reaction plateau; plastic points",
             solve=mf.lazy("masonryfw_jmm.solver:solve"),
-            version=__version__,
-            options=OPTIONS,
-        )
+            options=INCREMENTAL_OPTIONS,
+        ),
+        mf.Solver(
+            name="jmm-limit",
+            summary="the JMM continuum's collapse state directly: one static (lower-bound) limit LP on the mesh; "
+                    "smallest moving-support reaction, alpha, plastic points",
+            solve=mf.lazy("masonryfw_jmm.limit:solve"),
+            options=LIMIT_OPTIONS,
+            gallery=False,
+        ),
     ]

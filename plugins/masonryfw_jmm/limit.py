@@ -1,11 +1,11 @@
-"""``method=limit``: the collapse state of the JMM continuum as one linear programme on the mesh.
+"""``jmm-limit``: the collapse state of the JMM continuum as one linear programme on the mesh.
 
 The JMM strength domain is the polyhedron ``A s <= b`` (material.py), so the lower-bound
 (static) theorem of limit analysis on a finite-element stress field is a linear programme.
 The formulation is Sloan's (1988) static one, as used by Lyamin and Sloan:
 
-- **stress field**: linear in every triangle of the wall mesh (the corners of the P2 mesh of
-  ``build_problem``), three nodal stress triplets ``[sxx, syy, sxy]`` per triangle,
+- **stress field**: linear in every triangle of the wall mesh (the triangles of
+  :func:`.problem.wall_domain`, the same mesh as the incremental solver's), three nodal stress triplets ``[sxx, syy, sxy]`` per triangle,
   discontinuous between triangles; variable ``9 e + 3 k + c`` is component ``c`` at corner
   ``k`` of triangle ``e``;
 - **equilibrium** with gravity in every triangle (``div s + b = 0`` is constant there: two rows);
@@ -47,12 +47,14 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 import xarray as xr
+from skfem import MeshTri
 
 import masonryfw as mf
 
 from .cracks import crack_indicator
 from .output import mesh_variables, point_variables, variable
-from .problem import Problem, build_problem
+from .material import failure_mode
+from .problem import Domain, wall_domain
 
 ROLE = mf.flags("block_role")
 #: a strength row is plastic when its multiplier per unit volume exceeds this fraction of the largest
@@ -239,21 +241,21 @@ def plastic_rows(duals: np.ndarray, volume: np.ndarray) -> np.ndarray:
     return rate > PLASTIC_DUAL_FRACTION * rate.max(initial=0.0)
 
 
-def support_edges(problem: Problem, field: StaticField) -> tuple[np.ndarray, np.ndarray]:
+def support_edges(domain: Domain, field: StaticField) -> tuple[np.ndarray, np.ndarray]:
     """Boundary edge occurrences on fixed and on moving supports.
 
     An edge is on a support when it is horizontal, at the support block's top and within its
     x range (the same test as the incremental solver's prescribed DOFs).
     """
-    E, H = field.edges, problem.length
-    tol = 1e-6 * problem.mesh_size / H
+    E, H = field.edges, domain.length
+    tol = 1e-6 * domain.mesh_size / H
     occ = E.boundary
     ends = field.triangles[E.local[occ], E.element[occ][:, None]]  # (b, 2) global nodes
     px, py = field.points[0, ends], field.points[1, ends]
     horizontal = np.isclose(py[:, 0], py[:, 1], atol=tol)
     mid_x, mid_y = px.mean(axis=1), py.mean(axis=1)
     fixed, moving = np.zeros(occ.size, bool), np.zeros(occ.size, bool)
-    for x0, x1, y, _, role in problem.mesh.supports:  # a handful of supports
+    for x0, x1, y, _, role in domain.mesh.supports:  # a handful of supports
         on = horizontal & np.isclose(mid_y, y / H, atol=tol) & (mid_x > x0 / H - tol) & (mid_x < x1 / H + tol)
         (fixed if role == ROLE["fixed_support"] else moving)[on] = True
     moving &= ~fixed
@@ -267,9 +269,9 @@ def check_vertical_settlement(model: xr.Dataset) -> None:
     bad = moving[~(np.isclose(direction[:, 0], 0) & np.isclose(direction[:, 2], 0) & (direction[:, 1] < 0))]
     if bad.size:
         raise mf.ModelError(
-            f"jmm method=limit: moving support block {int(bad[0])} has settlement_direction "
+            f"jmm-limit: moving support block {int(bad[0])} has settlement_direction "
             f"{model.settlement_direction.values[bad[0]].tolist()}; the limit LP needs a downward vertical "
-            "translation (0, -1, 0) (use method=incremental for rotations)"
+            "translation (0, -1, 0) (use the solver jmm for rotations)"
         )
 
 
@@ -315,14 +317,16 @@ def settlement_lp(field: StaticField, unit_weight: np.ndarray, strong: np.ndarra
                         A.shape[0])
 
 
-def wall_settlement_lp(problem: Problem, model: xr.Dataset) -> SettlementLP:
-    """The settlement LP of the wall meshed by ``build_problem`` (non-dimensional, see the module docstring)."""
-    mesh, blocks, H = problem.disc.mesh, problem.mesh.block, problem.length
+def wall_settlement_lp(domain: Domain, model: xr.Dataset, A: np.ndarray, b: np.ndarray) -> SettlementLP:
+    """The settlement LP of the wall meshed by :func:`.problem.wall_domain` (non-dimensional, module docstring)."""
+    H = domain.length
+    mesh = MeshTri(domain.mesh.points / H, domain.mesh.triangles)
+    blocks = domain.mesh.block
     field = StaticField(mesh.p, mesh.t, model.block_thickness.values[blocks] / H)
-    unit_weight = model.block_unit_weight.values[blocks] / (problem.stress / H)
-    fixed, moving = support_edges(problem, field)
+    unit_weight = model.block_unit_weight.values[blocks] / domain.unit_weight
+    fixed, moving = support_edges(domain, field)
     strong = np.nonzero(model.block_role.values[blocks] == ROLE["unit"])[0]
-    return settlement_lp(field, unit_weight, strong, problem.return_map.A, problem.return_map.b, fixed, moving)
+    return settlement_lp(field, unit_weight, strong, A, b, fixed, moving)
 
 
 def collapse_points(field: StaticField, stress: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -338,18 +342,19 @@ def collapse_points(field: StaticField, stress: np.ndarray) -> tuple[np.ndarray,
     return xy.transpose(0, 2, 1).reshape(2, -1), at_points.reshape(-1, 3)
 
 
-def limit_dataset(model: xr.Dataset, problem: Problem, lp: SettlementLP, sol: LPSolution, assembly: float) -> xr.Dataset:
-    """FORMAT.md result variables (physical units) of the limit LP."""
-    field, H, S = lp.field, problem.length, problem.stress
+def limit_dataset(model: xr.Dataset, domain: Domain, lp: SettlementLP, sol: LPSolution, names: tuple[str, ...],
+                  assembly: float) -> xr.Dataset:
+    """The result variables (physical units) of the limit LP (docs/format.md)."""
+    field, H, S = lp.field, domain.length, domain.stress
     element = lp.strength_corner // 3
     plastic = plastic_rows(sol.strength_duals, field.area[element] * field.thickness[element] / 3.0)
     active = np.zeros((3 * field.n_el, lp.n_faces), dtype=bool)
     active[lp.strength_corner[plastic], lp.strength_face[plastic]] = True
-    failure = problem.return_map.failure_mode(active)
+    failure = failure_mode(active, names)
     (qx, qy), stress = collapse_points(field, sol.x)
     qx, qy, stress = qx * H, qy * H, stress * S
-    reaction = sol.objective * problem.force
-    dead = lp.dead_reaction * problem.force
+    reaction = sol.objective * domain.force
+    dead = lp.dead_reaction * domain.force
     variables = {
         **mesh_variables(field.points * H, field.triangles),
         **point_variables((qx, qy), failure, stress, "point (midway between a triangle corner and its centroid)",
@@ -358,12 +363,11 @@ def limit_dataset(model: xr.Dataset, problem: Problem, lp: SettlementLP, sol: LP
                                     "alpha = 1 - R_min / (W L_moving / L_contact), lower bound on the mesh"),
         "moving_support_reaction": variable((), reaction, "N",
                                         "smallest upward vertical reaction of the moving support (static LP)"),
-        "crack_indicator": variable("interface", crack_indicator(model, qx, qy, failure > 0, problem.mesh_size / 4), "1",
+        "crack_indicator": variable("interface", crack_indicator(model, qx, qy, failure > 0, domain.mesh_size / 4), "1",
                                 "fraction of the nearest points that are plastic in the collapse mechanism"),
     }
     attrs = {
-        "jmm_method": "limit",
-        "jmm_beta": problem.beta,
+        "jmm_beta": domain.beta,
         "jmm_dead_reaction_n": dead,
         "jmm_lp_variables": int(field.n_var),
         "jmm_lp_equalities": int(lp.equalities.shape[0]),
@@ -377,17 +381,18 @@ def limit_dataset(model: xr.Dataset, problem: Problem, lp: SettlementLP, sol: LP
     return xr.Dataset(variables, attrs=attrs)
 
 
-def solve_limit(model: xr.Dataset, options, progress) -> xr.Dataset:
-    """Smallest moving-support reaction the JMM continuum can carry, on the mesh of ``build_problem``."""
+def solve(model: xr.Dataset, options, progress) -> xr.Dataset:
+    """Smallest moving-support reaction the JMM continuum can carry: the ``jmm-limit`` solver entry point."""
     check_vertical_settlement(model)
     start = time.perf_counter()
     progress(0.0, "meshing and assembling the limit LP")
-    problem = build_problem(model, options)
-    lp = wall_settlement_lp(problem, model)
+    domain = wall_domain(model, options["mesh_size"], options["beta"])
+    A, b, _, names = domain.scaled_strength(options["apex_shift"]).faces()
+    lp = wall_settlement_lp(domain, model, A, b)
     assembly = time.perf_counter() - start
     progress(0.2, f"solving the limit LP: {lp.field.n_var} variables, {lp.equalities.shape[0]} equalities, "
              f"{lp.inequalities.shape[0]} inequalities")
     sol = solve_lp(lp.cost, lp.equalities, lp.rhs, lp.inequalities, lp.bounds)
-    result = limit_dataset(model, problem, lp, sol, assembly)
+    result = limit_dataset(model, domain, lp, sol, names, assembly)
     progress(1.0, f"limit LP {sol.status}: alpha = {float(result.collapse_multiplier):.4f}")
     return result

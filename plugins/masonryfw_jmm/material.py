@@ -190,19 +190,24 @@ class ReturnMap:
         return stress, tangent, active, multipliers
 
     def failure_mode(self, active: np.ndarray) -> np.ndarray:
-        """int8 flags per point: 0 elastic, 1 tensile, 2 shear, 3 tensile_shear.
+        """:func:`failure_mode` of this domain's faces."""
+        return failure_mode(active, self.names)
 
-        On a plane, an active cut-off or both Coulomb faces active (the apex: the joint
-        opens) is tensile; one Coulomb face alone is shear. A point with a tensile plane
-        and a shear plane is tensile_shear.
-        """
-        index = {name: i for i, name in enumerate(self.names)}
-        tensile = np.zeros(active.shape[0], dtype=bool)
-        shear = np.zeros(active.shape[0], dtype=bool)
-        for plane in ("bed", "head"):
-            plus, minus = active[:, index[f"{plane}+"]], active[:, index[f"{plane}-"]]
-            cutoff = active[:, index[f"{plane}_cutoff"]] if f"{plane}_cutoff" in index else np.zeros_like(plus)
-            opening = cutoff | (plus & minus)
-            tensile |= opening
-            shear |= (plus ^ minus) & ~opening
-        return (tensile * FAILURE["tensile"] + shear * FAILURE["shear"]).astype(np.int8)
+
+def failure_mode(active: np.ndarray, names: tuple[str, ...]) -> np.ndarray:
+    """int8 flags per point: 0 elastic, 1 tensile, 2 shear, 3 tensile_shear, from the active faces ``names``.
+
+    On a plane, an active cut-off or both Coulomb faces active (the apex: the joint
+    opens) is tensile; one Coulomb face alone is shear. A point with a tensile plane
+    and a shear plane is tensile_shear.
+    """
+    index = {name: i for i, name in enumerate(names)}
+    tensile = np.zeros(active.shape[0], dtype=bool)
+    shear = np.zeros(active.shape[0], dtype=bool)
+    for plane in ("bed", "head"):
+        plus, minus = active[:, index[f"{plane}+"]], active[:, index[f"{plane}-"]]
+        cutoff = active[:, index[f"{plane}_cutoff"]] if f"{plane}_cutoff" in index else np.zeros_like(plus)
+        opening = cutoff | (plus & minus)
+        tensile |= opening
+        shear |= (plus ^ minus) & ~opening
+    return (tensile * FAILURE["tensile"] + shear * FAILURE["shear"]).astype(np.int8)

@@ -88,22 +88,25 @@ def _joint_mean(model: xr.Dataset, name: str, kind: str, fallback: str | None = 
     return float(model[name].values[chosen].mean())
 
 
-def _block_constant(model: xr.Dataset, name: str, blocks: np.ndarray, option: float, default: float) -> np.ndarray:
-    """Per-block constant: the option if > 0, else the model's variable, else ``default``."""
-    if option > 0:
+def _block_constant(model: xr.Dataset, name: str, blocks: np.ndarray, option: float | None,
+                    default: float) -> np.ndarray:
+    """Per-block constant: the option if given, else the model's variable, else ``default``."""
+    if option is not None:
         return np.full(blocks.size, option)
     if name in model:
         return model[name].values[blocks].astype(float)
     return np.full(blocks.size, default)
 
 
-def strength_from_model(model: xr.Dataset, options) -> tuple[JointStrength, float]:
-    """The JMM strength (physical units) from the bed/head interfaces and the options; and beta."""
+def strength_from_model(model: xr.Dataset, beta: float | None, dilatancy: float | None) -> tuple[JointStrength, float]:
+    """The JMM strength (physical units) from the bed/head interfaces; and beta (auto: eq. 13).
+
+    ``dilatancy``: the dilatancy angle psi [deg] of both planes, None for associated flow.
+    """
     mu_bed = _joint_mean(model, "interface_friction", "bed")
     mu_head = _joint_mean(model, "interface_friction", "head", "bed")
-    beta = options["beta"] if options["beta"] >= 0 else interlocking_beta(model, mu_bed)
-    dilatancy = options["dilatancy"]
-    tan_psi = None if dilatancy < 0 else float(np.tan(np.radians(dilatancy)))
+    beta = beta if beta is not None else interlocking_beta(model, mu_bed)
+    tan_psi = None if dilatancy is None else float(np.tan(np.radians(dilatancy)))
     strength = JointStrength(
         friction_bed=mu_bed, friction_head=mu_head,
         cohesion_bed=_joint_mean(model, "interface_cohesion", "bed"),
@@ -176,8 +179,27 @@ def _elastic_matrices(young: np.ndarray, poisson: np.ndarray, hypothesis: str) -
     return np.stack([elastic_matrix(e, n, hypothesis) for e, n in pairs])[which.ravel()]
 
 
-def build_problem(model: xr.Dataset, options) -> Problem:
-    """Mesh the wall and set up materials, supports and gravity from ``model`` and ``options``."""
+@dataclass(frozen=True)
+class Domain:
+    """What both methods need: the wall meshed, its scales and its joint strength (physical units)."""
+
+    mesh: WallMesh
+    length: float  # H [m]: masonry height
+    mesh_size: float  # [m]
+    stress: float  # S = gamma H [Pa]
+    force: float  # S H^2 [N]
+    unit_weight: float  # gamma [N m-3]: the largest masonry unit weight
+    strength: JointStrength
+    beta: float
+
+    def scaled_strength(self, apex_shift: float) -> JointStrength:
+        """The non-dimensional strength (stresses over S) with the apex regularisation."""
+        return regularised(self.strength.scaled(self.stress), apex_shift)
+
+
+def wall_domain(model: xr.Dataset, mesh_size: float | None, beta: float | None,
+                dilatancy: float | None = None) -> Domain:
+    """Mesh the wall (cells no larger than ``mesh_size``, auto: half the unit height), scale it, read its strength."""
     role = model.block_role.values
     masonry_blocks = np.isin(role, [ROLE["unit"], ROLE["lintel"]])
     box = block_rectangles(model)
@@ -185,37 +207,46 @@ def build_problem(model: xr.Dataset, options) -> Problem:
     H = float(ys.max() - ys.min())
     unit_height = _modal(box[role == ROLE["unit"], 3] - box[role == ROLE["unit"], 1], 1e-6 * H) if (
         role == ROLE["unit"]).any() else H / 10
-    size = options["mesh_size"] if options["mesh_size"] > 0 else unit_height / 2
+    size = mesh_size if mesh_size is not None else unit_height / 2
     mesh = wall_mesh(model, size)
+    gamma_ref = float(model.block_unit_weight.values[mesh.block].max())
+    if not gamma_ref > 0:
+        raise mf.ModelError("jmm: the masonry has no weight (block_unit_weight is 0 everywhere)")
+    strength, beta = strength_from_model(model, beta, dilatancy)
+    S = gamma_ref * H
+    return Domain(mesh, H, size, S, S * H * H, gamma_ref, strength, beta)
+
+
+def build_problem(model: xr.Dataset, options) -> Problem:
+    """Mesh the wall and set up materials, supports and gravity for the incremental method."""
+    domain = wall_domain(model, options["mesh_size"], options["beta"], options["dilatancy"])
+    mesh, H, size, S = domain.mesh, domain.length, domain.mesh_size, domain.stress
+    role = model.block_role.values
     blocks = mesh.block
     nu = _block_constant(model, "block_poisson_ratio", blocks, options["poisson_ratio"], 0.2)
-    if options["shear_modulus"] > 0:
+    if options["shear_modulus"] is not None:
         E = 2.0 * options["shear_modulus"] * (1.0 + nu)
     else:  # the model's E, else the paper's G = 511 MPa
-        E = _block_constant(model, "block_young_modulus", blocks, 0.0, 0.0)
+        E = _block_constant(model, "block_young_modulus", blocks, None, 0.0)
         E = np.where(E > 0, E, 2.0 * 511e6 * (1.0 + nu))
     is_unit = role[blocks] == ROLE["unit"]
     ref = is_unit if is_unit.any() else np.ones_like(is_unit)
     young, poisson = float(E[ref].mean()), float(nu[ref].mean())
     G = young / (2.0 * (1.0 + poisson))
     gamma = model.block_unit_weight.values[blocks].astype(float)
-    gamma_ref = float(gamma.max())
-    if not gamma_ref > 0:
-        raise mf.ModelError("jmm: the masonry has no weight (block_unit_weight is 0 everywhere)")
-    S, U = gamma_ref * H, gamma_ref * H * H / G
+    U = S * H / G
     thickness = model.block_thickness.values[blocks] / H
     disc = Discretisation(MeshTri(mesh.points / H, mesh.triangles), options["element"], thickness)
     D_points = np.repeat(_elastic_matrices(E / G, nu, options["hypothesis"]), disc.nqp, axis=0)
     masonry_points = np.repeat(role[blocks] == ROLE["unit"], disc.nqp)
-    strength, beta = strength_from_model(model, options)
-    rmap = ReturnMap(regularised(strength.scaled(S), options["apex_shift"]),
+    rmap = ReturnMap(domain.scaled_strength(options["apex_shift"]),
                      elastic_matrix(young / G, poisson, options["hypothesis"]))
-    body = np.stack([np.zeros(blocks.size), -gamma / gamma_ref], axis=1)
+    body = np.stack([np.zeros(blocks.size), -gamma / domain.unit_weight], axis=1)
     gravity = disc.body_force(body)
     fixed, moving, direction = _support_dofs(mesh, disc, model, H, 1e-6 * size / H)
     return Problem(
         mesh=mesh, disc=disc, return_map=rmap, masonry_points=masonry_points, D_points=D_points,
         gravity=gravity, fixed=fixed, moving=moving, moving_direction=direction,
-        moving_vertical=moving % 2 == 1, length=H, mesh_size=size, stress=S, displacement=U, force=S * H * H,
-        beta=beta, young=young, poisson=poisson, strength=strength,
+        moving_vertical=moving % 2 == 1, length=H, mesh_size=size, stress=S, displacement=U, force=domain.force,
+        beta=domain.beta, young=young, poisson=poisson, strength=domain.strength,
     )

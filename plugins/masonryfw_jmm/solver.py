@@ -79,23 +79,24 @@ def run(problem: Problem, options, progress) -> tuple[State, History, dict]:
     kappa = options["vertex_stiffness"], options["settled_stiffness"]
     newton = NewtonSolver(problem, options["tolerance"], options["max_iterations"], regularisation=kappa)
     history = History()
-    info = {"jmm_interrupted": 0, "jmm_stop_reason": ""}
+    info = {"interrupted": 0, "stop_reason": ""}
     state = State.initial(problem)
     try:
         progress(0.0, "gravity")
         state, failure = _gravity_stage(newton, state, history)
         if failure:
-            info["jmm_stop_reason"] = failure
+            info["stop_reason"] = failure
             return state, history, info
         unloading, slope = elastic_unloading_settlement(newton, state)
         info["jmm_elastic_unloading_settlement_m"] = unloading * problem.displacement
-        limit = options["max_settlement"] / problem.displacement if options["max_settlement"] > 0 else 30 * unloading
+        limit = (options["max_settlement"] / problem.displacement if options["max_settlement"] is not None
+                 else 30 * unloading)
         increment, settlement = options["first_increment"] * unloading, 0.0
         largest = options["max_increment"] * unloading
         last_increment = None  # (du, ds) of the last converged step, extrapolated as a second predictor
         while True:
             if len(history.settlement) - 1 >= options["max_steps"]:
-                info["jmm_stop_reason"] = f"max_steps ({options['max_steps']}) reached"
+                info["stop_reason"] = f"max_steps ({options['max_steps']}) reached"
                 break
             target = min(settlement + increment, limit)
             guess = None
@@ -106,7 +107,7 @@ def run(problem: Problem, options, progress) -> tuple[State, History, dict]:
             if not report.converged:
                 increment /= 2
                 if increment < MIN_INCREMENT * unloading:
-                    info["jmm_stop_reason"] = f"no convergence at settlement {target * problem.displacement:.4g} m"
+                    info["stop_reason"] = f"no convergence at settlement {target * problem.displacement:.4g} m"
                     break
                 continue
             last_increment = (trial.u - state.u, target - settlement)
@@ -120,18 +121,18 @@ def run(problem: Problem, options, progress) -> tuple[State, History, dict]:
                      f"{settlement * problem.displacement:.3g} m, reaction {history.reaction[-1] * problem.force:.4g} N, "
                      f"{report.iterations} Newton iterations")
             if _plateau(history, slope, options):
-                info["jmm_stop_reason"] = "reaction plateau"
+                info["stop_reason"] = "reaction plateau"
                 break
             if settlement >= limit:
-                info["jmm_stop_reason"] = "max_settlement reached"
+                info["stop_reason"] = "max_settlement reached"
                 break
             if report.iterations <= options["target_iterations"]:
                 increment = min(1.5 * increment, largest)
             elif report.iterations > 2 * options["target_iterations"]:
                 increment *= 0.5
     except KeyboardInterrupt:
-        info["jmm_interrupted"] = 1
-        info["jmm_stop_reason"] = "interrupted"
+        info["interrupted"] = 1
+        info["stop_reason"] = "interrupted"
     return state, history, info
 
 
@@ -173,30 +174,11 @@ def result_dataset(model: xr.Dataset, problem: Problem, state: State, history: H
     return xr.Dataset(variables, attrs=attrs)
 
 
-NON_NEGATIVE = ("mesh_size", "shear_modulus", "poisson_ratio", "vertex_stiffness", "settled_stiffness",
-                "apex_shift", "max_settlement")
-POSITIVE = ("tolerance", "max_iterations", "first_increment", "max_increment", "max_steps", "plateau_slope",
-            "plateau_steps", "target_iterations")
-
-
-def check_options(options) -> None:
-    """Raise PluginError naming the first option out of range."""
-    for name in NON_NEGATIVE:
-        if not options[name] >= 0:
-            raise mf.PluginError(f"solver 'jmm': option {name!r} must be >= 0, got {options[name]}")
-    for name in POSITIVE:
-        if not options[name] > 0:
-            raise mf.PluginError(f"solver 'jmm': option {name!r} must be > 0, got {options[name]}")
-
-
 def solve(model: xr.Dataset, options, progress) -> xr.Dataset:
-    """Solve ``model`` with the Jointed Masonry Model: the ``jmm`` solver entry point."""
-    check_options(options)
-    if options["method"] == "limit":
-        from .limit import solve_limit
-
-        return solve_limit(model, options, progress)
+    """Solve ``model`` with the Jointed Masonry Model, settlement step by step: the ``jmm`` solver entry point."""
     problem = build_problem(model, options)
     state, history, info = run(problem, options, progress)
-    progress(1.0, info["jmm_stop_reason"])
+    if info["interrupted"] and len(history.settlement) == 0:
+        raise KeyboardInterrupt  # interrupted before the gravity stage converged: nothing to keep
+    progress(1.0, info["stop_reason"])
     return result_dataset(model, problem, state, history, info, problem.mesh_size)

@@ -1,15 +1,13 @@
 """``la``: rigid-block limit analysis of dry-joint walls under settlements (paper section 2.1).
 
-Registration only; the method lives in :mod:`.assembly`, :mod:`.backends`,
-:mod:`.postprocess` and :mod:`.solver`.
+Registration only (the solve is imported on first use); the method lives in
+:mod:`.assembly`, :mod:`.backends`, :mod:`.ipm`, :mod:`.postprocess` and :mod:`.solver`.
 """
 from __future__ import annotations
 
 import masonryfw as mf
 
-from .solver import OPTIONS, solve
-
-__version__ = "0.1.0"
+from .options import OPTIONS, VARIANTS
 
 
 @mf.hookimpl
@@ -18,8 +16,8 @@ def masonryfw_solvers():
         mf.Solver(
             name="la",
             summary="limit analysis: rigid blocks, no-tension dilatant Coulomb joints; alpha, mechanism, contact forces",
-            solve=solve,
-            version=__version__,
+            solve=mf.lazy("masonryfw_la.solver:solve"),
             options=OPTIONS,
+            variants=VARIANTS,
         )
     ]

@@ -37,7 +37,6 @@ import xarray as xr
 import masonryfw as mf
 
 ROLE = mf.flags("block_role")
-SUPPORT_ROLES = (ROLE["fixed_support"], ROLE["moving_support"])
 
 
 @dataclass(frozen=True)
@@ -72,8 +71,8 @@ class Wall:
             role=v["block_role"],
             fixed=v["block_fixed"] != 0,
             direction=v["settlement_direction"].astype(float),
-            dead=v["dead_load"].astype(float),
-            live=v["live_load"].astype(float),
+            dead=mf.block_loads(model, "dead"),
+            live=mf.block_loads(model, "live"),
             thickness=v["block_thickness"].astype(float),
             area=v["block_area"],
             centroid=np.c_[v["block_centroid_x"], v["block_centroid_y"]],
@@ -101,7 +100,7 @@ class Wall:
     @property
     def support(self) -> np.ndarray:
         """Blocks that are supports (ground)."""
-        return np.isin(self.role, SUPPORT_ROLES)
+        return mf.support_blocks(self.role)
 
     @property
     def moving(self) -> np.ndarray:
@@ -165,16 +164,15 @@ class KinematicLP:
         return self.column_map.shape[1]
 
 
-def model_scales(wall: Wall) -> Scales:
-    """Model scale, typical block size and total dead load (the live load's when there is no dead load)."""
-    length = mf.model_scale(wall.node_x, wall.node_y)
-    areas = np.abs(wall.area[~wall.support])
-    block = float(np.sqrt(np.median(areas))) if areas.size and np.median(areas) > 0 else length
+def model_scales(model: xr.Dataset, wall: Wall) -> Scales:
+    """The model's scales (:func:`masonryfw.model_scales`), the force being the total dead load
+    (the live load's when there is no dead load): the dual forces are then of order one."""
+    scales = mf.model_scales(model)
     for loads in (wall.dead, wall.live):
         force = float(np.hypot(loads[:, 0], loads[:, 1]).sum())
         if force > 0:
-            return Scales(length, block, force)
-    return Scales(length, block, 1.0)
+            return Scales(scales.length, scales.block, force)
+    return Scales(scales.length, scales.block, 1.0)
 
 
 def nondimensional_loads(loads: np.ndarray, scales: Scales) -> np.ndarray:

@@ -31,7 +31,6 @@ import scipy.sparse as sp
 
 import masonryfw as mf
 
-BACKENDS = ("highs", "ipm", "clarabel", "osqp")  # highs first: the exact vertex, the gallery's reference
 OSQP_REGULARISATION = 1e-3
 OSQP_FIRST_STEP_TOLERANCE = 1e-5
 OSQP_MAX_PROXIMAL_STEPS = 100

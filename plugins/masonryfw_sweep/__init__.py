@@ -14,19 +14,25 @@ From Python::
 """
 from __future__ import annotations
 
+import importlib
+
 import masonryfw as mf
 
-from .archive import verify_archive, write_archive
 from .commands import COMMANDS
-from .params import Param, parse_param
-from .store import Store, content_key
-from .sweep import SweepPlan, combine, dask_client, failed_points, plan_sweep, run_sweep
 
-__version__ = mf.__version__
-__all__ = [
-    "Param", "Store", "SweepPlan", "combine", "content_key", "dask_client", "failed_points", "parse_param",
-    "plan_sweep", "run_sweep", "verify_archive", "write_archive",
-]
+#: The Python API, imported on first access (PEP 562): registering the plugin stays cheap.
+_PUBLIC = {
+    "Param": "params", "parse_param": "params", "Store": "store", "content_key": "store",
+    "SweepPlan": "sweep", "combine": "sweep", "dask_client": "sweep", "failed_points": "sweep",
+    "plan_sweep": "sweep", "run_sweep": "sweep", "verify_archive": "archive", "write_archive": "archive",
+}
+__all__ = sorted(_PUBLIC)
+
+
+def __getattr__(name: str):
+    if name in _PUBLIC:
+        return getattr(importlib.import_module(f".{_PUBLIC[name]}", __name__), name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 @mf.hookimpl

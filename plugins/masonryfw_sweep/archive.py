@@ -124,6 +124,8 @@ def write_archive(target: str | os.PathLike, sweep_file: str | os.PathLike, comm
     target = Path(target).resolve()
     if target.exists() and (not target.is_dir() or any(target.iterdir())):
         raise mf.ModelError(f"{target}: exists and is not an empty folder; archive into a new folder")
+    if not target.exists():
+        mf.check_output_path(target)  # its folder exists and is writable
     sweep = mf.open_dataset(sweep_file)
     if sweep.attrs.get("masonryfw_format") != "sweep":
         raise mf.ModelError(f"{sweep_file}: not a sweep dataset (masonryfw_format is "

@@ -10,9 +10,6 @@ import click
 
 import masonryfw as mf
 
-from .archive import verify_archive, write_archive
-from .sweep import dask_client, failed_points, plan_sweep, run_sweep
-
 #: At most this many failed points are listed on the terminal (all are in the output file).
 LISTED_FAILURES = 10
 
@@ -64,13 +61,16 @@ def sweep_command(spec: str, solver: str, params: tuple[str, ...], zipped: bool,
     Writes one dataset with the swept keys as dimensions, and every point's
     result to a content-addressed store; a re-run reuses what the store holds.
     """
+    from .sweep import dask_client, failed_points, plan_sweep, run_sweep
+
     if scheduler and workers:
         raise click.UsageError("--workers sizes the local cluster; it cannot be used with --scheduler")
     plan = plan_sweep(spec, solver, params, mf.parse_option_pairs(options), zipped)
     out = Path(output) if output else _default_output(spec, solver)
-    if not out.resolve().parent.is_dir():
-        raise mf.ModelError(f"{out}: cannot write: directory {out.resolve().parent} does not exist")
+    mf.check_output_path(out, [spec] if Path(spec).is_file() else [])
     store_dir = Path(store) if store else out.with_name(out.name.removesuffix(".nc") + ".store")
+    if not store_dir.is_dir():
+        mf.check_output_path(store_dir)  # its folder exists and is writable: the store is made in it
     command = _command_line()
     with dask_client(scheduler, workers) as client, _progress(len(plan.points), not no_progress) as on_point:
         sweep = run_sweep(plan, client, store_dir, out.resolve().parent, on_point, command)
@@ -85,6 +85,8 @@ def sweep_command(spec: str, solver: str, params: tuple[str, ...], zipped: bool,
         click.echo(f"  ... and {len(failures) - LISTED_FAILURES} more (see status/message in {out})", err=True)
     click.echo(f"result: {out}")
     click.echo(f"store: {store_dir}")
+    if failures:
+        click.get_current_context().exit(1)
 
 
 @click.command("archive")
@@ -100,6 +102,8 @@ def archive_command(directory: str, sweep_file: str | None, verify: bool) -> Non
     every checksum and that every file reopens; it exits with 1 and lists every
     mismatch.
     """
+    from .archive import verify_archive, write_archive
+
     if verify == bool(sweep_file):
         raise click.UsageError("give either --from SWEEP.nc (to write an archive) or --verify (to check one)")
     if verify:

@@ -12,8 +12,8 @@ text itself (``highs``).
 from __future__ import annotations
 
 import copy
+import difflib
 import itertools
-import json
 import math
 import re
 from dataclasses import dataclass, replace
@@ -202,9 +202,23 @@ def check_spec_params(spec: Mapping, params: Sequence[Param]) -> None:
                 continue
             break
         else:
-            created = re.compile(rf"'{re.escape(_dotted(_first_new(spec, param.path)))}['.]")
+            new = _first_new(spec, param.path)
+            created = re.compile(rf"'{re.escape(_dotted(new))}['.]")
             if all(created.search(str(error)) for error in errors):
-                raise mf.SpecError(f"--param {param.key}: {errors[0]}")
+                raise mf.SpecError(f"--param {param.key}: {_misspelt(spec, new) or errors[0]}")
+
+
+def _misspelt(spec: Mapping, new: KeyPath) -> str:
+    """``unknown key 'supports.settlng' (did you mean 'supports.settling'?)`` when the new key is close to
+    an existing one beside it; else empty."""
+    parent: Any = spec
+    for segment in new[:-1]:
+        parent = parent[segment]
+    siblings = [str(k) for k in parent] if isinstance(parent, dict) else []
+    guess = difflib.get_close_matches(str(new[-1]), siblings, n=1)
+    if not guess:
+        return ""
+    return f"unknown key {_dotted(new)!r} (did you mean {_dotted((*new[:-1], guess[0]))!r}?)"
 
 
 def _first_new(spec: Mapping, path: KeyPath) -> KeyPath:
@@ -223,29 +237,12 @@ def resolve_option_params(solver: mf.Solver, params: Sequence[Param]) -> list[Pa
         if param.is_option:
             option = declared.get(param.option_name)
             if option is None:
-                valid = ", ".join(sorted(declared)) or "(none)"
-                raise mf.PluginError(
-                    f"--param {param.key}: solver {solver.name!r} has no option {param.option_name!r}; "
-                    f"valid options: {valid}"
-                )
-            param = replace(param, values=tuple(option.parse(v) for v in param.values))
+                raise mf.PluginError(f"--param {param.key}: solver {solver.name!r}: "
+                                     + mf.unknown_name_message("option", param.option_name, list(declared)))
+            owner = f"--param {param.key}: solver {solver.name!r}"
+            param = replace(param, values=tuple(option.parse(v, owner) for v in param.values))
         out.append(param)
     return out
-
-
-def resolve_options(solver: mf.Solver, given: Mapping[str, Any]) -> dict[str, Any]:
-    """The solver's defaults overlaid by ``given`` (parsed); an unknown name raises listing the valid ones."""
-    declared = {o.name: o for o in solver.options}
-    unknown = sorted(set(given) - set(declared))
-    if unknown:
-        valid = ", ".join(sorted(declared)) or "(none)"
-        raise mf.PluginError(f"solver {solver.name!r}: unknown option(s) {', '.join(unknown)}; valid options: {valid}")
-    return {name: (declared[name].parse(given[name]) if name in given else o.default) for name, o in declared.items()}
-
-
-def options_json(options: Mapping[str, Any]) -> str:
-    """The options as ``masonryfw.solve`` records them (``solver_options``)."""
-    return json.dumps(dict(options), sort_keys=True, default=str)
 
 
 # --------------------------------------------------------------------------- points

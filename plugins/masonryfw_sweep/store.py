@@ -5,8 +5,10 @@ Layout (every file written atomically: a temporary file renamed into place)::
     <store>/results/<key>.nc            a result (it holds its model, and the spec text in ``source_spec``)
     <store>/results/<key>.json          its record, written last: the commit mark
 
-``key = sha256(model content hash, solver name, solver version, resolved options)``
-(:func:`content_key`). A result counts only when its record exists and
+``key = sha256(model content hash, solver name, solver version, core version,
+resolved options)`` (:func:`content_key`). Both versions carry a digest of the
+code (the solver's package, the core that derives the comparable fields), so a
+changed solver never gets an older result from the store. A result counts only when its record exists and
 :meth:`Store.load_verified` re-derives the key from the record, matches the
 result file's SHA-256 against the record and reopens the result, whose
 provenance attributes must match too. A result file without its record (a
@@ -27,18 +29,18 @@ import xarray as xr
 
 import masonryfw as mf
 
-from .params import options_json
-
 RESULTS = "results"
 
 
-def content_key(model_sha256: str, solver: str, solver_version: str, options: Mapping[str, Any]) -> str:
-    """Hex SHA-256 naming a result: same model content, solver, version and options -> same key."""
+def content_key(model_sha256: str, solver: str, solver_version: str, core_version: str,
+                options: Mapping[str, Any]) -> str:
+    """Hex SHA-256 naming a result: same model content, solver, versions and options -> same key."""
     identity = {
         "model_sha256": model_sha256,
         "solver": solver,
         "solver_version": solver_version,
-        "solver_options": json.loads(options_json(options)),
+        "core_version": core_version,
+        "solver_options": json.loads(mf.options_json(options)),
     }
     return hashlib.sha256(json.dumps(identity, sort_keys=True).encode("utf-8")).hexdigest()
 
@@ -87,7 +89,7 @@ class Store:
             return None
         try:
             derived = content_key(record["model_sha256"], record["solver"], record["solver_version"],
-                                  record["solver_options"])
+                                  record["core_version"], record["solver_options"])
         except (KeyError, TypeError):
             return None
         path = self.result_path(key)
@@ -102,7 +104,8 @@ class Store:
             attrs.get("model_sha256") == record["model_sha256"]
             and attrs.get("solver") == record["solver"]
             and str(attrs.get("solver_version")) == str(record["solver_version"])
-            and attrs.get("solver_options") == options_json(record["solver_options"])
+            and str(attrs.get("core_version")) == str(record["core_version"])
+            and attrs.get("solver_options") == mf.options_json(record["solver_options"])
         )
         return result if consistent else None
 
@@ -115,6 +118,7 @@ class Store:
             "model_sha256": model_sha256,
             "solver": result.attrs["solver"],
             "solver_version": str(result.attrs["solver_version"]),
+            "core_version": str(result.attrs["core_version"]),
             "solver_options": json.loads(result.attrs["solver_options"]),
             "plugin": result.attrs.get("plugin", ""),
             "plugin_version": str(result.attrs.get("plugin_version", "")),

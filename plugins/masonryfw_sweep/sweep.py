@@ -29,17 +29,14 @@ from .params import (
     Param,
     check_names,
     check_spec_params,
-    options_json,
     parse_param,
     point_assignments,
     point_indices,
     resolve_option_params,
-    resolve_options,
 )
 from .tasks import STATUS, run_point, status_of, failure_message
 
 ZIP_DIM = "point"
-SWEEP_FORMAT_VERSION = 1
 _RESERVED = {"status", "message", "key", "result_path", "from_store", "task_time_s", ZIP_DIM}
 
 
@@ -102,8 +99,8 @@ def plan_sweep(
         spec=spec_dict,
         spec_text=text,
         solver=solver_record.name,
-        solver_version=str(solver_record.version),
-        options=resolve_options(solver_record, dict(options or {})),
+        solver_version=mf.solver_version(solver_record.name),
+        options=mf.resolve_options(f"solver {solver_record.name!r}", solver_record.options, dict(options or {})),
         params=tuple(parsed),
         zipped=zipped,
         shape=shape,
@@ -250,11 +247,11 @@ def combine(plan: SweepPlan, records: Sequence[dict], output_dir: Path, store_ro
     attrs = {
         "Conventions": "CF-1.11",
         "masonryfw_format": "sweep",
-        "masonryfw_format_version": SWEEP_FORMAT_VERSION,
+        "masonryfw_format_version": mf.FORMAT_VERSION,
         "title": f"sweep of {plan.spec.get('title', '')}".strip(),
         "solver": plan.solver,
         "solver_version": plan.solver_version,
-        "solver_options": options_json(plan.options),
+        "solver_options": mf.options_json(plan.options),
         "sweep_mode": "zip" if plan.zipped else "grid",
         "sweep_keys": " ".join(p.key for p in plan.params),
         "sweep_store": store_root,

@@ -10,7 +10,6 @@ from __future__ import annotations
 import time
 from typing import Any, Mapping, Sequence
 
-import numpy as np
 import xarray as xr
 
 import masonryfw as mf
@@ -27,7 +26,6 @@ _STATUS_OF_ERROR = (
     (mf.PluginError, "plugin_error"),
 )
 
-MACRO_BLOCK_COUNT = "macro_block_count"
 WALL_TIME = "wall_time_s"
 
 
@@ -41,26 +39,9 @@ def failure_message(exc: BaseException) -> str:
     return str(exc) if isinstance(exc, mf.MasonryError) else f"{type(exc).__name__}: {exc}"
 
 
-def scalar_outputs(result: xr.Dataset, model: xr.Dataset) -> dict[str, tuple[Any, dict]]:
-    """``{name: (value, attrs)}`` of a result's scalar outputs.
-
-    Every 0-d variable the solver added, the number of macro-blocks (distinct
-    ``macro_block`` labels, when the solver gives them) and the solve's wall time.
-    Numbers become floats; text stays text.
-    """
-    out = {}
-    for name in result.data_vars:
-        variable = result[name]
-        if variable.ndim == 0 and name not in model.variables:
-            value = variable.values.item()
-            value = value if isinstance(value, str) else float(value)
-            out[str(name)] = (value, {k: variable.attrs[k] for k in ("units", "long_name") if k in variable.attrs})
-    if "macro_block" in result.data_vars:
-        labels = np.asarray(result.macro_block.values)
-        out[MACRO_BLOCK_COUNT] = (
-            float(np.unique(labels[labels >= 0]).size),
-            {"units": "1", "long_name": "number of macro-blocks (distinct macro_block labels)"},
-        )
+def scalar_outputs(result: xr.Dataset) -> dict[str, tuple[Any, dict]]:
+    """``{name: (value, attrs)}``: the result's key numbers (:func:`masonryfw.key_numbers`) and the wall time."""
+    out = {n.name: (n.value, {"units": n.units, "long_name": n.long_name}) for n in mf.key_numbers(result)}
     out[WALL_TIME] = (float(result.attrs[WALL_TIME]), {"units": "s", "long_name": "wall time of the solve"})
     return out
 
@@ -95,15 +76,15 @@ def _solve_point(record: dict, base_spec, assignments, solver_name, options, sto
     """Fill ``record`` (see :func:`run_point`) for one point; failures become its status and message."""
     try:
         model = mf.build(with_values(base_spec, assignments))
-        solver = mf.get_solver(solver_name)
         model_sha256 = model_hash(model)
-        key = content_key(model_sha256, solver.name, solver.version, options)
+        key = content_key(model_sha256, solver_name, mf.solver_version(solver_name), mf.core_version(),
+                          options)
         store = Store(store_root)
         result = store.load_verified(key)
         record["reused"] = result is not None
         if result is None:
-            result = mf.solve(model, solver.name, options)
+            result = mf.solve(model, solver_name, options)
             store.put(key, model_sha256, result, provenance)
-        record.update(key=key, result=str(store.result_path(key)), scalars=scalar_outputs(result, model))
+        record.update(key=key, result=str(store.result_path(key)), scalars=scalar_outputs(result))
     except Exception as exc:  # recorded, never raised: see the module docstring
         record.update(status=status_of(exc), message=failure_message(exc))

@@ -80,8 +80,10 @@ def hand_model() -> xr.Dataset:
             "interface_friction": _var("interface_friction", "interface", np.full(n_if, 0.4)),
             "interface_cohesion": _var("interface_cohesion", "interface", np.zeros(n_if)),
             "interface_tensile_strength": _var("interface_tensile_strength", "interface", np.zeros(n_if)),
-            "dead_load": _var("dead_load", ("block", "dof"), dead),
-            "live_load": _var("live_load", ("block", "dof"), live),
+            "dead_load": _var("dead_load", ("block", "axis"), dead[:, :2]),
+            "dead_moment": _var("dead_moment", "block", dead[:, 2]),
+            "live_load": _var("live_load", ("block", "axis"), live[:, :2]),
+            "live_moment": _var("live_moment", "block", live[:, 2]),
             "block_fixed": _var("block_fixed", ("block", "dof"), fixed),
             "settlement_direction": _var("settlement_direction", ("block", "dof"), direction),
             "block_geometry": ((), np.int32(0), mf.variable_attrs("block_geometry")),
@@ -90,7 +92,7 @@ def hand_model() -> xr.Dataset:
         attrs={
             "Conventions": "CF-1.11",
             "masonryfw_format": "model",
-            "masonryfw_format_version": 1,
+            "masonryfw_format_version": 2,
             "title": "Hand wall",
         },
     )

@@ -59,7 +59,7 @@ def _drop_interfaces_of_block2(ds):
 
 
 def _transpose_dead_load(ds):
-    ds["dead_load"] = (("dof", "block"), ds.dead_load.values.T, ds.dead_load.attrs)
+    ds["dead_load"] = (("axis", "block"), ds.dead_load.values.T, ds.dead_load.attrs)
     return ds
 
 

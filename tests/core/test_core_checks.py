@@ -1,6 +1,6 @@
 """Validation: a hand-written valid model gives no problem; each way of breaking it gives its problem.
 
-The model is written here with plain xarray from FORMAT.md (no masonryfw writer)::
+The model is written here with plain xarray from docs/format.md (no masonryfw writer)::
 
     y 0.5 +---------+---------+
           | unit 0  | unit 1  |
@@ -38,7 +38,7 @@ def rectangle(x0, x1, y0, y1):
 
 
 def model_dataset(polygons=None, roles=None, interfaces=None, live_value=-1000.0):
-    """A FORMAT.md model with plain xarray: blocks, interfaces, loads and supports as given."""
+    """A docs/format.md model with plain xarray: blocks, interfaces, loads and supports as given."""
     polygons = polygons or [rectangle(*b) for b in BOXES]
     roles = np.array(roles or ROLES, dtype=np.int8)
     interfaces = interfaces or INTERFACES
@@ -77,13 +77,15 @@ def model_dataset(polygons=None, roles=None, interfaces=None, live_value=-1000.0
             "interface_friction": var("interface", np.full(ni, 0.6), "1", "mu"),
             "interface_cohesion": var("interface", np.zeros(ni), "Pa", "cohesion"),
             "interface_tensile_strength": var("interface", np.zeros(ni), "Pa", "tensile strength"),
-            "dead_load": var(("block", "dof"), dead, "N, N, N m", "dead load"),
-            "live_load": var(("block", "dof"), live, "N, N, N m", "live load"),
+            "dead_load": var(("block", "axis"), dead[:, :2], "N", "dead load"),
+            "dead_moment": var("block", dead[:, 2], "N m", "dead moment"),
+            "live_load": var(("block", "axis"), live[:, :2], "N", "live load"),
+            "live_moment": var("block", live[:, 2], "N m", "live moment"),
             "block_fixed": var(("block", "dof"), fixed, "1", "held"),
             "settlement_direction": var(("block", "dof"), direction, "1", "settlement"),
         },
         coords={"dof": ("dof", ["ux", "uy", "rz"], {"units": "1", "long_name": "dof"})},
-        attrs={"Conventions": "CF-1.11", "masonryfw_format": "model", "masonryfw_format_version": 1,
+        attrs={"Conventions": "CF-1.11", "masonryfw_format": "model", "masonryfw_format_version": 2,
                "title": "two units on two supports"},
     )
 
@@ -91,6 +93,7 @@ def model_dataset(polygons=None, roles=None, interfaces=None, live_value=-1000.0
 def result_dataset(**changes):
     ds = model_dataset()
     ds.attrs.update(masonryfw_format="result", plugin="la", plugin_version="0.1", solver="clarabel",
+                    solver_version="0.1+0123456789ab", core_version="0.1+0123456789ab",
                     solver_options='{"tolerance": 1e-9}', wall_time_s=0.01)
     ds["collapse_multiplier"] = ((), 0.42, {"units": "1", "long_name": "alpha"})
     ds["crack_indicator"] = ("interface", np.array([1.0, 0.0, 0.5]), {"units": "1", "long_name": "crack"})
@@ -149,14 +152,14 @@ def test_wrong_conventions():
     assert "'CF-1.11'" in the_only(check(ds), "attribute Conventions").message
 
 
-@pytest.mark.parametrize("version", [2, np.int32(2), "2"])
+@pytest.mark.parametrize("version", [3, np.int32(3), "3"])
 def test_unknown_format_version_is_one_clear_problem(version):
     ds = model_dataset()
     ds.attrs["masonryfw_format_version"] = version
     problems = check(ds)
     assert len(problems) == 1
     assert problems[0].where == "attribute masonryfw_format_version"
-    assert "unknown format version 2" in problems[0].message or "unknown format version '2'" in problems[0].message
+    assert "unknown format version 3" in problems[0].message or "unknown format version '3'" in problems[0].message
 
 
 def test_unknown_dataset_kind():
@@ -221,8 +224,10 @@ def test_zero_thickness_and_negative_unit_weight():
 
 def test_infinite_load_names_the_component():
     ds = model_dataset()
-    ds["dead_load"].values[0, 2] = np.inf
-    assert "dead_load[rz] = inf is not finite" in the_only(check(ds), "block 0").message
+    ds["dead_load"].values[0, 1] = np.inf
+    ds["dead_moment"].values[1] = -np.inf
+    assert "dead_load[y] = inf is not finite" in the_only(check(ds), "block 0").message
+    assert "dead_moment = -inf is not finite" in the_only(check(ds), "block 1").message
 
 
 def test_invalid_flag():
@@ -434,13 +439,13 @@ def test_result_attributes_and_variables():
     del ds.attrs["plugin"]
     ds["crack_indicator"].values[1] = 1.5
     ds["interface_state"].values[2] = 9
-    ds["block_displacement"] = (("block", "dof"), np.full((4, 3), np.nan), {"units": "m, m, rad", "long_name": "u"})
+    ds["block_displacement"] = (("block", "axis"), np.full((4, 2), np.nan), {"units": "m", "long_name": "u"})
     problems = check(ds)
     assert "missing" in the_only(problems, "attribute plugin").message
     assert "not valid JSON" in the_only(problems, "attribute solver_options").message
     assert "crack_indicator = 1.5 is above the maximum 1" in the_only(problems, "interface 1").message
     assert "interface_state = 9 is not a valid flag" in the_only(problems, "interface 2").message
-    assert sum("block_displacement" in p.message for p in problems) == 12
+    assert sum("block_displacement" in p.message for p in problems) == 8
 
 
 def test_result_variable_with_wrong_dims():

@@ -119,9 +119,9 @@ def test_plugins_lists_the_builtin_solver(tools):
     run = invoke("plugins")
     assert run.exit_code == 0, run.output
     assert f"example (masonryfw {mf.__version__})" in run.stdout
-    assert "  solver statics 1.0:" in run.stdout
+    assert "  solver statics: load resultants" in run.stdout
     assert "tools (registered in-process)" in run.stdout
-    assert "--option alpha=<float>  (default 0.5)" in run.stdout
+    assert "--option alpha=<float> (default 0.5)" in run.stdout
 
 
 def test_compare_and_plot_through_the_command_line(tools, model_file, in_tmp):
@@ -174,8 +174,10 @@ def test_failing_commands_leave_the_input_unchanged(tools, model_file, in_tmp):
         (["solve", model_file, "--plugin", "statics", "-o", model_file], "refusing to overwrite"),
         (["solve", model_file, "--plugin", "statics", "-o", in_tmp / ".." / in_tmp.name / model_file.name], "refusing"),
         (["solve", model_file, "--plugin", "nope"], "unknown solver 'nope'"),
-        (["solve", model_file, "--plugin", "constant", "--option", "alpha=x"], "cannot read 'x' as float"),
-        (["compare", model_file, model_file, "--comparator", "alpha-gap", "-o", model_file], "result A"),
+        (["solve", model_file, "--plugin", "constant", "--option", "alpha=x"], "option 'alpha' = 'x': not a float"),
+        (["compare", model_file, model_file, "--comparator", "alpha-gap", "-o", model_file], "refusing to overwrite"),
+        (["compare", model_file, model_file, "--comparator", "alpha-gap"], "result A"),
+        (["plot", model_file, "--kind", "nodes", "-o", model_file], "unknown file type '.nc'"),
         (["info", in_tmp / "missing.nc"], "missing.nc"),
     ]
     for args, message in failing:
@@ -184,7 +186,6 @@ def test_failing_commands_leave_the_input_unchanged(tools, model_file, in_tmp):
         assert run.stderr.startswith("error: ") and message in run.stderr, (args, run.stderr)
         assert "Traceback" not in run.output
         assert sha256(model_file) == before, args
-    assert invoke("plot", model_file, "--kind", "nodes", "-o", model_file).exit_code == 2  # .nc is no image type
     assert sha256(model_file) == before
 
 

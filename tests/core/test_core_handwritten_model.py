@@ -1,7 +1,8 @@
-"""A model written by hand from FORMAT.md alone, with plain xarray, loads and round-trips.
+"""A model written by hand from docs/format.md alone, with plain xarray, loads and round-trips.
 
 The file is built without any masonryfw writer: if it loads, a third-party tool
-following FORMAT.md can produce models. Expected areas, centroids, lengths and
+following docs/format.md can produce models; the same wall written in format
+version 1 reads as the same model. Expected areas, centroids, lengths and
 normals are hand values (rectangle and trapezoid formulas).
 
     y
@@ -57,8 +58,22 @@ def _weights() -> np.ndarray:
     return np.array(AREA) * THICKNESS * np.array([UNIT_WEIGHT] * 3 + [0.0, 0.0])
 
 
-def hand_model() -> xr.Dataset:
-    """The wall above as FORMAT.md describes a model, in plain xarray."""
+def loads(dead, live) -> dict:
+    """Version 2: forces over ``axis`` [N], moments apart [N m]."""
+    return {"dead_load": (("block", "axis"), dead[:, :2], {"units": "N", "long_name": "dead load"}),
+            "dead_moment": ("block", dead[:, 2], {"units": "N m", "long_name": "dead moment"}),
+            "live_load": (("block", "axis"), live[:, :2], {"units": "N", "long_name": "live load"}),
+            "live_moment": ("block", live[:, 2], {"units": "N m", "long_name": "live moment"})}
+
+
+def loads_version_1(dead, live) -> dict:
+    """Version 1: one variable over ``dof`` with per-component units (not CF)."""
+    return {"dead_load": (("block", "dof"), dead, {"units": "N, N, N m", "long_name": "dead load"}),
+            "live_load": (("block", "dof"), live, {"units": "N, N, N m", "long_name": "live load"})}
+
+
+def hand_model(version: int = 2) -> xr.Dataset:
+    """The wall above as docs/format.md describes a model, in plain xarray (``version`` 1: the old load layout)."""
     x = np.array([p[0] for poly in POLYGONS for p in poly])
     y = np.array([p[1] for poly in POLYGONS for p in poly])
     weight = _weights()
@@ -102,8 +117,7 @@ def hand_model() -> xr.Dataset:
             "interface_friction": var("interface", np.full(nint, 0.6), "1", "friction coefficient"),
             "interface_cohesion": var("interface", np.zeros(nint), "Pa", "cohesion"),
             "interface_tensile_strength": var("interface", np.zeros(nint), "Pa", "tensile strength"),
-            "dead_load": var(("block", "dof"), dead, "N, N, N m", "dead load"),
-            "live_load": var(("block", "dof"), live, "N, N, N m", "live load"),
+            **(loads_version_1(dead, live) if version == 1 else loads(dead, live)),
             "block_fixed": var(("block", "dof"), fixed, "1", "held components",
                                flag_values=np.array([0, 1], dtype=np.int8), flag_meanings="free held"),
             "settlement_direction": var(("block", "dof"), settlement, "1", "settlement direction"),
@@ -112,7 +126,7 @@ def hand_model() -> xr.Dataset:
         attrs={
             "Conventions": "CF-1.11",
             "masonryfw_format": "model",
-            "masonryfw_format_version": 1,
+            "masonryfw_format_version": version,
             "title": "hand-written three-unit wall",
         },
     )
@@ -214,3 +228,18 @@ def test_open_model_reports_every_problem(tmp_path):
     assert len(caught.value.problems) >= 2
     assert "block_thickness" in message and "interface_friction" in message
     masonryfw.open_model(path, validate=False)  # the geometry is still sound
+
+
+def test_a_version_1_file_reads_as_the_same_model(tmp_path):
+    """Format version 1 (loads over ``dof``) is upgraded on reading: the same content as the version-2 file."""
+    old, new = tmp_path / "v1.nc", tmp_path / "v2.nc"
+    hand_model(version=1).to_netcdf(old)
+    hand_model(version=2).to_netcdf(new)
+    from_old, from_new = masonryfw.open_model(old), masonryfw.open_model(new)
+    assert from_old.attrs["masonryfw_format_version"] == 2
+    for name in ("dead_load", "dead_moment", "live_load", "live_moment"):
+        np.testing.assert_array_equal(from_old[name].values, from_new[name].values, err_msg=name)
+        assert from_old[name].dims == from_new[name].dims
+    assert masonryfw.check(xr.open_dataset(old)) == []  # a plain reader's dataset checks as it reads
+    result = masonryfw.solve(from_old, "statics")
+    assert float(result.masonry_weight) == pytest.approx(_weights().sum())

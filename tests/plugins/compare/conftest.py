@@ -1,11 +1,11 @@
-"""Hand-made models and results for the compare plugin's tests.
+"""Models and hand-made results for the compare plugin's tests.
 
 The model is a stack-bonded grid wall (``rows`` x ``cols`` units of b x h) on two
-support blocks: a fixed one under the first ``split`` columns and a moving one
-under the rest. Interfaces are written out by hand (head, bed and support joints),
-so every count and coordinate below is known without running the core.
-Results follow FORMAT.md ("Result variables") for three kinds of solver:
-limit analysis (LA), FEM/DEM and a continuum (JMM).
+support blocks, from the kit (:func:`masonryfw.testing.rectangles_model`): a
+fixed one under the first ``split`` columns and a moving one under the rest.
+Results are written by hand after docs/format.md ("Result variables") for three
+kinds of solver, limit analysis (LA), FEM/DEM and a continuum (JMM), so that
+every score below can be computed by hand.
 """
 from __future__ import annotations
 
@@ -17,6 +17,7 @@ import pytest
 import xarray as xr
 
 import masonryfw as mf
+import masonryfw.testing as mt
 
 B, H = 0.2, 0.1  # unit length and height [m]
 WEIGHT = 12e3  # N m-3
@@ -27,92 +28,14 @@ def _attrs(name: str) -> dict:
     return mf.variable_attrs(name)
 
 
-def _rectangles(x0, x1, y0, y1):
-    """Counter-clockwise vertices of rectangles, block after block."""
-    x = np.column_stack([x0, x1, x1, x0]).ravel()
-    y = np.column_stack([y0, y0, y1, y1]).ravel()
-    return x, y
-
-
 def grid_model(rows: int = 4, cols: int = 6, split: int = 3, title: str = "Grid wall") -> xr.Dataset:
-    """A valid model dataset: units ``r * cols + c``, then the fixed and the moving support."""
+    """A checked model: units ``r * cols + c``, then the fixed and the moving support."""
     r, c = np.divmod(np.arange(rows * cols), cols)
-    sx0 = np.array([0.0, split * B])
-    sx1 = np.array([split * B, cols * B])
-    x, y = _rectangles(
-        np.concatenate([c * B, sx0]), np.concatenate([(c + 1) * B, sx1]),
-        np.concatenate([r * H, [-H, -H]]), np.concatenate([(r + 1) * H, [0.0, 0.0]]),
-    )
-    nblock = rows * cols + 2
-    fixed, moving = rows * cols, rows * cols + 1
-    role = np.zeros(nblock, dtype=np.int8)
-    role[fixed], role[moving] = 2, 3
-
-    # head joints: left block is side 0 (n = +x), end 0 on top (t = (0, -1))
-    hr, hc = np.divmod(np.arange(rows * (cols - 1)), cols - 1)
-    head_blocks = np.column_stack([hr * cols + hc, hr * cols + hc + 1])
-    head_x = np.column_stack([(hc + 1) * B, (hc + 1) * B])
-    head_y = np.column_stack([(hr + 1) * H, hr * H])
-    # bed joints: lower block is side 0 (n = +y), end 0 on the left (t = (1, 0))
-    br, bc = np.divmod(np.arange((rows - 1) * cols), cols)
-    bed_blocks = np.column_stack([br * cols + bc, (br + 1) * cols + bc])
-    bed_x = np.column_stack([bc * B, (bc + 1) * B])
-    bed_y = np.column_stack([(br + 1) * H, (br + 1) * H])
-    # support joints under the first course
-    sc = np.arange(cols)
-    sup_blocks = np.column_stack([np.where(sc < split, fixed, moving), sc])
-    sup_x = np.column_stack([sc * B, (sc + 1) * B])
-    sup_y = np.zeros((cols, 2))
-
-    blocks = np.concatenate([head_blocks, bed_blocks, sup_blocks])
-    kind = np.concatenate([np.full(len(head_blocks), 1), np.zeros(len(bed_blocks)), np.full(cols, 2)]).astype(np.int8)
-    nint = len(blocks)
-
-    unit_weight = np.where(role < 2, WEIGHT, 0.0)
-    total = WEIGHT * THICKNESS * B * H * rows * cols
-    share = total * (cols - split) / cols
-    dead = np.zeros((nblock, 3))
-    dead[: rows * cols, 1] = -WEIGHT * THICKNESS * B * H
-    dead[moving, 1] = share
-    live = np.zeros((nblock, 3))
-    live[moving, 1] = -share
-    block_fixed = np.zeros((nblock, 3), dtype=np.int8)
-    block_fixed[fixed] = 1
-    block_fixed[moving] = [1, 0, 1]
-    direction = np.zeros((nblock, 3))
-    direction[moving, 1] = -1.0
-
-    def var(dims, values, name):
-        return (dims, values, _attrs(name))
-
-    return xr.Dataset(
-        {
-            "node_x": var("node", x, "node_x"),
-            "node_y": var("node", y, "node_y"),
-            "block_node_count": var("block", np.full(nblock, 4, dtype=np.int32), "block_node_count"),
-            "block_role": var("block", role, "block_role"),
-            "block_thickness": var("block", np.full(nblock, THICKNESS), "block_thickness"),
-            "block_unit_weight": var("block", unit_weight, "block_unit_weight"),
-            "interface_blocks": var(("interface", "side"), blocks.astype(np.int32), "interface_blocks"),
-            "interface_x": var(("interface", "end"), np.concatenate([head_x, bed_x, sup_x]), "interface_x"),
-            "interface_y": var(("interface", "end"), np.concatenate([head_y, bed_y, sup_y]), "interface_y"),
-            "interface_kind": var("interface", kind, "interface_kind"),
-            "interface_friction": var("interface", np.full(nint, 0.4), "interface_friction"),
-            "interface_cohesion": var("interface", np.zeros(nint), "interface_cohesion"),
-            "interface_tensile_strength": var("interface", np.zeros(nint), "interface_tensile_strength"),
-            "dead_load": var(("block", "dof"), dead, "dead_load"),
-            "live_load": var(("block", "dof"), live, "live_load"),
-            "block_fixed": var(("block", "dof"), block_fixed, "block_fixed"),
-            "settlement_direction": var(("block", "dof"), direction, "settlement_direction"),
-        },
-        coords={"dof": ("dof", np.array(["ux", "uy", "rz"]))},
-        attrs={
-            "Conventions": "CF-1.11",
-            "masonryfw_format": "model",
-            "masonryfw_format_version": 1,
-            "title": title,
-        },
-    )
+    units = np.column_stack([c * B, r * H, (c + 1) * B, (r + 1) * H])
+    supports = [(0.0, -H, split * B, 0.0), (split * B, -H, cols * B, 0.0)]
+    roles = ["unit"] * (rows * cols) + ["fixed_support", "moving_support"]
+    return mt.rectangles_model(np.vstack([units, supports]), roles, unit_weight=WEIGHT, thickness=THICKNESS,
+                               title=title)
 
 
 def head_line(model: xr.Dataset, column: int) -> np.ndarray:
@@ -129,15 +52,18 @@ def unit_column(model: xr.Dataset) -> np.ndarray:
     return np.concatenate([np.arange(n_units) % cols, [-1, -1]])
 
 
-def _result_attrs(model: xr.Dataset, solver: str, options: dict) -> dict:
+def _result_attrs(model: xr.Dataset, solver: str, options: dict, **extra) -> dict:
     return {
         **model.attrs,
         "masonryfw_format": "result",
         "plugin": solver,
         "plugin_version": "0",
         "solver": solver,
+        "solver_version": "0+000000000000",
+        "core_version": "0+000000000000",
         "solver_options": json.dumps(options),
         "wall_time_s": 0.01,
+        **extra,
     }
 
 
@@ -150,23 +76,13 @@ def _translation_mechanism(model: xr.Dataset, first_moving_column: int) -> np.nd
     return u
 
 
-def _relative_translation(model: xr.Dataset, u: np.ndarray):
-    """Opening and slip per interface end for translating blocks (same at both ends)."""
-    geo = mf.derive_geometry(model)
-    blocks = model.interface_blocks.values
-    dv = u[blocks[:, 1], :2] - u[blocks[:, 0], :2]
-    opening = dv[:, 0] * geo.interface_normal_x.values + dv[:, 1] * geo.interface_normal_y.values
-    slip = dv[:, 0] * geo.interface_tangent_x.values + dv[:, 1] * geo.interface_tangent_y.values
-    return np.repeat(opening[:, None], 2, axis=1), np.repeat(slip[:, None], 2, axis=1)
-
-
 def la_result(model: xr.Dataset, first_moving_column: int = 3, cracked=None, backend: str = "highs") -> xr.Dataset:
     """A limit-analysis result: the units right of a vertical crack translate down with the support.
 
     ``cracked`` (interface mask) defaults to every joint whose blocks move apart.
     """
     u = _translation_mechanism(model, first_moving_column)
-    opening, slip = _relative_translation(model, u)
+    opening, slip = mf.relative_motion(model, u, "small")
     moving_apart = (np.abs(opening).max(axis=1) > 0) | (np.abs(slip).max(axis=1) > 0)
     cracked = moving_apart if cracked is None else np.asarray(cracked, dtype=bool)
     state = np.where(opening.max(axis=1) > 0, 1, 0) + np.where(np.abs(slip).max(axis=1) > 0, 2, 0)
@@ -174,7 +90,7 @@ def la_result(model: xr.Dataset, first_moving_column: int = 3, cracked=None, bac
     macro = np.where(u[:, 1] < 0, 1, 0)
     return model.assign(
         collapse_multiplier=((), 0.3, _attrs("collapse_multiplier")),
-        block_displacement=(("block", "dof"), u, _attrs("block_displacement")),
+        **mf.motion_variables(u),
         interface_opening=(("interface", "end"), opening, _attrs("interface_opening")),
         interface_slip=(("interface", "end"), slip, _attrs("interface_slip")),
         interface_normal_force=(("interface", "end"), normal, _attrs("interface_normal_force")),
@@ -182,21 +98,26 @@ def la_result(model: xr.Dataset, first_moving_column: int = 3, cracked=None, bac
         interface_state=("interface", np.where(cracked, state, 0).astype(np.int8), _attrs("interface_state")),
         crack_indicator=("interface", cracked.astype(float), _attrs("crack_indicator")),
         macro_block=("block", macro.astype(np.int32), _attrs("macro_block")),
-    ).assign_attrs(_result_attrs(model, "la", {"solver": backend}))
+    ).assign_attrs(_result_attrs(model, "la", {"solver": backend}, rotations="small", flow_rule="associative"))
 
 
 def fdem_result(model: xr.Dataset, first_moving_column: int = 3) -> xr.Dataset:
-    """An incremental discrete result: 5 mm final settlement, reaction history, no forces or states."""
+    """An incremental discrete result: 5 mm final settlement, reaction history, no forces or states.
+
+    The crack indicator is chosen by hand (the head joints of one line), independent of the motion."""
     u = 0.005 * _translation_mechanism(model, first_moving_column)
     steps = np.linspace(0.0, 0.005, 11)
     crack = head_line(model, first_moving_column).astype(float)
+    opening, slip = mf.relative_motion(model, u, "finite")
     return model.assign(
-        block_displacement=(("block", "dof"), u, _attrs("block_displacement")),
+        **mf.motion_variables(u),
+        interface_opening=(("interface", "end"), opening, _attrs("interface_opening")),
+        interface_slip=(("interface", "end"), slip, _attrs("interface_slip")),
         crack_indicator=("interface", crack, _attrs("crack_indicator")),
         macro_block=("block", np.where(u[:, 1] < 0, 1, 0).astype(np.int32), _attrs("macro_block")),
         step_settlement=("step", steps, _attrs("step_settlement")),
         step_reaction=("step", 100.0 * np.exp(-steps / 0.001), _attrs("step_reaction")),
-    ).assign_attrs(_result_attrs(model, "fdem", {}))
+    ).assign_attrs(_result_attrs(model, "fdem", {}, rotations="finite", flow_rule="nonassociative"))
 
 
 def jmm_result(

@@ -85,6 +85,9 @@ def test_mixed_polygons_are_grouped_by_vertex_count(results, tmp_path):
 def test_the_export_command_writes_the_files(results, tmp_path):
     source = tmp_path / "r.nc"
     mf.save(results["fdem"], source)
+    missing = CliRunner().invoke(export_command, [str(source), "-o", str(tmp_path / "out" / "f.vtu")])
+    assert missing.exit_code == 1 and "directory" in str(missing.exception) and not (tmp_path / "out").exists()
+    (tmp_path / "out").mkdir()
     outcome = CliRunner().invoke(export_command, [str(source), "--format", "vtk", "-o", str(tmp_path / "out" / "f.vtu")])
     assert outcome.exit_code == 0, outcome.output
     assert "f_joints.vtu" in outcome.output

@@ -8,7 +8,6 @@ from PIL import Image
 
 import masonryfw as mf
 from masonryfw_compare.plotting import default_amplification, thrust_segments
-from masonryfw_compare.shapes import with_geometry
 
 
 def plot(result, kind, **options):
@@ -25,7 +24,7 @@ SUPPORTED = {
 }
 REFUSAL = {
     "mechanism": "result has no block_displacement: the mechanism plot needs block displacements",
-    "cracks": "result has no interface_state, interface_opening/interface_slip or block_displacement",
+    "cracks": "result has no interface_opening: the cracks plot needs the relative motion at the joints",
     "forces": "result has no interface_normal_force: the forces plot needs contact forces",
     "plastic": "result has no qp_failure: the plastic plot needs a continuum \\(jmm\\) result",
     "history": "result has no step_settlement: the history plot needs an incremental",
@@ -73,15 +72,15 @@ def test_compare_refuses_results_of_different_models(results, build):
 
 def test_default_amplification_draws_the_largest_motion_as_a_tenth_of_the_wall(results):
     # LA mechanism: units translate by 1 (unit settlement); wall + supports: 1.2 m x 0.5 m, diagonal 1.3 m
-    geo = with_geometry(results["la"])
-    assert default_amplification(geo, results["la"].block_displacement.values) == pytest.approx(0.13)
+    geo = mf.derive_geometry(results["la"])
+    assert default_amplification(geo, mf.block_motion(results["la"])) == pytest.approx(0.13)
     # FEM/DEM: 5 mm -> 0.13 / 0.005
-    assert default_amplification(geo, results["fdem"].block_displacement.values) == pytest.approx(26.0)
+    assert default_amplification(geo, mf.block_motion(results["fdem"])) == pytest.approx(26.0)
 
 
 def test_thrust_passes_through_the_centre_of_pressure(results):
     """Interface 0: head joint x = 0.2, end 0 at y = 0.1, end 1 at y = 0; N = (10, 30) -> y = 0.1 - 0.75*0.1."""
-    geo = with_geometry(results["la"])
+    geo = mf.derive_geometry(results["la"])
     normal = np.zeros((geo.sizes["interface"], 2))
     normal[0] = [10.0, 30.0]
     shear = np.zeros_like(normal)
@@ -96,12 +95,14 @@ def test_thrust_passes_through_the_centre_of_pressure(results):
 
 
 def test_plot_options_and_file_names_are_checked(results, tmp_path):
-    with pytest.raises(mf.PluginError, match="unknown option.*colour; valid options: amplification, threshold"):
+    with pytest.raises(mf.PluginError, match="unknown option 'colour'; valid options: amplification, threshold"):
         plot(results["la"], "mechanism", colour="red")
-    with pytest.raises(mf.PluginError, match="amplification.*cannot read 'big' as float"):
+    with pytest.raises(mf.PluginError, match="option 'amplification' = 'big': not a float"):
         plot(results["la"], "mechanism", amplification="big")
+    with pytest.raises(mf.PluginError, match="option 'amplification' = -1.0: must be > 0"):
+        plot(results["la"], "mechanism", amplification=-1)
     figure, _ = plot(results["la"], "mechanism", amplification=50)
-    with pytest.raises(mf.MasonryError, match="unknown image type '.jpg'"):
+    with pytest.raises(mf.MasonryError, match="unknown file type '.jpg'"):
         mf.save_figure(figure, tmp_path / "m.jpg")
 
 

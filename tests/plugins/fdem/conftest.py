@@ -47,7 +47,7 @@ def gravity_rotated(model, angle_deg: float):
     masonry = model.block_role.values < 2
     dead[masonry, 0] = weight[masonry] * np.sin(theta)
     dead[masonry, 1] = -weight[masonry] * np.cos(theta)
-    return model.assign(dead_load=(("block", "dof"), dead, model.dead_load.attrs))
+    return model.assign(dead_load=(("block", "axis"), dead, model.dead_load.attrs))
 
 
 @pytest.fixture(scope="session")

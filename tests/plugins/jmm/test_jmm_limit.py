@@ -1,4 +1,4 @@
-"""method=limit: the static (lower-bound) LP of the JMM continuum against closed forms and the incremental plateau.
+"""jmm-limit: the static (lower-bound) LP of the JMM continuum against closed forms and the incremental plateau.
 
 References, all independent of the LP:
 - shear block: the base shear can never exceed mu p L (Coulomb on the bed plane of any horizontal
@@ -19,9 +19,8 @@ import scipy.sparse as sp
 from skfem import MeshTri
 
 import masonryfw as mf
-from masonryfw_jmm.limit import StaticField, settlement_lp, solve_limit, solve_lp
+from masonryfw_jmm.limit import StaticField, settlement_lp, solve_lp
 from masonryfw_jmm.material import JointStrength
-from masonryfw_jmm.options import OPTIONS
 
 MU = 0.4
 STRENGTH = JointStrength(MU, MU, beta=0.8)
@@ -110,12 +109,8 @@ def test_unit_with_the_wedge_near_the_free_side_converges_from_below():
     assert fine == pytest.approx(exact, abs=1e-5)
 
 
-def options(**given):
-    return {**{o.name: o.default for o in OPTIONS}, **given}
-
-
 def limit(model, **given):
-    return solve_limit(mf.derive_geometry(model), options(**given), mf.no_progress)
+    return mf.solve(model, "jmm-limit", given)
 
 
 def wedge_reaction(model, height, fixed_end, wall_end):
@@ -127,11 +122,11 @@ def wedge_reaction(model, height, fixed_end, wall_end):
 
 def test_limit_result_format_and_dead_reaction(small_wall):
     result = limit(small_wall, mesh_size=0.025)
-    assert mf.check(small_wall.merge(result)) == []
+    assert mf.check(result) == []
     for name in ["mesh", "mesh_node_x", "mesh_node_y", "mesh_face_nodes", "qp_x", "qp_y", "qp_failure",
                  "collapse_multiplier", "moving_support_reaction", "crack_indicator"]:
         assert name in result, name
-    assert result.attrs["jmm_method"] == "limit"
+    assert result.attrs["solver"] == "jmm-limit"
     assert result.sizes["qp"] == 3 * result.sizes["mesh_face"]
     # R_0: the paper's settlement dead load, as the builder puts it on the moving support block
     moving = int(np.nonzero(small_wall.block_role.values == ROLE["moving_support"])[0][0])
@@ -182,10 +177,12 @@ def test_12c_limit_is_the_wedge_mechanism(test_12c):
 
 
 def test_rotating_support_is_refused(small_wall):
-    model = small_wall.copy(deep=True)
-    moving = int(np.nonzero(model.block_role.values == ROLE["moving_support"])[0][0])
-    model["settlement_direction"].values[moving] = [0.0, -0.8, 0.6]
-    with pytest.raises(mf.ModelError, match=f"moving support block {moving}"):
+    moving = int(np.nonzero(small_wall.block_role.values == ROLE["moving_support"])[0][0])
+    direction, held = small_wall.settlement_direction.values.copy(), small_wall.block_fixed.values.copy()
+    direction[moving], held[moving] = [0.0, -0.8, 0.6], 0
+    model = small_wall.assign(settlement_direction=small_wall.settlement_direction.copy(data=direction),
+                              block_fixed=small_wall.block_fixed.copy(data=held))
+    with pytest.raises(mf.ModelError, match=f"jmm-limit: moving support block {moving}"):
         limit(model)
 
 

@@ -1,116 +1,15 @@
-"""Test-only construction of FORMAT.md models from axis-aligned rectangles, by hand.
-
-Independent of the core builder on purpose: the closed-form tests need exact
-control of the geometry, supports and loads.
-"""
+"""Walls of the la tests: rectangles through the kit's helper (:func:`masonryfw.testing.rectangles_model`)."""
 from __future__ import annotations
+
+from functools import partial
 
 import numpy as np
 import pytest
-import xarray as xr
 
 import masonryfw as mf
+import masonryfw.testing as mt
 
 ROLE = mf.flags("block_role")
-KIND = mf.flags("interface_kind")
-
-
-def rectangle_contacts(rects: np.ndarray, tol: float = 1e-9):
-    """Shared edges of axis-aligned rectangles ``(x0, y0, x1, y1)``: pairs, end points, horizontal?"""
-    x0, y0, x1, y1 = (rects[:, k] for k in range(4))
-    scale = np.ptp(rects) or 1.0
-    pairs, xs, ys, horizontal = [], [], [], []
-    # i below j: top of i on bottom of j
-    touch = np.isclose(y1[:, None], y0[None, :], atol=tol * scale)
-    lo = np.maximum(x0[:, None], x0[None, :])
-    hi = np.minimum(x1[:, None], x1[None, :])
-    i, j = np.nonzero(touch & (hi - lo > tol * scale))
-    pairs.append(np.c_[i, j]); xs.append(np.c_[lo[i, j], hi[i, j]]); ys.append(np.c_[y1[i], y1[i]])
-    horizontal.append(np.ones(i.size, bool))
-    # i left of j: right of i on left of j
-    touch = np.isclose(x1[:, None], x0[None, :], atol=tol * scale)
-    lo = np.maximum(y0[:, None], y0[None, :])
-    hi = np.minimum(y1[:, None], y1[None, :])
-    i, j = np.nonzero(touch & (hi - lo > tol * scale))
-    pairs.append(np.c_[i, j]); xs.append(np.c_[x1[i], x1[i]]); ys.append(np.c_[lo[i, j], hi[i, j]])
-    horizontal.append(np.zeros(i.size, bool))
-    return np.concatenate(pairs), np.concatenate(xs), np.concatenate(ys), np.concatenate(horizontal)
-
-
-def rect_model(
-    rects,
-    roles,
-    *,
-    mu=0.4,
-    unit_weight=12e3,
-    thickness=0.1,
-    loading="tilt",
-    cohesion=0.0,
-    tensile_strength=0.0,
-    length_unit=1.0,
-):
-    """A model of rectangles in metres (times ``length_unit`` for the coordinates).
-
-    ``loading="tilt"``: horizontal live load = weight on every unit, supports fixed.
-    ``loading="settlement"``: the paper's convention (moving supports translate down,
-    dead load up = W * contact length / total contact length, live load the same down).
-    Loads are computed in metres and are the same whatever ``length_unit``; moments are zero.
-    """
-    rects = np.asarray(rects, dtype=float)
-    roles = np.asarray(roles, dtype=np.int8)
-    n = len(rects)
-    x0, y0, x1, y1 = rects.T
-    node_x = np.c_[x0, x1, x1, x0].ravel()
-    node_y = np.c_[y0, y0, y1, y1].ravel()
-    pairs, ix, iy, horizontal = rectangle_contacts(rects)
-    support = np.isin(roles, [ROLE["fixed_support"], ROLE["moving_support"]])
-    kind = np.where(horizontal, KIND["bed"], KIND["head"]).astype(np.int8)
-    kind[support[pairs].any(axis=1)] = KIND["support"]
-    weight = np.where(support, 0.0, unit_weight * (x1 - x0) * (y1 - y0) * thickness)
-    dead = np.zeros((n, 3))
-    live = np.zeros((n, 3))
-    dead[:, 1] = -weight
-    fixed = np.zeros((n, 3), np.int8)
-    direction = np.zeros((n, 3))
-    fixed[roles == ROLE["fixed_support"]] = 1
-    moving = roles == ROLE["moving_support"]
-    fixed[moving] = (1, 0, 1)
-    direction[moving] = (0, -1, 0)
-    if loading == "tilt":
-        live[:, 0] = weight
-    else:
-        length = np.abs(ix[:, 1] - ix[:, 0]) + np.abs(iy[:, 1] - iy[:, 0])
-        sup = support[pairs]
-        wall_on_support = sup.any(axis=1) & ~sup.all(axis=1)
-        support_block = np.where(sup[:, 0], pairs[:, 0], pairs[:, 1])[wall_on_support]
-        contact = np.bincount(support_block, weights=length[wall_on_support], minlength=n)
-        share = weight.sum() * contact / contact.sum()
-        dead[moving, 1] = share[moving]
-        live[moving, 1] = -share[moving]
-    ds = xr.Dataset(
-        {
-            "node_x": ("node", node_x * length_unit),
-            "node_y": ("node", node_y * length_unit),
-            "block_node_count": ("block", np.full(n, 4, np.int32)),
-            "block_role": ("block", roles),
-            "block_thickness": ("block", np.full(n, thickness * length_unit)),
-            "block_unit_weight": ("block", np.where(support, 0.0, unit_weight / length_unit**3)),
-            "interface_blocks": (("interface", "side"), pairs.astype(np.int32)),
-            "interface_x": (("interface", "end"), ix * length_unit),
-            "interface_y": (("interface", "end"), iy * length_unit),
-            "interface_kind": ("interface", kind),
-            "interface_friction": ("interface", np.full(len(pairs), mu, dtype=float)),
-            "interface_cohesion": ("interface", np.full(len(pairs), cohesion / length_unit**2)),
-            "interface_tensile_strength": ("interface", np.full(len(pairs), tensile_strength / length_unit**2)),
-            "dead_load": (("block", "dof"), dead),
-            "live_load": (("block", "dof"), live),
-            "block_fixed": (("block", "dof"), fixed),
-            "settlement_direction": (("block", "dof"), direction),
-        },
-        coords={"dof": ["ux", "uy", "rz"]},
-        attrs={"title": "test wall"},
-    )
-    return mf.derive_geometry(ds)
 
 
 def running_bond(n_courses, width, unit_length, unit_height, *, half_first=True, y0=0.0):
@@ -135,38 +34,103 @@ def ferris_tin_loi_wall(length_unit=1.0):
     units = running_bond(6, 2.0, 0.4, 0.175, half_first=True)
     rects = np.vstack([(-0.2, -0.175, 2.2, 0.0), units])
     roles = [ROLE["fixed_support"]] + [ROLE["unit"]] * len(units)
-    return rect_model(rects, roles, mu=0.65, length_unit=length_unit)
+    return mt.rectangles_model(rects, roles, friction=0.65, loading="tilt", length_unit=length_unit)
+
+
+def static_alpha(model) -> float:
+    """The largest multiplier of the live load that contact forces can equilibrate: the static (lower-bound)
+    limit analysis LP, written here from the geometry alone, independently of the la plugin.
+
+    Unknowns: per interface end a normal force N (compression positive) and a shear
+    force T, and alpha. Every free block is in equilibrium under its dead load, alpha
+    times its live load and the contact forces (forces and moment about its
+    centroid); a moving support, which may move only along its settlement direction
+    ``d``, is in equilibrium along ``d``. Every end obeys the joint's strength:
+    ``N >= -a_t``, ``|T| <= a_c + mu N`` (``a_c = c A``, ``a_t = min(ft, c / mu) A``, A
+    the end's half of the contact area). Interfaces between two supports carry nothing.
+    Maximise alpha with HiGHS. By the static theorem (and LP duality) this is the
+    collapse multiplier of the associative kinematic programme.
+    """
+    from scipy.optimize import linprog
+    import scipy.sparse as sp
+
+    blocks = model.interface_blocks.values.astype(int)
+    n_if, n_block = blocks.shape[0], model.sizes["block"]
+    role = model.block_role.values
+    support = np.isin(role, [ROLE["fixed_support"], ROLE["moving_support"]])
+    active = ~support[blocks].all(axis=1)
+    nx, ny = model.interface_normal_x.values, model.interface_normal_y.values
+    tx, ty = model.interface_tangent_x.values, model.interface_tangent_y.values
+    cx, cy = model.block_centroid_x.values, model.block_centroid_y.values
+    n_var = 4 * n_if + 1  # N0, N1, T0, T1 per interface, alpha last
+    rows, cols, vals = [], [], []
+    for i in np.flatnonzero(active):
+        for end in (0, 1):
+            px, py = model.interface_x.values[i, end], model.interface_y.values[i, end]
+            for side, sign in ((0, -1.0), (1, 1.0)):
+                b = blocks[i, side]
+                for var, (fx, fy) in ((4 * i + end, (nx[i], ny[i])), (4 * i + 2 + end, (tx[i], ty[i]))):
+                    moment = (px - cx[b]) * fy - (py - cy[b]) * fx
+                    for dof, value in enumerate((fx, fy, moment)):
+                        rows.append(3 * b + dof), cols.append(var), vals.append(sign * value)
+    contact = sp.csr_matrix((vals, (rows, cols)), shape=(3 * n_block, n_var))
+    dead = mf.block_loads(model, "dead").ravel()
+    live = mf.block_loads(model, "live").ravel()
+    total = (contact + sp.csr_matrix((live, (np.arange(3 * n_block), np.full(3 * n_block, n_var - 1))),
+                                     shape=(3 * n_block, n_var))).tocsr()
+    free = ((model.block_fixed.values == 0) & ~support[:, None]).ravel()
+    moving = np.flatnonzero(role == ROLE["moving_support"])
+    direction = model.settlement_direction.values
+    equations = [total[free]]
+    rhs = [-dead[free]]
+    if moving.size:  # one shared settlement parameter: the moving supports together, along their directions
+        weights = np.zeros(3 * n_block)
+        for b in moving:
+            weights[3 * b:3 * b + 3] = direction[b]
+        equations.append(sp.csr_matrix(weights @ total))
+        rhs.append([-(weights @ dead)])
+    half_area = 0.5 * model.interface_length.values * model.block_thickness.values[blocks].min(axis=1)
+    mu = model.interface_friction.values
+    cohesion = model.interface_cohesion.values
+    cap = np.where(mu > 0, cohesion / np.where(mu > 0, mu, 1.0), np.inf)
+    a_c = cohesion * half_area
+    a_t = np.minimum(model.interface_tensile_strength.values, cap) * half_area
+    ends = np.array([(i, end) for i in np.flatnonzero(active) for end in (0, 1)]).reshape(-1, 2)
+    k = np.arange(2 * len(ends))
+    row_if, row_end = np.tile(ends[:, 0], 2), np.tile(ends[:, 1], 2)
+    sign = np.repeat([1.0, -1.0], len(ends))  # sign T - mu N <= a_c
+    upper = sp.csr_matrix((np.concatenate([sign, -mu[row_if]]), (np.concatenate([k, k]),
+                           np.concatenate([4 * row_if + 2 + row_end, 4 * row_if + row_end]))), shape=(k.size, n_var))
+    bounds = [(None, None)] * n_var
+    for i in range(n_if):
+        for end in (0, 1):
+            bounds[4 * i + end] = (-a_t[i], None) if active[i] else (0.0, 0.0)
+            bounds[4 * i + 2 + end] = (None, None) if active[i] else (0.0, 0.0)
+    cost = np.zeros(n_var)
+    cost[-1] = -1.0
+    res = linprog(cost, A_ub=upper, b_ub=a_c[row_if], A_eq=sp.vstack(equations),
+                  b_eq=np.concatenate(rhs), bounds=bounds, method="highs")
+    assert res.status == 0, res.message
+    return float(res.x[-1])
 
 
 class Walls:
-    """Factories shared by the la tests (pytest fixture ``walls``)."""
+    """Factories shared by the la tests (pytest fixture ``walls``); ``rect_model`` loads by tilting by default."""
 
-    rect_model = staticmethod(rect_model)
+    rect_model = staticmethod(partial(mt.rectangles_model, loading="tilt"))
     running_bond = staticmethod(running_bond)
     ferris_tin_loi_wall = staticmethod(ferris_tin_loi_wall)
+    static_alpha = staticmethod(static_alpha)
     ROLE = ROLE
 
     @staticmethod
-    def options(**given):
-        import masonryfw_la
-
-        (solver,) = masonryfw_la.masonryfw_solvers()
-        resolved = {o.name: o.default for o in solver.options}
-        resolved.update(given)
-        return resolved
-
-    @staticmethod
     def solve(model, **given):
-        """The plugin's solve function called directly; the model with the result variables."""
-        import masonryfw_la
-
-        (solver,) = masonryfw_la.masonryfw_solvers()
-        result = solver.solve(model, Walls.options(**given), mf.no_progress)
-        merged = model.assign(result.data_vars)
-        merged.attrs = {**model.attrs, **result.attrs}
-        return merged
+        """``mf.solve(model, "la", given)``: the result with the core's comparable fields."""
+        return mf.solve(model, "la", given)
 
 
 @pytest.fixture
 def walls():
     return Walls
+
+

@@ -25,9 +25,9 @@ def single_unit(walls, b, h, **material):
 )
 def test_la_single_unit_under_its_weight_sideways(walls, backend, b, h, mu, regime):
     """alpha = min(b/h, mu): rocking about the toe (b/h) or sliding with dilatancy (mu)."""
-    result = walls.solve(single_unit(walls, b, h, mu=mu), solver=backend)
+    result = walls.solve(single_unit(walls, b, h, friction=mu), solver=backend)
     assert float(result.collapse_multiplier) == pytest.approx(min(b / h, mu), rel=1e-7)
-    u = result.block_displacement.values[1]
+    u = mf.block_motion(result)[1]
     base_joint = result.interface_state.values[0]
     if regime == "rocking":  # turns clockwise, the heel lifts, nothing slides
         assert u[2] < 0
@@ -62,7 +62,7 @@ def test_la_unit_over_a_settling_support(walls, backend, a):
     result = walls.solve(model, solver=backend)
     assert float(result.collapse_multiplier) == pytest.approx(expected, abs=1e-7)
     # the moving support moves a unit distance down (FORMAT.md normalisation)
-    np.testing.assert_allclose(result.block_displacement.values[1], [0.0, -1.0, 0.0], atol=1e-12)
+    np.testing.assert_allclose(mf.block_motion(result)[1], [0.0, -1.0, 0.0], atol=1e-12)
     dead_reaction = float(model.dead_load.values[1, 1])
     assert float(result.moving_support_reaction) == pytest.approx(
         (1.0 - expected) * dead_reaction, abs=1e-5 * dead_reaction
@@ -83,7 +83,7 @@ def test_la_cohesion_and_tensile_strength(walls, backend, mu, cohesion, tension,
     """
     b, h, s, gamma = 0.5, 1.0, 0.1, 12e3
     weight = gamma * b * h * s
-    model = single_unit(walls, b, h, mu=mu, cohesion=cohesion, tensile_strength=tension, thickness=s)
+    model = single_unit(walls, b, h, friction=mu, cohesion=cohesion, tensile_strength=tension, thickness=s)
     ft = min(tension, cohesion / mu) if mu > 0 else tension
     rocking = b / h + ft * s * b**2 / (weight * h)
     sliding = mu + cohesion * b * s / weight

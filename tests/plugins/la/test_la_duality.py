@@ -65,7 +65,7 @@ def test_la_static_and_kinematic_solutions_agree(walls, case, backend):
     assert result.attrs["la_alpha_dual"] == pytest.approx(alpha, abs=1e-7)
 
     # every free block (and the moving supports along their direction) is in equilibrium
-    residual = model.dead_load.values + alpha * model.live_load.values + contact_resultants(result)
+    residual = mf.block_loads(model, "dead") + alpha * mf.block_loads(model, "live") + contact_resultants(result)
     residual /= np.array([weight, weight, weight * size])
     moving = model.block_role.values == ROLE["moving_support"]
     free = (model.block_fixed.values == 0) & ~moving[:, None]
@@ -94,10 +94,10 @@ def test_la_static_and_kinematic_solutions_agree(walls, case, backend):
     a_t, a_c = (tension * half_area)[:, None], (cohesion * half_area)[:, None]
     dissipation = np.where(ground[:, None], 0.0, a_t * opening + (a_c - mu[:, None] * a_t) * np.abs(slip))
     work = normal * opening + shear * slip
-    scale = weight * np.abs(result.block_displacement.values[:, :2]).max()
+    scale = weight * np.abs(mf.block_motion(result)[:, :2]).max()
     assert np.abs(work + dissipation).max() < TOL * scale
-    u = result.block_displacement.values.ravel()
-    external = (model.dead_load.values.ravel() + alpha * model.live_load.values.ravel()) @ u
+    u = mf.block_motion(result).ravel()
+    external = (mf.block_loads(model, "dead").ravel() + alpha * mf.block_loads(model, "live").ravel()) @ u
     assert external == pytest.approx(dissipation.sum(), abs=TOL * scale)
 
     # settlement cases: the moving support carries (1 - alpha) x its dead reaction at collapse

@@ -41,7 +41,7 @@ def test_the_grid_has_the_swept_keys_as_dimensions(grid_run):
     np.testing.assert_array_equal(sweep.supports_settling_start.values, STARTS)
     assert sweep.option_solver.values.tolist() == list(SOLVERS)
     assert sweep.supports_settling_start.attrs["sweep_key"] == "supports.settling.start"
-    for name in ("collapse_multiplier", "moving_support_reaction", "macro_block_count", "wall_time_s",
+    for name in ("alpha", "collapse_reaction", "macro_blocks", "wall_time_s",
                  "message", "result_path", "key", "from_store"):
         assert sweep[name].dims == sweep.status.dims, name
 
@@ -53,11 +53,12 @@ def test_values_equal_single_solves_in_process(grid_run, reference_solve):
             point = sweep.sel(supports_settling_start=start, option_solver=solver)
             reference = reference_solve(start, solver=solver)
             assert int(point.status) == 0
-            for name in ("collapse_multiplier", "moving_support_reaction"):
-                assert float(point[name]) == pytest.approx(float(reference[name]), rel=1e-12, abs=1e-12), name
-            assert float(point.macro_block_count) == np.unique(reference.macro_block.values).size
+            for name, variable in (("alpha", "collapse_multiplier"), ("collapse_reaction", "moving_support_reaction")):
+                assert float(point[name]) == pytest.approx(float(reference[variable]), rel=1e-12, abs=1e-12), name
+            masonry = mf.masonry_blocks(reference.block_role.values)
+            assert float(point.macro_blocks) == np.unique(reference.macro_block.values[masonry]).size
             stored = mf.open_dataset(folder / str(point.result_path.values))
-            assert float(stored.collapse_multiplier) == float(point.collapse_multiplier)
+            assert float(stored.collapse_multiplier) == float(point.alpha)
             assert stored.attrs["solver_options"] == reference.attrs["solver_options"]
 
 
@@ -66,7 +67,7 @@ def test_a_bad_spec_value_is_recorded_and_the_others_run(grid_run):
     bad = sweep.sel(supports_settling_start=1.2)
     assert (bad.status.values == 1).all()  # spec_error
     assert all("'supports.settling.end'" in str(m) and "must exceed start" in str(m) for m in bad.message.values)
-    assert np.isnan(bad.collapse_multiplier.values).all()
+    assert np.isnan(bad.alpha.values).all()
     assert (bad.result_path.values == "").all()
     assert (sweep.sel(supports_settling_start=[0.5, 0.8]).status.values == 0).all()
     listed = failed_points(sweep)
@@ -86,7 +87,7 @@ def test_a_solver_failure_is_recorded_and_keys_are_shared_across_sweeps(grid_run
     same = grid.sel(supports_settling_start=0.5, option_solver="highs")
     assert str(zipped.key.values[0]) == str(same.key.values)
     assert int(zipped.from_store.values[0]) == 1
-    assert float(zipped.collapse_multiplier.values[0]) == float(same.collapse_multiplier)
+    assert float(zipped.alpha.values[0]) == float(same.alpha)
 
 
 def test_a_rerun_solves_nothing_and_an_interrupted_point_is_solved_again(grid_run, client):
@@ -96,7 +97,7 @@ def test_a_rerun_solves_nothing_and_an_interrupted_point_is_solved_again(grid_ru
     again = run_sweep(plan, client, store, folder)
     assert _results(store) == before  # nothing rewritten
     assert again.from_store.sel(supports_settling_start=[0.5, 0.8]).values.all()
-    np.testing.assert_array_equal(again.collapse_multiplier.values, first.collapse_multiplier.values)
+    np.testing.assert_array_equal(again.alpha.values, first.alpha.values)
 
     # A kill between the result file and its record; a truncated result; a temporary file left behind.
     keys = first.key.sel(supports_settling_start=0.5).values.tolist()
@@ -109,5 +110,5 @@ def test_a_rerun_solves_nothing_and_an_interrupted_point_is_solved_again(grid_ru
     assert resumed.from_store.sel(supports_settling_start=0.8).values.tolist() == [1, 1]
     after = _results(store)
     assert {name for name in after if after[name] != before[name]} == {f"{k}.nc" for k in keys}
-    np.testing.assert_array_equal(resumed.collapse_multiplier.values, first.collapse_multiplier.values)
+    np.testing.assert_array_equal(resumed.alpha.values, first.alpha.values)
     assert os.path.getsize(truncated) > 1000

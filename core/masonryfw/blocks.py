@@ -1,0 +1,232 @@
+"""From blocks (polygons with roles), a material, supports and a loading to a model dataset.
+
+The one place where a model's interfaces, interface kinds, support kinematics
+and loads are made; the parametric builder, the import of drawings and
+:mod:`masonryfw.testing` all assemble their models here. Conventions
+(docs/format.md):
+
+- interfaces: the common segments of the blocks' collinear opposite edges
+  (:func:`masonryfw.detect_interfaces`), but none between two supports (ground
+  against ground carries nothing the analysis needs);
+- kinds: ``support`` when a side is a support, else ``bed`` (horizontal),
+  ``head`` (vertical) or ``other`` (inclined);
+- loads: every unit and lintel carries its weight as dead load. Settlement
+  loading: the masonry weight W is spread uniformly over the wall-on-support
+  contact length L_total, so a moving support of contact length L_m carries the
+  upward dead load ``W L_m / L_total`` and the same live load downward. Tilt
+  loading: the weight acts horizontally as live load on every unit and lintel,
+  and every support is held;
+- a moving support translates vertically (``block_fixed`` 1 0 1, direction
+  0 -1 0) or rotates about a pivot (free, direction of the small rotation that
+  moves its centroid down, as a unit vector).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import xarray as xr
+
+from .dofs import load_variables
+from .errors import SpecError
+from .geometry import polygon_area_centroid
+from .interfaces import detect_interfaces
+from .schema import FORMAT_VERSION, flags, variable_attrs
+
+DOF_NAMES = ("ux", "uy", "rz")
+#: Position tolerance of the interface kinds, relative to the interface length.
+KIND_TOLERANCE = 1.0e-9
+LOADINGS = ("settlement", "tilt")
+
+
+@dataclass(frozen=True)
+class Material:
+    """What every masonry block and joint of a model is made of (SI)."""
+
+    unit_weight: float  # N m-3
+    friction: float  # mu = tan(phi)
+    cohesion: float = 0.0  # Pa
+    tensile_strength: float = 0.0  # Pa
+    young_modulus: float | None = None  # Pa
+    poisson_ratio: float | None = None
+
+
+@dataclass(frozen=True)
+class Support:
+    """How one support block moves: ``kind`` fixed or moving; ``motion`` translation or rotation (about ``pivot``)."""
+
+    name: str
+    kind: str = "fixed"
+    motion: str = "none"
+    pivot: tuple[float, float] | None = None
+
+
+def rotation_direction(centre, pivot) -> np.ndarray:
+    """Unit dof-space direction of a small rotation about ``pivot`` that moves ``centre`` down."""
+    dx, dy = centre[0] - pivot[0], centre[1] - pivot[1]
+    omega = -math.copysign(1.0, dx)
+    direction = np.array([-omega * dy, omega * dx, omega])
+    return direction / np.linalg.norm(direction)
+
+
+def support_kinematics(supports, centres, loading: str):
+    """``block_fixed``, ``settlement_direction`` and role of every support block (tilt: all held)."""
+    role = flags("block_role")
+    count = len(supports)
+    fixed = np.ones((count, 3), dtype=np.int8)
+    direction = np.zeros((count, 3))
+    roles = np.full(count, role["fixed_support"], dtype=np.int8)
+    if loading == "tilt":
+        return fixed, direction, roles
+    for i, support in enumerate(supports):
+        if support.kind != "moving":
+            continue
+        roles[i] = role["moving_support"]
+        if support.motion == "rotation":
+            fixed[i] = 0
+            direction[i] = rotation_direction(centres[i], support.pivot)
+        else:
+            fixed[i] = (1, 0, 1)
+            direction[i] = (0.0, -1.0, 0.0)
+    return fixed, direction, roles
+
+
+def interface_kinds(blocks, ix, iy, is_support) -> np.ndarray:
+    """``bed``, ``head``, ``support`` or ``other`` of every interface."""
+    kind = flags("interface_kind")
+    dx = np.abs(ix[:, 1] - ix[:, 0])
+    dy = np.abs(iy[:, 1] - iy[:, 0])
+    length = np.hypot(dx, dy)
+    out = np.full(blocks.shape[0], kind["other"], dtype=np.int8)
+    out[dy <= KIND_TOLERANCE * length] = kind["bed"]
+    out[dx <= KIND_TOLERANCE * length] = kind["head"]
+    out[is_support[blocks].any(axis=1)] = kind["support"]
+    return out
+
+
+def support_contact(blocks, length, support_index: np.ndarray, n_support: int) -> np.ndarray:
+    """Wall-on-support contact length of every support (``support_index``: block -> support, -1 off supports)."""
+    local = support_index[blocks]
+    on = local >= 0
+    return np.bincount(local[on], weights=np.broadcast_to(length[:, None], blocks.shape)[on], minlength=n_support)
+
+
+def support_reactions(supports, contact: np.ndarray, weight_total: float, loading: str) -> np.ndarray:
+    """Dead-load reaction ``R = W L_m / L_total`` of every support (0 for fixed ones and under tilt)."""
+    total = contact.sum()
+    if total <= 0:
+        raise SpecError("supports: no masonry rests on any support")
+    reaction = np.zeros(len(supports))
+    if loading != "settlement":
+        return reaction
+    for i, support in enumerate(supports):
+        if support.kind == "moving":
+            if contact[i] <= 0:
+                raise SpecError(f"{support.name}: no masonry rests on this moving support")
+            reaction[i] = weight_total * contact[i] / total
+    return reaction
+
+
+def model_from_blocks(
+    node_x: np.ndarray,
+    node_y: np.ndarray,
+    block_node_count: np.ndarray,
+    role: np.ndarray,
+    thickness: np.ndarray | float,
+    material: Material,
+    supports,
+    loading: str = "settlement",
+    tilt_direction: int = 1,
+    attrs: dict | None = None,
+) -> xr.Dataset:
+    """The model dataset of a block assembly (not yet checked: see :func:`masonryfw.checked_model`).
+
+    ``role`` gives every block's flag (unit, lintel, fixed_support or
+    moving_support, as in the format); ``supports`` describes the support
+    blocks in block order, one :class:`Support` each. Polygons are counter-clockwise,
+    in metres. ``attrs`` adds global attributes (``title``, ``source_spec``, ...).
+    """
+    if loading not in LOADINGS:
+        raise SpecError(f"loading {loading!r}: must be one of {', '.join(LOADINGS)}")
+    flag = flags("block_role")
+    role = np.asarray(role, dtype=np.int8)
+    node_x, node_y = np.asarray(node_x, dtype=float), np.asarray(node_y, dtype=float)
+    counts = np.asarray(block_node_count, dtype=np.int32)
+    is_support = np.isin(role, (flag["fixed_support"], flag["moving_support"]))
+    support_blocks = np.flatnonzero(is_support)
+    if len(supports) != support_blocks.size:
+        raise SpecError(f"{support_blocks.size} support blocks but {len(supports)} support descriptions")
+    n_block = role.size
+    area, cx, cy = polygon_area_centroid(node_x, node_y, counts)
+    s_fixed, s_direction, s_role = support_kinematics(supports, np.c_[cx, cy][support_blocks], loading)
+    role = role.copy()
+    role[support_blocks] = s_role
+
+    found = detect_interfaces(node_x, node_y, counts)
+    blocks = np.asarray(found["blocks"], dtype=np.int64).reshape(-1, 2)
+    keep = ~is_support[blocks].all(axis=1)
+    blocks = blocks[keep]
+    ix = np.asarray(found["x"], dtype=float).reshape(-1, 2)[keep]
+    iy = np.asarray(found["y"], dtype=float).reshape(-1, 2)[keep]
+    length = np.hypot(ix[:, 1] - ix[:, 0], iy[:, 1] - iy[:, 0])
+
+    thickness = np.broadcast_to(np.asarray(thickness, dtype=float), (n_block,)).copy()
+    unit_weight = np.where(is_support, 0.0, material.unit_weight)
+    weight = unit_weight * np.abs(area) * thickness
+    support_index = np.full(n_block, -1)
+    support_index[support_blocks] = np.arange(support_blocks.size)
+    contact = support_contact(blocks, length, support_index, support_blocks.size)
+    reaction = support_reactions(supports, contact, weight.sum(), loading)
+
+    dead = np.zeros((n_block, 3))
+    live = np.zeros((n_block, 3))
+    dead[:, 1] = -weight
+    dead[support_blocks, 1] = reaction
+    live[support_blocks, 1] = -reaction
+    if loading == "tilt":
+        live[~is_support, 0] = tilt_direction * weight[~is_support]
+    fixed = np.zeros((n_block, 3), dtype=np.int8)
+    fixed[support_blocks] = s_fixed
+    direction = np.zeros((n_block, 3))
+    direction[support_blocks] = s_direction
+
+    n_interface = blocks.shape[0]
+    variables = {
+        "node_x": (("node",), node_x),
+        "node_y": (("node",), node_y),
+        "block_node_count": (("block",), counts),
+        "block_geometry": ((), np.int8(0)),
+        "block_role": (("block",), role),
+        "block_thickness": (("block",), thickness),
+        "block_unit_weight": (("block",), unit_weight),
+        "interface_blocks": (("interface", "side"), blocks.astype(np.int32)),
+        "interface_x": (("interface", "end"), ix),
+        "interface_y": (("interface", "end"), iy),
+        "interface_kind": (("interface",), interface_kinds(blocks, ix, iy, is_support)),
+        "interface_friction": (("interface",), np.full(n_interface, material.friction)),
+        "interface_cohesion": (("interface",), np.full(n_interface, material.cohesion)),
+        "interface_tensile_strength": (("interface",), np.full(n_interface, material.tensile_strength)),
+        "block_fixed": (("block", "dof"), fixed),
+        "settlement_direction": (("block", "dof"), direction),
+    }
+    if material.young_modulus is not None:
+        variables["block_young_modulus"] = (("block",), np.full(n_block, material.young_modulus))
+    if material.poisson_ratio is not None:
+        variables["block_poisson_ratio"] = (("block",), np.full(n_block, material.poisson_ratio))
+    data_vars = {name: (dims, values, variable_attrs(name)) for name, (dims, values) in variables.items()}
+    data_vars.update(load_variables("dead", dead))
+    data_vars.update(load_variables("live", live))
+    return xr.Dataset(
+        data_vars,
+        coords={"dof": ("dof", list(DOF_NAMES), variable_attrs("dof"))},
+        attrs={"Conventions": "CF-1.11", "masonryfw_format": "model", "masonryfw_format_version": FORMAT_VERSION,
+               "title": "", **(attrs or {})},
+    )
+
+
+def rectangle_nodes(x0, x1, y0, y1):
+    """Counter-clockwise vertices ``(node_x, node_y, block_node_count)`` of rectangles, block after block."""
+    node_x = np.stack((x0, x1, x1, x0), axis=1).ravel()
+    node_y = np.stack((y0, y0, y1, y1), axis=1).ravel()
+    return node_x, node_y, np.full(np.size(x0), 4, dtype=np.int32)

@@ -1,0 +1,331 @@
+"""What block results mean: one definition for every solver, the comparisons and the pictures.
+
+A solver returns its primary fields (block displacements, contact forces,
+histories); :func:`masonryfw.solve` derives the comparable fields below from
+``block_displacement``, the same way whatever the solver:
+
+- **relative motion** at an interface end: the motion of side 1 minus that of
+  side 0 at the end point; ``opening = dv . n`` (>= 0 opens), ``slip = dv . t``.
+  A mechanism (a velocity field, ``rotations = "small"``) moves points by the
+  linearised rigid motion ``u_c + rz x (p - c)``; a displacement
+  (``rotations = "finite"``) by ``u_c + (R(rz) - I)(p - c)``;
+- **joint motion**: the largest ``|(max(opening, 0), slip)|`` of the joint's two
+  ends (a closing end is compression, not a crack);
+- **intact**: a joint whose motion is at most :data:`INTACT_SHARE` of the largest
+  masonry-joint motion. One threshold for every solver; measured on the ten
+  bundled walls (docs/format.md): fdem's elastic contact motions stay below
+  0.3-1 % of the largest joint motion, while la's mechanisms have joints moving
+  1-2 % of it;
+- **crack_indicator**: joint motion over the largest masonry-joint motion, 0 on
+  intact joints and on joints between two supports (ground against ground);
+- **interface_state**: ``intact``; ``open`` when the slip stays within the
+  threshold; ``slide`` when the slip exceeds it and the opening is no more than
+  the flow rule's dilatancy of that slip (``tan(psi) |slip|``: ``mu |slip|`` for
+  associative joints, 0 otherwise) plus the threshold; ``open_slide`` when the
+  joint opens beyond that as well;
+- **macro_block**: blocks connected through intact interfaces (supports
+  included), labelled 0, 1, ... in order of their lowest block index.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import xarray as xr
+
+from .dofs import block_loads
+from .geometry import block_offsets, model_scale, node_block
+from .schema import flags, variable_attrs
+
+#: A joint moving at most this share of the largest masonry-joint motion is intact.
+INTACT_SHARE = 0.01
+#: The reaction history is at its plateau from the first settlement after which it stays within
+#: this share of the dead reaction of its final value.
+PLATEAU_SHARE = 0.01
+ROTATIONS = ("small", "finite")
+FLOW_RULES = ("associative", "nonassociative")
+DERIVED_RESULT_VARIABLES = ("interface_opening", "interface_slip", "interface_state", "crack_indicator",
+                            "macro_block")
+
+_ROLE = flags("block_role")
+_STATE = flags("interface_state")
+
+
+# ---------------------------------------------------------------- masks and scales
+
+def support_blocks(role: np.ndarray) -> np.ndarray:
+    """Blocks that are supports (ground): fixed or moving."""
+    return np.isin(role, (_ROLE["fixed_support"], _ROLE["moving_support"]))
+
+
+def masonry_blocks(role: np.ndarray) -> np.ndarray:
+    """Units and lintels."""
+    return np.isin(role, (_ROLE["unit"], _ROLE["lintel"]))
+
+
+def masonry_joints(role: np.ndarray, interface_blocks: np.ndarray) -> np.ndarray:
+    """Interfaces with at least one masonry side (not ground against ground)."""
+    return ~support_blocks(np.asarray(role)[np.asarray(interface_blocks, dtype=np.int64)]).all(axis=1)
+
+
+def polar_moment(node_x, node_y, block_node_count) -> np.ndarray:
+    """Polar second moment of area of every polygon about its own centroid [m4].
+
+    Shoelace sums in coordinates local to each block's first vertex (full
+    precision far from the origin), moved to the centroid with the parallel-axis
+    theorem. For a b x h rectangle: A (b^2 + h^2) / 12.
+    """
+    x = np.asarray(node_x, dtype=float)
+    y = np.asarray(node_y, dtype=float)
+    counts = np.asarray(block_node_count, dtype=np.int64)
+    start = block_offsets(counts)[:-1]
+    owner = node_block(counts)
+    xs, ys = x - x[start][owner], y - y[start][owner]
+    following = np.arange(x.size) + 1
+    following[start + counts - 1] = start
+    xn, yn = xs[following], ys[following]
+    cross = xs * yn - xn * ys
+    area = 0.5 * np.add.reduceat(cross, start)
+    sx = np.add.reduceat((xs + xn) * cross, start) / 6.0  # first moments (area * centroid)
+    sy = np.add.reduceat((ys + yn) * cross, start) / 6.0
+    ixx = np.add.reduceat((ys * ys + ys * yn + yn * yn) * cross, start) / 12.0
+    iyy = np.add.reduceat((xs * xs + xs * xn + xn * xn) * cross, start) / 12.0
+    return ixx + iyy - (sx * sx + sy * sy) / area
+
+
+@dataclass(frozen=True)
+class ModelScales:
+    """Reference sizes of a model, for solvers that work non-dimensionally.
+
+    ``length``: bounding-box diagonal [m]; ``block``: square root of the median
+    masonry block area [m]; ``weight``: weight of the units and lintels [N] (the
+    total live load's magnitude for a weightless model, else 1).
+    """
+
+    length: float
+    block: float
+    weight: float
+
+
+def model_scales(model: xr.Dataset) -> ModelScales:
+    """The :class:`ModelScales` of a model with derived geometry."""
+    length = model_scale(model.node_x.values, model.node_y.values)
+    masonry = masonry_blocks(model.block_role.values)
+    area = np.abs(model.block_area.values[masonry])
+    block = float(np.sqrt(np.median(area))) if area.size and np.median(area) > 0 else length
+    weight = float((model.block_unit_weight.values * np.abs(model.block_area.values)
+                    * model.block_thickness.values)[masonry].sum())
+    if not weight > 0:
+        live = block_loads(model, "live")
+        weight = float(np.hypot(live[:, 0], live[:, 1]).sum()) or 1.0
+    return ModelScales(length, block, weight)
+
+
+# ---------------------------------------------------------------- graphs
+
+def connected_components(n_node: int, edges: np.ndarray) -> np.ndarray:
+    """Connected-component label of every node through the ``(k, 2)`` node pairs ``edges``.
+
+    Labels are 0..k-1 in order of the lowest node of each component. Min-label
+    hooking with pointer jumping, vectorised over the edges: every node's parent
+    only decreases, so each component ends on its lowest node. (``scipy.sparse.csgraph``
+    would do it too, but importing it imports ``scipy.sparse.linalg``: 0.1 s of every
+    ``masonryfw solve``.)
+    """
+    edges = np.asarray(edges, dtype=np.int64).reshape(-1, 2)
+    parent = np.arange(n_node)
+    while True:
+        a, b = parent[edges[:, 0]], parent[edges[:, 1]]
+        apart = a != b
+        if not apart.any():
+            break
+        np.minimum.at(parent, np.maximum(a, b)[apart], np.minimum(a, b)[apart])
+        while True:  # pointer jumping: every node straight onto its current root
+            grand = parent[parent]
+            if np.array_equal(grand, parent):
+                break
+            parent = grand
+    return np.unique(parent, return_inverse=True)[1].reshape(n_node)
+
+
+# ---------------------------------------------------------------- kinematics
+
+def point_motion(u, centroid_x, centroid_y, px, py, owner, rotations: str = "small"):
+    """Motion ``(ux, uy)`` of points ``p`` carried by blocks ``owner`` under block motions ``u`` (block, 3).
+
+    ``rotations="small"``: the linearised rigid motion ``u_c + rz x (p - c)`` (a
+    mechanism); ``"finite"``: ``u_c + (R(rz) - I)(p - c)`` (a displacement).
+    """
+    u = np.asarray(u, dtype=float)[owner]
+    dx = np.asarray(px, dtype=float) - np.asarray(centroid_x)[owner]
+    dy = np.asarray(py, dtype=float) - np.asarray(centroid_y)[owner]
+    theta = u[..., 2]
+    if rotations == "finite":
+        c, s = np.cos(theta) - 1.0, np.sin(theta)
+        return u[..., 0] + c * dx - s * dy, u[..., 1] + s * dx + c * dy
+    return u[..., 0] - theta * dy, u[..., 1] + theta * dx
+
+
+def relative_motion(model: xr.Dataset, u: np.ndarray, rotations: str) -> tuple[np.ndarray, np.ndarray]:
+    """Opening and slip (interface, end) of block motions ``u`` (block, 3), side 1 minus side 0."""
+    sides = model.interface_blocks.values.astype(np.int64)
+    px, py = model.interface_x.values, model.interface_y.values
+    cx, cy = model.block_centroid_x.values, model.block_centroid_y.values
+    u0x, u0y = point_motion(u, cx, cy, px, py, sides[:, [0, 0]], rotations)
+    u1x, u1y = point_motion(u, cx, cy, px, py, sides[:, [1, 1]], rotations)
+    dx, dy = u1x - u0x, u1y - u0y
+    nx, ny = model.interface_normal_x.values[:, None], model.interface_normal_y.values[:, None]
+    tx, ty = model.interface_tangent_x.values[:, None], model.interface_tangent_y.values[:, None]
+    return dx * nx + dy * ny, dx * tx + dy * ty
+
+
+def joint_motion(opening: np.ndarray, slip: np.ndarray) -> np.ndarray:
+    """Largest end motion ``|(max(opening, 0), slip)|`` of every interface."""
+    return np.hypot(np.maximum(opening, 0.0), slip).max(axis=1)
+
+
+def intact_threshold(motion: np.ndarray, masonry: np.ndarray, share: float = INTACT_SHARE) -> float:
+    """The joint motion at or below which a joint is intact: ``share`` of the largest masonry-joint motion."""
+    return share * float(motion[masonry].max(initial=0.0))
+
+
+def crack_indicator(motion: np.ndarray, masonry: np.ndarray, share: float = INTACT_SHARE) -> np.ndarray:
+    """Joint motion over the largest masonry-joint motion; 0 on intact and non-masonry joints."""
+    largest = float(motion[masonry].max(initial=0.0))
+    if largest <= 0:
+        return np.zeros_like(motion, dtype=float)
+    return np.where(masonry & (motion > share * largest), np.minimum(motion / largest, 1.0), 0.0)
+
+
+def interface_states(opening: np.ndarray, slip: np.ndarray, dilatancy: np.ndarray | float,
+                     threshold: float) -> np.ndarray:
+    """int8 state of every interface (module docstring); ``threshold`` in the units of the motion."""
+    moves = joint_motion(opening, slip) > threshold
+    slips = np.abs(slip).max(axis=1) > threshold
+    dilatant = np.asarray(dilatancy, dtype=float).reshape(-1, 1) * np.abs(slip)
+    opens_beyond = (opening - dilatant).max(axis=1) > threshold
+    state = np.full(opening.shape[0], _STATE["intact"], dtype=np.int8)
+    state[moves & ~slips] = _STATE["open"]
+    state[moves & slips & ~opens_beyond] = _STATE["slide"]
+    state[moves & slips & opens_beyond] = _STATE["open_slide"]
+    return state
+
+
+def macro_blocks(n_block: int, interface_blocks: np.ndarray, state: np.ndarray) -> np.ndarray:
+    """Label of the rigid macro-block of every block: connected through intact interfaces."""
+    intact = np.asarray(interface_blocks)[np.asarray(state) == _STATE["intact"]]
+    return connected_components(n_block, intact)
+
+
+def dilatancy(model: xr.Dataset, flow_rule: str) -> np.ndarray:
+    """Per interface, the opening per unit slip of a sliding joint: mu (associative) or 0."""
+    if flow_rule == "associative":
+        return model.interface_friction.values.astype(float)
+    return np.zeros(model.sizes.get("interface", 0))
+
+
+def derived_variables(model: xr.Dataset, u: np.ndarray, rotations: str, flow_rule: str,
+                      share: float = INTACT_SHARE) -> dict[str, tuple]:
+    """The comparable result variables of block motions ``u`` (block, 3) on ``model`` (derived geometry)."""
+    opening, slip = relative_motion(model, u, rotations)
+    motion = joint_motion(opening, slip)
+    masonry = masonry_joints(model.block_role.values, model.interface_blocks.values)
+    state = interface_states(opening, slip, dilatancy(model, flow_rule), intact_threshold(motion, masonry, share))
+    labels = macro_blocks(model.sizes["block"], model.interface_blocks.values, state)
+    ie = ("interface", "end")
+    return {
+        "interface_opening": (ie, opening, variable_attrs("interface_opening")),
+        "interface_slip": (ie, slip, variable_attrs("interface_slip")),
+        "interface_state": (("interface",), state, variable_attrs("interface_state")),
+        "crack_indicator": (("interface",), crack_indicator(motion, masonry, share), variable_attrs("crack_indicator")),
+        "macro_block": (("block",), labels.astype(np.int32), variable_attrs("macro_block")),
+    }
+
+
+def states_at(result: xr.Dataset, share: float) -> np.ndarray:
+    """``interface_state`` recomputed with another intact share (e.g. a plot's threshold)."""
+    opening, slip = result.interface_opening.values, result.interface_slip.values
+    motion = joint_motion(opening, slip)
+    masonry = masonry_joints(result.block_role.values, result.interface_blocks.values)
+    rule = str(result.attrs.get("flow_rule", "nonassociative"))
+    return interface_states(opening, slip, dilatancy(result, rule), intact_threshold(motion, masonry, share))
+
+
+# ---------------------------------------------------------------- the numbers a user came for
+
+@dataclass(frozen=True)
+class KeyNumber:
+    """One headline number of a result, with its unit and what it is."""
+
+    name: str
+    value: float
+    units: str
+    long_name: str
+
+    def __str__(self) -> str:
+        unit = f" {self.units}" if self.units not in ("", "1") else ""
+        return f"{self.name} = {self.value:.6g}{unit}"
+
+
+def dead_reaction(model: xr.Dataset) -> float:
+    """Upward dead load on the moving supports [N]: the paper's settlement reaction R0 (0 without one)."""
+    moving = model.block_role.values == _ROLE["moving_support"]
+    return float(block_loads(model, "dead")[moving, 1].sum())
+
+
+def plateau_start(settlement: np.ndarray, reaction: np.ndarray, band: float) -> int:
+    """Index of the first record after which the reaction stays within ``band`` of its final value."""
+    outside = np.flatnonzero(np.abs(reaction - reaction[-1]) > band)
+    return int(outside[-1] + 1) if outside.size else 0
+
+
+def _history_numbers(result: xr.Dataset) -> list[KeyNumber]:
+    settlement = np.asarray(result.step_settlement.values, dtype=float)
+    reaction = np.asarray(result.step_reaction.values, dtype=float)
+    if settlement.size == 0:
+        return []
+    loaded = np.flatnonzero(settlement <= 0)
+    first = int(loaded[-1]) if loaded.size else 0
+    r0 = float(reaction[first])
+    numbers = [KeyNumber("dead_reaction", r0, "N", "reaction on the moving supports before they settle")]
+    s, r = settlement[first:], reaction[first:]
+    if s.size < 2:
+        return numbers
+    low = int(np.argmin(r))
+    start = plateau_start(s, r, PLATEAU_SHARE * abs(r0))
+    return numbers + [
+        KeyNumber("minimum_reaction", float(r[low]), "N", "smallest reaction on the moving supports"),
+        KeyNumber("minimum_reaction_settlement", float(s[low]), "m", "settlement at the smallest reaction"),
+        KeyNumber("plateau_reaction", float(r[start:].mean()), "N",
+                  f"mean reaction from the plateau on (within {PLATEAU_SHARE:.0%} of R0 of the final value)"),
+        KeyNumber("plateau_settlement", float(s[start]), "m", "settlement where the plateau starts"),
+        KeyNumber("final_settlement", float(s[-1]), "m", "settlement of the last record"),
+    ]
+
+
+def key_numbers(result: xr.Dataset) -> list[KeyNumber]:
+    """The numbers a user came for, whatever the solver.
+
+    Limit analysis: alpha and the reaction on the moving supports at collapse
+    (the solver's ``moving_support_reaction``, else ``(1 - alpha) R0``). Incremental solvers: the dead reaction, the smallest
+    reaction and the plateau reaction with their settlements. Both: the number of
+    masonry macro-blocks when the result has them.
+    """
+    numbers: list[KeyNumber] = []
+    if "collapse_multiplier" in result:
+        alpha = float(result.collapse_multiplier.values)
+        numbers.append(KeyNumber("alpha", alpha, "1", "collapse multiplier"))
+        r0 = dead_reaction(result)
+        if "moving_support_reaction" in result:
+            numbers.append(KeyNumber("collapse_reaction", float(result.moving_support_reaction.values), "N",
+                                     "reaction on the moving supports at collapse"))
+        elif r0 > 0:
+            numbers.append(KeyNumber("collapse_reaction", (1.0 - alpha) * r0, "N",
+                                     "reaction on the moving supports at collapse, (1 - alpha) R0"))
+    if "step_reaction" in result and "step_settlement" in result:
+        numbers += _history_numbers(result)
+    if "macro_block" in result:
+        masonry = masonry_blocks(result.block_role.values)
+        count = np.unique(result.macro_block.values[masonry]).size
+        numbers.append(KeyNumber("macro_blocks", float(count), "1", "macro-blocks of the masonry"))
+    return numbers

@@ -1,0 +1,248 @@
+"""A kit for solver authors (and the project's own tests): small models, and a conformance suite.
+
+Small models from rectangles::
+
+    import masonryfw.testing as mt
+
+    model = mt.rectangles_model(
+        [(0.0, -0.1, 0.6, 0.0), (0.6, -0.1, 1.0, 0.0), (0.0, 0.0, 1.0, 0.2)],
+        ["fixed_support", "moving_support", "unit"],
+    )
+
+The conformance suite checks a solver against the contract every masonryfw
+solver keeps (docs/format.md, ``masonryfw.hookspecs``). In the plugin's tests::
+
+    from masonryfw.testing import SolverConformance
+
+    class TestToy(SolverConformance):
+        solver = "toy"               # its registered name
+        options = {"scale": 2.0}     # options for a quick run (default: its defaults)
+
+It checks that the result passes :func:`masonryfw.check` with the schema's
+names, dims and units, that every variable it adds has ``units`` and a
+``long_name``, that progress is reported in [0, 1], that an interruption
+(``KeyboardInterrupt`` raised from the progress callback) either propagates or
+returns a result marked ``interrupted = 1``, that every declared option's
+default obeys its own rules and that values breaking them are refused, and that
+the solve depends neither on the order of the blocks nor on mm against m (to a
+relative ``invariance_tolerance`` of the key numbers). Needs pytest.
+"""
+from __future__ import annotations
+
+import math
+from typing import Any, ClassVar, Mapping, Sequence
+
+import numpy as np
+import pytest
+import xarray as xr
+
+from . import blocks
+from .errors import PluginError
+from .model import checked_model
+from .plugins import get_solver, solve
+from .schema import flags, load_schema
+from .checks import check
+from .semantics import key_numbers
+
+ROLES = flags("block_role")
+
+
+def rectangles_model(
+    rects: Sequence[Sequence[float]],
+    roles: Sequence[str | int],
+    *,
+    friction: float = 0.4,
+    unit_weight: float = 12e3,
+    thickness: float = 0.1,
+    loading: str = "settlement",
+    cohesion: float = 0.0,
+    tensile_strength: float = 0.0,
+    young_modulus: float | None = None,
+    poisson_ratio: float | None = None,
+    motions: Mapping[int, tuple[str, tuple[float, float] | None]] | None = None,
+    length_unit: float = 1.0,
+    title: str = "test wall",
+) -> xr.Dataset:
+    """A checked model of axis-aligned rectangles ``(x0, y0, x1, y1)`` [m], one role each.
+
+    Roles are the format's (``unit``, ``lintel``, ``fixed_support``,
+    ``moving_support``, names or flags). Moving supports translate straight down
+    unless ``motions`` maps their block index to ``("rotation", pivot)``.
+    ``loading``: ``settlement`` (the paper's) or ``tilt`` (horizontal live load =
+    weight, supports held). ``length_unit`` scales the coordinates and thickness
+    (1e3: the same wall in mm, with unit weight, cohesion, tensile strength and
+    Young's modulus rescaled so that the loads in N and the strains are the same).
+    """
+    rects = np.asarray(rects, dtype=float).reshape(-1, 4) * length_unit
+    role = np.array([ROLES[r] if isinstance(r, str) else int(r) for r in roles], dtype=np.int8)
+    if role.size != rects.shape[0]:
+        raise ValueError(f"{rects.shape[0]} rectangles but {role.size} roles")
+    motions = dict(motions or {})
+    supports = []
+    for b in np.flatnonzero(np.isin(role, (ROLES["fixed_support"], ROLES["moving_support"]))):
+        if role[b] == ROLES["fixed_support"]:
+            supports.append(blocks.Support(f"support block {b}"))
+        else:
+            motion, pivot = motions.get(int(b), ("translation", None))
+            pivot = None if pivot is None else (pivot[0] * length_unit, pivot[1] * length_unit)
+            supports.append(blocks.Support(f"support block {b}", "moving", motion, pivot))
+    material = blocks.Material(unit_weight / length_unit**3, friction, cohesion / length_unit**2,
+                               tensile_strength / length_unit**2,
+                               None if young_modulus is None else young_modulus / length_unit**2, poisson_ratio)
+    x0, y0, x1, y1 = rects.T
+    ds = blocks.model_from_blocks(*blocks.rectangle_nodes(x0, x1, y0, y1), role, thickness * length_unit,
+                                  material, supports, loading, attrs={"title": title})
+    return checked_model(ds, repr(title))
+
+
+def small_settlement_wall(length_unit: float = 1.0) -> xr.Dataset:
+    """Three courses of 0.2 x 0.1 m units in running bond, 0.8 m wide, the right 0.3 m of the base settling."""
+    rects, roles = [], []
+    for course in range(3):
+        y = 0.1 * course
+        cuts = [0.0, 0.2, 0.4, 0.6, 0.8] if course % 2 == 0 else [0.0, 0.1, 0.3, 0.5, 0.7, 0.8]
+        rects += [(a, y, b, y + 0.1) for a, b in zip(cuts[:-1], cuts[1:])]
+        roles += ["unit"] * (len(cuts) - 1)
+    rects += [(0.0, -0.1, 0.5, 0.0), (0.5, -0.1, 0.8, 0.0)]
+    roles += ["fixed_support", "moving_support"]
+    return rectangles_model(rects, roles, young_modulus=1.2e9, poisson_ratio=0.2, length_unit=length_unit,
+                            title="conformance wall")
+
+
+def permuted(model: xr.Dataset, block_order: np.ndarray, interface_order: np.ndarray) -> xr.Dataset:
+    """The same model with its blocks and interfaces listed in another order (a checked model)."""
+    counts = model.block_node_count.values.astype(np.int64)
+    start = np.concatenate(([0], np.cumsum(counts)))
+    nodes = np.concatenate([np.arange(start[b], start[b + 1]) for b in block_order])
+    new_index = np.empty_like(block_order)
+    new_index[block_order] = np.arange(block_order.size)
+    ds = model.isel(block=block_order, node=nodes, interface=interface_order)
+    ds = ds.assign(interface_blocks=(("interface", "side"), new_index[ds.interface_blocks.values].astype(np.int32),
+                                     ds.interface_blocks.attrs))
+    return checked_model(ds)
+
+
+def scaled(model: xr.Dataset, factor: float) -> xr.Dataset:
+    """The same model with every length times ``factor`` and the loads [N], strains and strengths kept."""
+    lengths = ("node_x", "node_y", "interface_x", "interface_y", "block_thickness")
+    per_area = ("interface_cohesion", "interface_tensile_strength", "block_young_modulus")
+    changed = {name: model[name] * factor for name in lengths}
+    changed.update({name: model[name] / factor**2 for name in per_area if name in model})
+    changed["block_unit_weight"] = model.block_unit_weight / factor**3
+    changed["dead_moment"] = model.dead_moment * factor
+    changed["live_moment"] = model.live_moment * factor
+    rotation = model.settlement_direction.values.copy()
+    rotation[:, 2] /= factor  # rad per metre of the settlement parameter
+    changed["settlement_direction"] = model.settlement_direction.copy(data=rotation)
+    return checked_model(model.assign(changed))
+
+
+class SolverConformance:
+    """Tests every masonryfw solver passes; subclass as ``TestMySolver`` and set ``solver`` (module docstring)."""
+
+    solver: ClassVar[str] = ""
+    options: ClassVar[Mapping[str, Any]] = {}
+    #: Relative tolerance of the key numbers under block reordering and mm against m.
+    invariance_tolerance: ClassVar[float] = 1e-6
+
+    @staticmethod
+    def conformance_model() -> xr.Dataset:
+        """The model the suite solves (override for a solver that needs another)."""
+        return small_settlement_wall()
+
+    @pytest.fixture(scope="class")
+    def solved(self) -> tuple[xr.Dataset, list]:
+        calls: list[tuple[float, str]] = []
+        result = solve(self.conformance_model(), self.solver, self.options,
+                       progress=lambda fraction, message="": calls.append((fraction, message)))
+        return result, calls
+
+    def test_the_result_passes_check(self, solved):
+        result, _ = solved
+        assert check(result) == []
+        assert result.attrs["solver"] == self.solver
+
+    def test_every_added_variable_has_units_and_a_long_name(self, solved):
+        result, _ = solved
+        model_variables = set(load_schema("model")["variables"])
+        for name, variable in result.variables.items():
+            if name in model_variables or name in result.coords:
+                continue
+            assert "units" in variable.attrs, f"{self.solver}: variable {name} has no units"
+            assert variable.attrs.get("long_name"), f"{self.solver}: variable {name} has no long_name"
+
+    def test_progress_is_reported_between_0_and_1(self, solved):
+        _, calls = solved
+        assert calls, f"{self.solver} never called progress"
+        assert all(0.0 <= fraction <= 1.0 for fraction, _ in calls)
+        assert all(isinstance(message, str) for _, message in calls)
+
+    def test_an_interruption_is_honoured(self, solved):
+        _, calls = solved
+        for at in sorted({1, len(calls) // 2 + 1, len(calls)}):
+            seen = []
+
+            def interrupt(fraction, message="", at=at):
+                seen.append(fraction)
+                if len(seen) == at:
+                    raise KeyboardInterrupt
+
+            try:
+                result = solve(self.conformance_model(), self.solver, self.options, progress=interrupt)
+            except KeyboardInterrupt:
+                continue  # nothing to keep: propagated
+            assert int(result.attrs.get("interrupted", 0)) == 1, (
+                f"{self.solver} swallowed a KeyboardInterrupt at progress call {at} and returned as if complete")
+            assert check(result) == []
+
+    def test_every_default_obeys_its_rules(self):
+        for option in get_solver(self.solver).options:
+            if not option.auto:
+                assert option.parse(option.default) == option.default, option.name
+
+    def test_values_breaking_the_rules_are_refused(self):
+        record = get_solver(self.solver)
+        with pytest.raises(PluginError, match="unknown option"):
+            solve(self.conformance_model(), self.solver, {"no_such_option": 1})
+        for option in record.options:
+            for value in _breaking_values(option):
+                with pytest.raises(PluginError, match=option.name):
+                    solve(self.conformance_model(), self.solver, {**self.options, option.name: value})
+
+    def test_the_order_of_the_blocks_does_not_matter(self, solved):
+        result, _ = solved
+        model = self.conformance_model()
+        rng = np.random.default_rng(7)
+        shuffled = permuted(model, rng.permutation(model.sizes["block"]), rng.permutation(model.sizes["interface"]))
+        _assert_same_numbers(result, solve(shuffled, self.solver, self.options), self.invariance_tolerance)
+
+    def test_millimetres_give_the_metre_result(self, solved):
+        result, _ = solved
+        again = solve(scaled(self.conformance_model(), 1e3), self.solver, self.options)
+        _assert_same_numbers(result, again, self.invariance_tolerance)
+
+
+def _breaking_values(option) -> list:
+    values: list[Any] = []
+    if option.type in (int, float):
+        values.append("not-a-number")
+        for bound, step in ((option.above, 0.0), (option.at_least, -1.0), (option.below, 0.0), (option.at_most, 1.0)):
+            if bound is not None:
+                values.append(option.type(bound + step) if option.type is float else int(math.floor(bound + step)))
+    if option.choices is not None:
+        values.append("no-such-choice")
+    return values
+
+
+#: Key numbers compared by the invariance tests: forces and multipliers (settlements at a minimum or
+#: a plateau's start move between records on a flat curve, and macro-block counts with noise).
+COMPARED_NUMBERS = ("alpha", "collapse_reaction", "dead_reaction", "minimum_reaction", "plateau_reaction")
+
+
+def _assert_same_numbers(a: xr.Dataset, b: xr.Dataset, tolerance: float) -> None:
+    """The headline forces and multipliers of two results agree to ``tolerance`` (relative)."""
+    first = {n.name: n.value for n in key_numbers(a) if n.name in COMPARED_NUMBERS}
+    second = {n.name: n.value for n in key_numbers(b) if n.name in COMPARED_NUMBERS}
+    assert set(first) == set(second)
+    for name, value in first.items():
+        assert second[name] == pytest.approx(value, rel=tolerance, abs=1e-12), name
