@@ -47,7 +47,7 @@ def running_bond_polygons(courses: int, units: int):
 
 
 def model_dataset(node_x, node_y, counts, found) -> xr.Dataset:
-    """A FORMAT.md model of the wall: units of weight, a moving support carrying the live load."""
+    """A docs/format.md model of the wall: units of weight, a moving support carrying the live load."""
     nb, ni = counts.size, len(found["blocks"])
     roles = mf.flags("block_role")
     role = np.full(nb, roles["unit"], dtype=np.int8)

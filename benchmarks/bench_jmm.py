@@ -11,14 +11,13 @@ import sys
 import time
 
 import numpy as np
+from _report import write_section
 
 import masonryfw as mf
 from masonryfw_jmm.material import JointStrength, ReturnMap, elastic_matrix
 from masonryfw_jmm.newton import NewtonSolver, State
-from masonryfw_jmm.problem import build_problem
 from masonryfw_jmm.options import OPTIONS
-
-from _report import write_section
+from masonryfw_jmm.problem import build_problem
 
 DEFAULT = {o.name: o.default for o in OPTIONS}
 

@@ -12,12 +12,11 @@ import sys
 import time
 
 import numpy as np
+from _report import write_section
 
 import masonryfw as mf
 from masonryfw_jmm.limit import solve_limit
 from masonryfw_jmm.options import OPTIONS
-
-from _report import write_section
 
 FLAG = mf.flags("qp_failure")
 

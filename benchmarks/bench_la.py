@@ -112,9 +112,8 @@ def backends_on_walls() -> tuple[str, str, list]:
 def other_forms() -> str:
     """The same LP as (i) the multiplier form of the paper (eq. 9: dn = mu(l1+l2)+l3, dt = l1-l2,
     l >= 0, equalities) and (ii) the static form (max alpha, G^T y + alpha a = c, y >= 0)."""
-    from scipy.optimize import linprog
-
     import clarabel
+    from scipy.optimize import linprog
 
     rows = []
     for case in ("test-12c", "facade-3"):

@@ -8,15 +8,29 @@ Solver plugins import only the names exported here.
 """
 from __future__ import annotations
 
-from importlib.metadata import PackageNotFoundError, version as _dist_version
+from importlib.metadata import PackageNotFoundError
+from importlib.metadata import version as _dist_version
 
 try:
     __version__ = _dist_version("masonryfw")
 except PackageNotFoundError:  # running from a source tree that is not installed
     __version__ = "0+unknown"
 
-from .errors import MasonryError, ModelError, PluginError, SolveError, SpecError
-from .progress import ProgressCallback, no_progress
+from .builder import build, dump_toml, load_spec
+from .checks import Problem, check
+from .datasets import CASE_NAMES, bundled_cases, bundled_spec_path
+from .dofs import block_loads, block_motion, load_variables, motion_variables, upgrade
+from .errors import MasonryError, ModelError, PluginError, SolveError, SpecError, listed
+from .geometry import (
+    DERIVED_GEOMETRY_VARIABLES,
+    block_bounds,
+    block_offsets,
+    derive_geometry,
+    interface_frame,
+    model_scale,
+    node_block,
+    polygon_area_centroid,
+)
 from .hookspecs import (
     AUTO,
     Comparator,
@@ -30,18 +44,25 @@ from .hookspecs import (
     resolve_options,
     unknown_name_message,
 )
-from .schema import FORMAT_VERSION, flags, load_schema, variable_attrs
-from .geometry import (
-    DERIVED_GEOMETRY_VARIABLES,
-    block_bounds,
-    block_offsets,
-    derive_geometry,
-    interface_frame,
-    model_scale,
-    node_block,
-    polygon_area_centroid,
+from .interfaces import detect_interfaces
+from .io import add_history, check_output_path, content_sha256, open_dataset, save, save_figure, sha256_file
+from .linalg import cholesky_factor, has_cholmod
+from .model import checked_model, model_part, open_model
+from .plugins import (
+    compare,
+    core_version,
+    get_comparator,
+    get_plotter,
+    get_solver,
+    installed_solvers,
+    options_json,
+    plugin_manager,
+    render,
+    solve,
+    solver_version,
 )
-from .dofs import block_loads, block_motion, load_variables, motion_variables, upgrade
+from .progress import ProgressCallback, no_progress
+from .schema import FORMAT_VERSION, flags, load_schema, variable_attrs
 from .semantics import (
     INTACT_SHARE,
     KeyNumber,
@@ -61,26 +82,6 @@ from .semantics import (
     relative_motion,
     states_at,
     support_blocks,
-)
-from .interfaces import detect_interfaces
-from .checks import Problem, check
-from .linalg import cholesky_factor, has_cholmod
-from .io import add_history, check_output_path, content_sha256, open_dataset, save, save_figure, sha256_file
-from .model import checked_model, model_part, open_model
-from .builder import build, dump_toml, load_spec
-from .datasets import CASE_NAMES, bundled_cases, bundled_spec_path
-from .plugins import (
-    compare,
-    core_version,
-    get_comparator,
-    get_plotter,
-    get_solver,
-    installed_solvers,
-    options_json,
-    plugin_manager,
-    render,
-    solve,
-    solver_version,
 )
 
 __all__ = [name for name in dir() if not name.startswith("_")]

@@ -231,7 +231,7 @@ class _Table:
             raise SpecError(f"spec key {self.key(name)!r} = {value!r}: must be a pair of numbers [x, y]")
         return float(value[0]) * self.scale, float(value[1]) * self.scale
 
-    def sub(self, name: str, allowed: tuple[str, ...], default=_REQUIRED) -> "_Table":
+    def sub(self, name: str, allowed: tuple[str, ...], default=_REQUIRED) -> _Table:
         return _Table(self.raw(name, default), self.key(name), allowed, self.scale)
 
 

@@ -7,11 +7,12 @@ unless ``--debug`` is given; usage errors exit with 2 (click's default).
 from __future__ import annotations
 
 import json
-import signal
 import shlex
+import signal
 import sys
 import warnings
 from pathlib import Path
+from typing import Any
 
 import click
 import numpy as np
@@ -124,9 +125,10 @@ class _StderrBar:
             self.stream.flush()
 
 
-def _progress_bar(enabled: bool) -> _StderrBar | None:
-    """A bar on stderr when it is a terminal and the user did not pass ``--no-progress``."""
-    return _StderrBar(sys.stderr) if enabled and sys.stderr.isatty() else None
+def _progress_bar(wanted: bool | None) -> _StderrBar | None:
+    """A bar on stderr: with ``--progress`` always, with ``--no-progress`` never, else when stderr is a terminal."""
+    show = sys.stderr.isatty() if wanted is None else wanted
+    return _StderrBar(sys.stderr) if show else None
 
 
 # ---------------------------------------------------------------- build, check, info, datasets
@@ -266,8 +268,8 @@ def plugins() -> None:
     for plugin in installed_plugins():
         origin = f"{plugin.distribution} {plugin.version}" if plugin.distribution else "registered in-process"
         click.echo(f"{plugin.name} ({origin})")
-        records = [("solver", r) for r in plugin.solvers] + [("comparator", r) for r in plugin.comparators]
-        records += [("plotter", r) for r in plugin.plotters]
+        records: list[tuple[str, Any]] = [("solver", r) for r in plugin.solvers]
+        records += [("comparator", r) for r in plugin.comparators] + [("plotter", r) for r in plugin.plotters]
         for kind, record in records:
             for line in _record_lines(kind, record):
                 click.echo(line)
@@ -306,8 +308,9 @@ class Interrupted(mf.MasonryError):
 @click.option("--plugin", "solver", required=True, help="Name of the solver (see `masonryfw plugins`).")
 @click.option("-o", "--output", type=click.Path(dir_okay=False), help="[default: <model>.<plugin>.nc]")
 @_OPTION
-@click.option("--no-progress", is_flag=True, help="Do not draw a progress bar.")
-def solve(model: str, solver: str, output: str | None, options: dict[str, str], no_progress: bool) -> None:
+@click.option("--progress/--no-progress", default=None,
+              help="Draw a progress bar on stderr [default: when stderr is a terminal].")
+def solve(model: str, solver: str, output: str | None, options: dict[str, str], progress: bool | None) -> None:
     """Solve MODEL (a model file, a spec file or a bundled case name) with a solver plugin.
 
     Prints the headline numbers: alpha and the reaction at collapse (limit
@@ -319,7 +322,7 @@ def solve(model: str, solver: str, output: str | None, options: dict[str, str], 
     out = Path(output) if output else Path(f"{Path(model).stem if inputs else model}.{solver}.nc")
     mf.check_output_path(out, inputs)
     dataset = mf.open_model(model)
-    bar = _progress_bar(not no_progress)
+    bar = _progress_bar(progress)
     try:
         result = mf.solve(dataset, solver, options, progress=bar)
     except KeyboardInterrupt:

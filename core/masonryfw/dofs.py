@@ -85,7 +85,7 @@ def upgrade(ds: xr.Dataset) -> xr.Dataset:
         return ds
     if not is_one:
         return ds
-    split = [name for name, var in ds.data_vars.items()
+    split = [str(name) for name, var in ds.data_vars.items()
              if var.dims[-1:] == ("dof",) and name not in ("block_fixed", "settlement_direction")]
     replaced = {}
     for name in split:

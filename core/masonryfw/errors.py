@@ -34,3 +34,10 @@ class PluginError(MasonryError):
 
 class SolveError(MasonryError):
     """A solver ran but could not produce a result (infeasible, diverged, ...)."""
+
+
+def listed(indices, limit: int = 20) -> str:
+    """``"12, 13 and 5 more"``: the first ``limit`` indices of a message, then how many more."""
+    items = [str(int(i)) for i in indices]
+    more = len(items) - limit
+    return ", ".join(items[:limit]) + (f" and {more} more" if more > 0 else "")

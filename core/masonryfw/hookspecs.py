@@ -22,8 +22,9 @@ from __future__ import annotations
 import difflib
 import importlib
 import math
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import Any, Callable, Mapping, Sequence
+from typing import Any
 
 import pluggy
 import xarray as xr
@@ -103,11 +104,15 @@ class Option:
                 return None
             raise PluginError(f"{where}: has no automatic value; give a {self.type.__name__}")
         if self.many:
-            items = [v for v in value.split(",") if v.strip()] if isinstance(value, str) else list(value)
+            if isinstance(value, str):
+                items = [v for v in value.split(",") if v.strip()]
+            else:
+                items = list(value) if isinstance(value, (list, tuple)) else [value]
             return tuple(self._one(item, where) for item in items)
         return self._one(value, where)
 
     def _one(self, value: Any, where: str) -> Any:
+        parsed: Any
         try:
             if self.type is bool and isinstance(value, str):
                 low = value.strip().lower()
@@ -117,7 +122,10 @@ class Option:
             elif self.type is int and isinstance(value, float) and not value.is_integer():
                 raise ValueError(value)
             elif self.type is int and isinstance(value, str):
-                parsed = int(float(value)) if float(value).is_integer() else int(value)
+                number = float(value)
+                if not number.is_integer():
+                    raise ValueError(value)
+                parsed = int(number)
             else:
                 parsed = self.type(value.strip() if isinstance(value, str) and self.type is not str else value)
         except (TypeError, ValueError, OverflowError):

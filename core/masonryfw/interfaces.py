@@ -34,6 +34,7 @@ import numpy as np
 from .errors import ModelError
 from .geometry import model_scale, next_node, node_block
 
+
 def detect_interfaces(node_x, node_y, block_node_count, *, tol=None) -> dict:
     """Find every contact segment between the polygons of a block assembly.
 

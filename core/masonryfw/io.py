@@ -29,7 +29,6 @@ from .geometry import DERIVED_GEOMETRY_VARIABLES
 from .schema import load_schema, variable_attrs
 
 CONVENTIONS = "CF-1.11"
-UGRID = "UGRID-1.0"
 COMPRESSION = {"zlib": True, "complevel": 4, "shuffle": True}
 
 _NODE_AXES = {"node_x": "X", "node_y": "Y"}
@@ -212,12 +211,6 @@ def _as_int8_flags(name: str, values: np.ndarray) -> np.ndarray:
     return values.astype(np.int8)
 
 
-def conventions(ds: xr.Dataset) -> str:
-    """``CF-1.11``, plus ``UGRID-1.0`` when the dataset holds a UGRID mesh topology."""
-    ugrid = any(v.attrs.get("cf_role") == "mesh_topology" for v in ds.variables.values())
-    return f"{CONVENTIONS} {UGRID}" if ugrid else CONVENTIONS
-
-
 def cf_normalized(ds: xr.Dataset) -> xr.Dataset:
     """``ds`` in the form :func:`save` writes it (the caller's dataset is not changed).
 
@@ -228,7 +221,7 @@ def cf_normalized(ds: xr.Dataset) -> xr.Dataset:
     """
     schema_variables = load_schema("result")["variables"]
     out = ds.copy(deep=False)
-    out.attrs["Conventions"] = conventions(out)
+    out.attrs.setdefault("Conventions", CONVENTIONS)
     if all(v in out.variables for v in _GEOMETRY_VARIABLES) and "block_geometry" not in out.variables:
         out = out.assign(block_geometry=xr.Variable((), np.int32(0)))
     coords, data_vars = {}, {}  # replaced in one assignment each: every xarray assignment is a merge

@@ -21,7 +21,7 @@ def has_cholmod() -> bool:
     return True
 
 
-def cholesky_factor(lower: sp.csc_matrix, use_cholmod: bool | None = None) -> "CholmodFactor | SuperLUFactor":
+def cholesky_factor(lower: sp.csc_matrix, use_cholmod: bool | None = None) -> CholmodFactor | SuperLUFactor:
     """A factor object for matrices with the lower-triangular pattern ``lower`` (CSC, sorted indices).
 
     ``factor.factorise(values)`` takes the values in the order of ``lower.data`` and

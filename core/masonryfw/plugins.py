@@ -15,10 +15,11 @@ import json
 import sys
 import time
 import warnings
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from importlib.metadata import entry_points
 from pathlib import Path
-from typing import Any, Mapping, Sequence
+from typing import Any
 
 import click
 import pluggy
@@ -265,7 +266,7 @@ def _merge_result(kind: str, name: str, base: xr.Dataset, reserved: xr.Dataset, 
     error = _failure(kind)
     if not isinstance(produced, xr.Dataset):
         raise error(f"{kind} {name} returned {type(produced).__name__}, not an xarray.Dataset")
-    clash = sorted(set(produced.data_vars) & set(reserved.data_vars))
+    clash = sorted(map(str, set(produced.data_vars) & set(reserved.data_vars)))
     if clash:
         raise error(
             f"{kind} {name} returned variable(s) {', '.join(clash)} that belong to its input; "
@@ -294,7 +295,7 @@ def _package_files(module_name: str) -> tuple[Path, list[Path]]:
     return Path("."), []
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def code_digest(module_name: str) -> str:
     """First 12 hex digits of the SHA-256 of the code of the package holding ``module_name``.
 
@@ -337,7 +338,7 @@ def _derive_comparable_fields(name: str, model: xr.Dataset, produced: xr.Dataset
     """``produced`` with the fields :mod:`.semantics` derives from its ``block_displacement``."""
     if "block_displacement" not in produced:
         return produced
-    derived_too = sorted(set(produced.data_vars) & set(DERIVED_RESULT_VARIABLES))
+    derived_too = sorted(map(str, set(produced.data_vars) & set(DERIVED_RESULT_VARIABLES)))
     if derived_too:
         raise SolveError(
             f"solver {name} returned {', '.join(derived_too)} with block_displacement; the core derives "

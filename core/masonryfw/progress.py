@@ -5,7 +5,7 @@ A solver receives a plain callable ``progress(fraction, message)`` with
 """
 from __future__ import annotations
 
-from typing import Callable
+from collections.abc import Callable
 
 ProgressCallback = Callable[[float, str], None]
 

@@ -6,7 +6,7 @@ and bounds; validation and writers read them from here.
 from __future__ import annotations
 
 import json
-from functools import lru_cache
+from functools import cache
 from importlib import resources
 
 from .errors import ModelError
@@ -17,7 +17,7 @@ READABLE_VERSIONS = (1, 2)
 KINDS = ("model", "result", "comparison", "sweep")
 
 
-@lru_cache(maxsize=None)
+@cache
 def load_schema(kind: str, version: int = FORMAT_VERSION) -> dict:
     """The schema of a dataset kind, with ``extends`` resolved (a result holds the model's variables)."""
     if kind not in KINDS:

@@ -30,18 +30,19 @@ relative ``invariance_tolerance`` of the key numbers). Needs pytest.
 from __future__ import annotations
 
 import math
-from typing import Any, ClassVar, Mapping, Sequence
+from collections.abc import Mapping, Sequence
+from typing import Any, ClassVar
 
 import numpy as np
 import pytest
 import xarray as xr
 
 from . import blocks
+from .checks import check
 from .errors import PluginError
 from .model import checked_model
 from .plugins import get_solver, solve
 from .schema import flags, load_schema
-from .checks import check
 from .semantics import key_numbers
 
 ROLES = flags("block_role")
@@ -151,9 +152,11 @@ class SolverConformance:
         return small_settlement_wall()
 
     @pytest.fixture(scope="class")
-    def solved(self) -> tuple[xr.Dataset, list]:
+    @classmethod
+    def solved(cls) -> tuple[xr.Dataset, list]:
+        """One solve of the conformance model, with every progress call it made."""
         calls: list[tuple[float, str]] = []
-        result = solve(self.conformance_model(), self.solver, self.options,
+        result = solve(cls.conformance_model(), cls.solver, cls.options,
                        progress=lambda fraction, message="": calls.append((fraction, message)))
         return result, calls
 
@@ -182,7 +185,7 @@ class SolverConformance:
         for at in sorted({1, len(calls) // 2 + 1, len(calls)}):
             seen = []
 
-            def interrupt(fraction, message="", at=at):
+            def interrupt(fraction, message="", at=at, seen=seen):
                 seen.append(fraction)
                 if len(seen) == at:
                     raise KeyboardInterrupt

@@ -7,7 +7,8 @@ a :class:`masonryfw.MasonryError` naming the variable and the kind of result it 
 """
 from __future__ import annotations
 
-from typing import Any, Mapping, Sequence
+from collections.abc import Mapping, Sequence
+from typing import Any
 
 import numpy as np
 import xarray as xr

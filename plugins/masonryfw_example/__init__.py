@@ -28,7 +28,7 @@ def solve_statics(model: xr.Dataset, options, progress) -> xr.Dataset:
 
     The masonry weight W (minus the dead vertical load on units and lintels) is
     shared by the supports in proportion to their contact length with the wall:
-    ``R_s = W * L_s / L_total`` (FORMAT.md, settlement loading).
+    ``R_s = W * L_s / L_total`` (docs/format.md, settlement loading).
     """
     is_support = mf.support_blocks(model.block_role.values)
     dead, live = mf.block_loads(model, "dead"), mf.block_loads(model, "live")

@@ -28,9 +28,18 @@ from numba import njit
 
 import masonryfw as mf
 
-from .kernels import DISSIPATED_DAMPING, DISSIPATED_FRICTION, RELEASED, SETTLEMENT, TIME, WORK_GRAVITY, \
-    WORK_SUPPORT, face_geometry, settlement_rate
-from .scene import Scene, name_list
+from .kernels import (
+    DISSIPATED_DAMPING,
+    DISSIPATED_FRICTION,
+    RELEASED,
+    SETTLEMENT,
+    TIME,
+    WORK_GRAVITY,
+    WORK_SUPPORT,
+    face_geometry,
+    settlement_rate,
+)
+from .scene import Scene
 
 jit = njit(cache=True, error_model="numpy")
 # the element loop has no nan/inf logic: fastmath (fused multiply-adds) makes it ~25 % faster
@@ -87,10 +96,10 @@ def elastic_constants(model, n_block: int) -> tuple[np.ndarray, np.ndarray]:
     nu = model.block_poisson_ratio.values.astype(float)
     bad = np.flatnonzero(~(young > 0))
     if bad.size:
-        raise mf.ModelError(f"block(s) {name_list(bad)}: block_young_modulus must be positive")
+        raise mf.ModelError(f"block(s) {mf.listed(bad)}: block_young_modulus must be positive")
     bad = np.flatnonzero(~((nu > -1.0) & (nu < 0.5)))
     if bad.size:
-        raise mf.ModelError(f"block(s) {name_list(bad)}: block_poisson_ratio must be in (-1, 0.5)")
+        raise mf.ModelError(f"block(s) {mf.listed(bad)}: block_poisson_ratio must be in (-1, 0.5)")
     return np.broadcast_to(young, (n_block,)), np.broadcast_to(nu, (n_block,))
 
 
@@ -124,11 +133,11 @@ def check_supported(scene: Scene) -> None:
     load, has no nodal meaning here."""
     held = np.flatnonzero(~scene.driven & ~scene.free.all(axis=1))
     if held.size:
-        raise mf.ModelError(f"block(s) {name_list(held)}: block_fixed holds a component of a free block; "
+        raise mf.ModelError(f"block(s) {mf.listed(held)}: block_fixed holds a component of a free block; "
                             "the fdem deformable mode does not support it (make the block a support)")
     moment = np.flatnonzero((scene.dead[:, 2] != 0) | (scene.live[:, 2] != 0))
     if moment.size:
-        raise mf.ModelError(f"block(s) {name_list(moment)}: dead_load / live_load has a moment component; "
+        raise mf.ModelError(f"block(s) {mf.listed(moment)}: dead_load / live_load has a moment component; "
                             "the fdem deformable mode takes only forces (applied in proportion to the nodal masses)")
 
 
@@ -228,14 +237,6 @@ def cst_element_forces(x, y, triangles, constants, force):
         force[n2, 0] -= p11 * bx2 + p12 * by2
         force[n2, 1] -= p21 * bx2 + p22 * by2
     return 0.5 * energy
-
-
-@jit
-def cst_forces(x, y, triangles, grad_x, grad_y, area0, young, poisson, active_tri, force):
-    """Add the internal forces of every active CST to ``force`` (node, 2); returns the strain energy
-    (:func:`cst_element_forces` on the packed constants; the time loop packs them once per call)."""
-    tri, constants = element_constants(triangles, grad_x, grad_y, area0, young, poisson, active_tri)
-    return cst_element_forces(x, y, tri, constants, force)
 
 
 @jit
@@ -373,7 +374,7 @@ def advance(n_steps, dt, x, y, vel, x0, y0, x_detect, y_detect, offs, node_block
     for k in range(n_node):
         load_norm += abs(load[k, 0]) + abs(load[k, 1])
     limit = half_buffer * half_buffer
-    for step in range(n_steps):
+    for _ in range(n_steps):
         time = acc[TIME]
         rate_now = settlement_rate(time + 0.5 * dt, rate, ramp_time, start_time)
         driven_motion(acc[SETTLEMENT], rate_now, x0, y0, node_block, driven_nodes, pos0, direction, x, y, vel)

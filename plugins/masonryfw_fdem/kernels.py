@@ -390,7 +390,7 @@ def advance(n_steps, dt, pos, vel, pos0, pos_detect, radius, lx, ly, offs, faces
     load_norm = 0.0
     for i in range(n_block):
         load_norm += abs(load[i, 0]) + abs(load[i, 1])
-    for step in range(n_steps):
+    for _ in range(n_steps):
         force[:, :] = 0.0
         place_vertices(pos, lx, ly, offs, vx, vy)
         time = acc[TIME]

@@ -17,13 +17,6 @@ import masonryfw as mf
 
 GRAVITY = 9.81  # m s-2: turns unit weights into masses
 ROLE = mf.flags("block_role")
-MAX_NAMED = 8
-
-
-def name_list(indices: np.ndarray) -> str:
-    shown = ", ".join(str(int(i)) for i in indices[:MAX_NAMED])
-    more = indices.size - MAX_NAMED
-    return shown + (f" and {more} more" if more > 0 else "")
 
 
 @dataclass(frozen=True)
@@ -78,7 +71,7 @@ def check_convex(lx: np.ndarray, ly: np.ndarray, offs: np.ndarray) -> None:
     concave = np.minimum.reduceat(cross, offs[:-1]) < -1e-9 * size**2
     if np.any(concave):
         raise mf.ModelError(
-            f"block(s) {name_list(np.flatnonzero(concave))}: not convex; the fdem solver's "
+            f"block(s) {mf.listed(np.flatnonzero(concave))}: not convex; the fdem solver's "
             "face-pair contact needs convex blocks (split them into convex parts)"
         )
 
@@ -100,7 +93,7 @@ def build_scene(model: xr.Dataset) -> Scene:
     weightless = np.flatnonzero(~driven & ~(weight > 0))
     if weightless.size:
         raise mf.ModelError(
-            f"block(s) {name_list(weightless)}: block_unit_weight * area * thickness is not positive; "
+            f"block(s) {mf.listed(weightless)}: block_unit_weight * area * thickness is not positive; "
             "a free block needs a mass in fdem"
         )
     scales = Scales(length=length, force=total, time=float(np.sqrt(length / GRAVITY)))

@@ -7,7 +7,8 @@ The core derives the comparable fields from the final block positions:
 from __future__ import annotations
 
 import logging
-from typing import Any, Mapping
+from collections.abc import Mapping
+from typing import Any
 
 import numpy as np
 import xarray as xr

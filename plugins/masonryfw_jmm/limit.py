@@ -52,8 +52,8 @@ from skfem import MeshTri
 import masonryfw as mf
 
 from .cracks import crack_indicator
-from .output import mesh_variables, point_variables, variable
 from .material import failure_mode
+from .output import mesh_variables, point_variables, variable
 from .problem import Domain, wall_domain
 
 ROLE = mf.flags("block_role")

@@ -85,7 +85,7 @@ class JointStrength:
         A, b, G = (np.array(v, dtype=float) for v in zip(*rows))
         return A, b, G, tuple(names)
 
-    def scaled(self, stress_scale: float) -> "JointStrength":
+    def scaled(self, stress_scale: float) -> JointStrength:
         """The same strength with cohesions and tensile strengths divided by ``stress_scale``."""
         return JointStrength(
             self.friction_bed, self.friction_head, self.cohesion_bed / stress_scale,
@@ -144,10 +144,6 @@ class ReturnMap:
                     tangent = tangent + self.vertex_stiffness * D
                 sets.append(ActiveSet(faces, M, P, np.ascontiguousarray(A @ P), tangent))
         return sets
-
-    def yield_values(self, stress: np.ndarray) -> np.ndarray:
-        """``(n, faces)`` values ``A s - b`` (<= 0 inside)."""
-        return np.asarray(stress) @ self.A.T - self.b
 
     def __call__(self, trial: np.ndarray, tol: float = 1e-10):
         """Return ``(stress, tangent, active, multipliers)`` for trial stresses ``(n, 3)``.

@@ -31,7 +31,7 @@ class State:
     residual: np.ndarray = field(default=None, repr=False)
 
     @classmethod
-    def initial(cls, problem: Problem) -> "State":
+    def initial(cls, problem: Problem) -> State:
         n, nf = problem.disc.n_points, len(problem.return_map.b)
         return cls(
             u=np.zeros(problem.disc.ndof), strain=np.zeros((n, 3)), stress=np.zeros((n, 3)),

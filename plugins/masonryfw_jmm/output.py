@@ -1,4 +1,4 @@
-"""Result variables both jmm methods write: the UGRID mesh and the quadrature-point fields (FORMAT.md)."""
+"""Result variables both jmm methods write: the mesh and the quadrature-point fields (docs/format.md)."""
 from __future__ import annotations
 
 import numpy as np
@@ -12,15 +12,12 @@ def variable(dims, values, units: str, long_name: str, **attrs) -> xr.Variable:
 
 
 def mesh_variables(points: np.ndarray, triangles: np.ndarray) -> dict[str, xr.Variable]:
-    """UGRID topology of the triangles ``(3, faces)`` on ``points`` ``(2, nodes)`` [m]."""
+    """The triangles ``(3, faces)`` on ``points`` ``(2, nodes)`` [m]: node coordinates and the face-node table."""
     return {
-        "mesh": variable((), np.int32(0), "1", "UGRID mesh topology", cf_role="mesh_topology", topology_dimension=2,
-                         node_coordinates="mesh_node_x mesh_node_y", face_node_connectivity="mesh_face_nodes"),
         "mesh_node_x": variable("mesh_node", points[0], "m", "continuum mesh node x"),
         "mesh_node_y": variable("mesh_node", points[1], "m", "continuum mesh node y"),
         "mesh_face_nodes": variable(("mesh_face", "mesh_face_node"), triangles.T.astype(np.int32), "1",
-                                    "node indices of each mesh face (0-based, UGRID face_node_connectivity)",
-                                    cf_role="face_node_connectivity", start_index=0),
+                                    mf.variable_attrs("mesh_face_nodes")["long_name"]),
     }
 
 

@@ -9,8 +9,8 @@ import xarray as xr
 import masonryfw as mf
 
 from .cracks import crack_indicator
-from .output import mesh_variables, point_variables, variable
 from .newton import NewtonSolver, State
+from .output import mesh_variables, point_variables, variable
 from .problem import Problem, build_problem
 
 MIN_INCREMENT = 1e-4  # of the elastic unloading settlement: below it a failing step stops the run
@@ -138,7 +138,7 @@ def run(problem: Problem, options, progress) -> tuple[State, History, dict]:
 
 def result_dataset(model: xr.Dataset, problem: Problem, state: State, history: History, info: dict,
                    spacing: float) -> xr.Dataset:
-    """FORMAT.md result variables (physical units) from the final converged state and the history."""
+    """docs/format.md result variables (physical units) from the final converged state and the history."""
     p, disc = problem, problem.disc
     H, U = p.length, p.displacement
     vertex = disc.vertex_dofs()

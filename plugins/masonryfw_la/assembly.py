@@ -64,7 +64,7 @@ class Wall:
     tensile_strength: np.ndarray
 
     @classmethod
-    def from_model(cls, model: xr.Dataset) -> "Wall":
+    def from_model(cls, model: xr.Dataset) -> Wall:
         # Variables, not DataArrays: building a DataArray for each of the 26 took 1.5 ms at 100 units
         v = {name: np.asarray(var.values) for name, var in model.variables.items()}
         return cls(

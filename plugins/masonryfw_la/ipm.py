@@ -127,12 +127,12 @@ def lower_pattern(constraints: sp.csr_matrix) -> tuple[sp.csc_matrix, sp.csr_mat
     pattern = sp.tril(structure, format="csc")
     pattern.sort_indices()
     slot_of = sp.csc_matrix((np.arange(1, pattern.nnz + 1), pattern.indices, pattern.indptr), shape=(n, n))
-    take = (cols[:, None, :] >= 0) & (cols[:, :, None] >= cols[:, None, :])  # (row, k, l): M[col k, col l]
+    take = (cols[:, None, :] >= 0) & (cols[:, :, None] >= cols[:, None, :])  # (row, k, j): M[col k, col j]
     indptr = np.concatenate([[0], np.cumsum(take.sum(axis=(1, 2)))])
     flat = np.flatnonzero(take)
-    row, k, l = flat // (width * width), (flat // width) % width, flat % width
-    slot = np.asarray(slot_of[cols[row, k], cols[row, l]]).ravel() - 1
-    products = vals[row, k] * vals[row, l]
+    row, k, j = flat // (width * width), (flat // width) % width, flat % width
+    slot = np.asarray(slot_of[cols[row, k], cols[row, j]]).ravel() - 1
+    products = vals[row, k] * vals[row, j]
     pairs = sp.csr_matrix((products, slot, indptr), shape=(n_row, pattern.nnz))
     return pattern, pairs
 

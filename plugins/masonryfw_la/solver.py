@@ -7,7 +7,8 @@ velocity field) and ``flow_rule = "associative"`` (dilatant joints).
 from __future__ import annotations
 
 import time
-from typing import Any, Mapping
+from collections.abc import Mapping
+from typing import Any
 
 import numpy as np
 import xarray as xr

@@ -6,16 +6,6 @@ import numpy as np
 import masonryfw as mf
 
 
-MAX_NAMED = 20
-
-
-def name_blocks(blocks: np.ndarray) -> str:
-    """``"12, 13"`` (the first few, then how many more)."""
-    shown = ", ".join(str(b) for b in blocks[:MAX_NAMED])
-    more = blocks.size - MAX_NAMED
-    return shown + (f" and {more} more" if more > 0 else "")
-
-
 def check_supported(wall) -> None:
     """Raise when a connected group of blocks touches no support and holds no component.
 
@@ -28,7 +18,7 @@ def check_supported(wall) -> None:
     np.logical_or.at(supported, labels, anchored)
     loose = np.flatnonzero(~supported[labels])
     if loose.size:
-        what = f"block {loose[0]} is" if loose.size == 1 else f"blocks {name_blocks(loose)} are"
+        what = f"block {loose[0]} is" if loose.size == 1 else f"blocks {mf.listed(loose)} are"
         raise mf.SolveError(
             f"{what} not supported: no chain of contacts links them to a support or a held "
             "block, so they can move as a rigid body with no joint resisting"

@@ -21,9 +21,10 @@ import hashlib
 import json
 import os
 import secrets
+from collections.abc import Mapping
 from datetime import datetime, timezone
 from pathlib import Path
-from typing import Any, Mapping
+from typing import Any
 
 import xarray as xr
 

@@ -16,9 +16,10 @@ import contextlib
 import logging
 import os
 import secrets
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Callable, Iterator, Mapping, Sequence
+from typing import Any
 
 import numpy as np
 import xarray as xr
@@ -34,7 +35,7 @@ from .params import (
     point_indices,
     resolve_option_params,
 )
-from .tasks import STATUS, run_point, status_of, failure_message
+from .tasks import STATUS, failure_message, run_point, status_of
 
 ZIP_DIM = "point"
 _RESERVED = {"status", "message", "key", "result_path", "from_store", "task_time_s", ZIP_DIM}
@@ -63,12 +64,12 @@ def _spec_source(spec: str | os.PathLike | dict):
     """``(spec dict, spec text)`` of a path, a bundled case name, TOML text or a dict."""
     if isinstance(spec, dict):
         return mf.load_spec(spec), mf.dump_toml(spec)
+    if isinstance(spec, str) and ("=" in spec or "\n" in spec):  # TOML text (may be too long for a file name)
+        return mf.load_spec(spec), spec
     if Path(spec).is_file():
         return mf.load_spec(spec), Path(spec).read_text(encoding="utf-8")
-    if isinstance(spec, str) and "=" not in spec and "\n" not in spec:
-        path = mf.bundled_spec_path(spec)
-        return mf.load_spec(path), path.read_text(encoding="utf-8")
-    return mf.load_spec(spec), str(spec)
+    path = mf.bundled_spec_path(str(spec))
+    return mf.load_spec(path), path.read_text(encoding="utf-8")
 
 
 def plan_sweep(

@@ -8,7 +8,8 @@ points a sweep has.
 from __future__ import annotations
 
 import time
-from typing import Any, Mapping, Sequence
+from collections.abc import Mapping, Sequence
+from typing import Any
 
 import xarray as xr
 

@@ -46,7 +46,7 @@ def _var(name, dims, values):
 
 
 def hand_model() -> xr.Dataset:
-    """The model drawn in the module docstring, FORMAT.md-complete, built without the builder."""
+    """The model drawn in the module docstring, docs/format.md-complete, built without the builder."""
     roles, kinds = mf.flags("block_role"), mf.flags("interface_kind")
     rects = np.array([r[:4] for r in RECTANGLES])
     node_x = np.stack([rects[:, 0], rects[:, 1], rects[:, 1], rects[:, 0]], axis=1).ravel()

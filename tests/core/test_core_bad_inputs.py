@@ -2,7 +2,7 @@
 no traceback, and the input file unchanged.
 
 The model cases break the hand-built five-block model of ``conftest.py`` (plain xarray,
-FORMAT.md) in one way each; the others are files that are not models at all, bad
+docs/format.md) in one way each; the others are files that are not models at all, bad
 specs, and bad solver requests.
 """
 from __future__ import annotations
@@ -193,5 +193,12 @@ def test_bad_solver_requests_list_the_valid_choices(model_file, tmp_path):
     _assert_clean_failure(onto_input, r"refusing to overwrite", model_file, digest)
 
 
-def test_the_corpus_holds_at_least_thirty_bad_inputs():
-    assert len(MODEL_CASES) + len(NOT_A_MODEL) + 2 + len(BAD_SPECS) + 3 >= 30
+def test_each_broken_model_differs_from_a_valid_one_by_its_break_alone(make_model):
+    """The unbroken model has no problem, so every problem the corpus reports comes from its own break."""
+    import masonryfw as mf
+
+    assert mf.check(make_model()) == []
+    for case, (breaker, message) in MODEL_CASES.items():
+        problems = mf.check(breaker(make_model()))
+        assert problems, case
+        assert any(__import__("re").search(message, str(p)) for p in problems), (case, [str(p) for p in problems])

@@ -4,10 +4,10 @@ from __future__ import annotations
 import copy
 import math
 import time
-import tomllib
 
 import numpy as np
 import pytest
+import tomllib
 
 import masonryfw
 from masonryfw import SpecError, build, flags, load_spec

@@ -244,7 +244,7 @@ def test_progress_bar_on_a_terminal_unless_no_progress(model_file, in_tmp, monke
 # ---------------------------------------------------------------- bundled cases and plugin commands
 
 def test_build_check_info_and_datasets_on_a_bundled_case(in_tmp):
-    """Test 12C (CASES.md): 1.1 x 0.6 x 0.1 m at 12 kN/m3, 6 x 12 = 72 units + 2 supports.
+    """Test 12C (datasets/README.md): 1.1 x 0.6 x 0.1 m at 12 kN/m3, 6 x 12 = 72 units + 2 supports.
 
     Closed form: W = 1.1 * 0.6 * 0.1 * 12000 = 792 N; the moving support (0.6 of 1.1 m)
     carries 792 * 0.6 / 1.1 = 432 N.

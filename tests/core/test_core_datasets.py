@@ -1,4 +1,4 @@
-"""The ten bundled walls against the paper's numbers (CASES.md) and closed-form reactions."""
+"""The ten bundled walls against the paper's numbers (datasets/README.md) and closed-form reactions."""
 from __future__ import annotations
 
 import numpy as np
@@ -9,7 +9,7 @@ from masonryfw import ModelError, build, bundled_cases, bundled_spec_path, flags
 
 ROLE = flags("block_role")
 
-# name: (title, units + lintels in the paper) -- /work/shared/CASES.md, paper sec. 3
+# name: (title, units + lintels in the paper) -- datasets/README.md, paper sec. 3
 PAPER = {
     "test-8c": ("Test 8C", 48),
     "test-12c": ("Test 12C", 72),

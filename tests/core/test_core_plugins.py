@@ -27,7 +27,6 @@ from masonryfw import plugins
 from masonryfw.cli import cli, main
 from masonryfw.errors import ModelError, PluginError, SolveError
 
-
 # ---------------------------------------------------------------- in-process plugins
 
 class ToyPlugin:

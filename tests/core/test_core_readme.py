@@ -1,10 +1,16 @@
 """The README's examples run as written (examples double as tests)."""
 from __future__ import annotations
 
+import os
 import re
 import subprocess
 import sys
 from pathlib import Path
+
+try:  # Python >= 3.11
+    import tomllib
+except ModuleNotFoundError:  # pragma: no cover - Python 3.10
+    import tomli as tomllib
 
 import numpy as np
 import xarray as xr
@@ -36,22 +42,48 @@ def test_the_spec_of_the_tour_builds_a_valid_wall(tmp_path):
     assert abs(masonry - (2.0 * 1.0 - 0.4 * 0.4)) < 1e-12
 
 
-def test_the_third_party_solver_of_the_tour_installs_and_solves(tmp_path):
-    package = tmp_path / "my_solver"
-    package.mkdir()
+def install_the_tour_plugin(site: Path) -> dict:
+    """The README's package written into ``site`` as pip would install it (its module and a dist-info with the
+    entry points of the README's pyproject.toml); returns that pyproject."""
+    package = site / "my_solver"
+    package.mkdir(parents=True)
     (package / "__init__.py").write_text(_block("python", "# my_solver/__init__.py"))
-    dist = tmp_path / "my_solver-0.1.dist-info"
+    pyproject = tomllib.loads(_block("toml", "# pyproject.toml of your package"))
+    project = pyproject["project"]
+    dist = site / f"my_solver-{project['version']}.dist-info"
     dist.mkdir()
-    (dist / "METADATA").write_text("Metadata-Version: 2.1\nName: my-solver\nVersion: 0.1\n")
-    entry_point = _block("toml", "# pyproject.toml of your package").split("\n", 1)[1].replace('"', "")
-    (dist / "entry_points.txt").write_text("[masonryfw]\n" + entry_point)
+    (dist / "METADATA").write_text(f"Metadata-Version: 2.1\nName: {project['name']}\nVersion: {project['version']}\n")
+    entry_points = "".join(f"{k} = {v}\n" for k, v in project["entry-points"]["masonryfw"].items())
+    (dist / "entry_points.txt").write_text("[masonryfw]\n" + entry_points)
+    return pyproject
+
+
+def test_the_third_party_solver_of_the_tour_installs_and_solves(tmp_path):
+    pyproject = install_the_tour_plugin(tmp_path)
+    assert pyproject["build-system"]["build-backend"] == "setuptools.build_meta"
     out = tmp_path / "toy.nc"
     done = subprocess.run(
         [sys.executable, "-m", "masonryfw", "solve", "test-12c", "--plugin", "toy", "-o", str(out), "--no-progress"],
         env={"PYTHONPATH": str(tmp_path), "PATH": "/usr/bin:/bin"}, capture_output=True, text=True, timeout=120,
     )
     assert done.returncode == 0, done.stderr
-    result = xr.open_dataset(out)
-    y = result.interface_y.values.mean(axis=1)
-    np.testing.assert_allclose(result.crack_indicator.values, (y - y.min()) / (y.max() - y.min()))
-    assert result.attrs["plugin_version"] == "0.1"
+    result = mf.open_dataset(out)
+    assert result.attrs["plugin_version"] == "0.1" and result.attrs["solver_version"].startswith("0.1+")
+    # the core derived the cracks: the head joints along the settling support's edge (x = 0.5 m) and the
+    # base joints over it; the units standing over the settling support are one macro-block
+    cracked = result.crack_indicator.values > 0
+    head = result.interface_kind.values == mf.flags("interface_kind")["head"]
+    assert np.all(np.isclose(result.interface_x.values[cracked & head], 0.5, atol=0.1))
+    assert np.unique(result.macro_block.values[mf.block_motion(result)[:, 1] < 0]).size == 1
+
+
+def test_the_conformance_kit_of_the_tour_passes_for_the_tour_plugin(tmp_path):
+    install_the_tour_plugin(tmp_path / "site")
+    tests = tmp_path / "tests"
+    tests.mkdir()
+    (tests / "test_toy.py").write_text(_block("python", "# tests/test_toy.py"))
+    done = subprocess.run([sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", str(tests)],
+                          env={**os.environ, "PYTHONPATH": str(tmp_path / "site")}, capture_output=True, text=True,
+                          timeout=300, cwd=tmp_path)
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert re.search(r"\b8 passed", done.stdout), done.stdout

@@ -4,9 +4,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 import scipy.sparse as sp
+import xarray as xr
 from scipy.sparse.csgraph import connected_components
 
 import masonryfw as mf
+import masonryfw.testing as mt
 from masonryfw import connected_components as components
 
 
@@ -48,3 +50,185 @@ def test_polar_moment_of_a_rectangle_and_a_triangle_far_from_the_origin():
     assert moment[1] == pytest.approx(6 * (9 + 16 + 25) / 36, rel=1e-9)
 
 
+
+
+# ---------------------------------------------------------------- relative motion against closed forms
+
+def two_blocks():
+    """A 1 x 0.5 unit B (block 1) on a fixed 1 x 0.2 base A (block 0): one bed joint, ends at x = 0 and x = 1."""
+    return mt.rectangles_model([(0.0, -0.2, 1.0, 0.0), (0.0, 0.0, 1.0, 0.5)], ["fixed_support", "unit"],
+                               loading="tilt")
+
+
+def rotation_about(pivot, theta, centroid):
+    """Block motion (ux, uy, rz) of a rotation by ``theta`` about ``pivot`` (finite)."""
+    c = np.asarray(centroid) - pivot
+    moved = pivot + np.array([[np.cos(theta), -np.sin(theta)], [np.sin(theta), np.cos(theta)]]) @ c
+    return np.array([*(moved - centroid), theta])
+
+
+@pytest.mark.parametrize("theta", [1e-3, 0.3])
+def test_finite_rotation_about_a_corner_opens_the_far_end_by_l_sin_theta(theta):
+    """B tips about its left bottom corner: end 1 (x = 1) moves by (L (cos - 1), L sin); end 0 stays."""
+    model = two_blocks()
+    u = np.zeros((2, 3))
+    u[1] = rotation_about(np.array([0.0, 0.0]), theta, [0.5, 0.25])
+    opening, slip = mf.relative_motion(model, u, "finite")
+    assert opening[0] == pytest.approx([0.0, np.sin(theta)], abs=1e-14)
+    assert slip[0] == pytest.approx([0.0, np.cos(theta) - 1.0], abs=1e-14)
+
+
+def test_a_mechanism_moves_points_by_the_linearised_rotation():
+    """The same motion read as a velocity field: opening theta L, no slip, whatever theta's size."""
+    model = two_blocks()
+    theta = 0.3
+    u = np.zeros((2, 3))
+    u[1] = (-theta * 0.25, theta * 0.5, theta)  # v_c = w x (c - pivot), c - pivot = (0.5, 0.25)
+    opening, slip = mf.relative_motion(model, u, "small")
+    assert opening[0] == pytest.approx([0.0, theta], abs=1e-14)
+    assert slip[0] == pytest.approx([0.0, 0.0], abs=1e-14)
+
+
+def test_side_one_minus_side_zero_with_the_interface_frame():
+    """A translation of B by (a, b) over a fixed A: opening b (n = +y), slip a (t = +x) at both ends."""
+    model = two_blocks()
+    u = np.zeros((2, 3))
+    u[1, :2] = (0.02, 0.005)
+    for rotations in ("small", "finite"):
+        opening, slip = mf.relative_motion(model, u, rotations)
+        assert opening[0] == pytest.approx([0.005, 0.005]) and slip[0] == pytest.approx([0.02, 0.02])
+
+
+# ---------------------------------------------------------------- states, indicator, macro-blocks
+
+STATE = mf.flags("interface_state")
+
+
+def test_states_by_hand():
+    """Threshold 0.1; rows: still, tipping, sliding with dilatancy mu = 0.5, sliding and lifting, closing."""
+    opening = np.array([[0.0, 0.05], [0.0, 1.0], [0.5, 0.5], [1.0, 0.6], [-1.0, -1.0]])
+    slip = np.array([[0.0, 0.0], [0.05, 0.05], [1.0, 1.0], [1.0, 1.0], [0.0, 0.0]])
+    associative = mf.interface_states(opening, slip, 0.5, 0.1)
+    assert associative.tolist() == [STATE["intact"], STATE["open"], STATE["slide"], STATE["open_slide"],
+                                    STATE["intact"]]
+    # without dilatancy the same opening beside a slip is an opening beyond it
+    nonassociative = mf.interface_states(opening, slip, 0.0, 0.1)
+    assert nonassociative[2] == STATE["open_slide"]
+    assert mf.joint_motion(opening, slip).tolist() == pytest.approx(
+        [0.05, np.hypot(1.0, 0.05), np.hypot(0.5, 1), np.hypot(1, 1), 0.0])  # closing is no motion
+
+
+def test_crack_indicator_is_relative_to_the_largest_masonry_joint():
+    motion = np.array([2.0, 1.0, 0.03, 0.019, 5.0])
+    masonry = np.array([True, True, True, True, False])  # the last is ground against ground
+    indicator = mf.crack_indicator(motion, masonry)
+    assert indicator.tolist() == pytest.approx([1.0, 0.5, 0.015, 0.0, 0.0])  # 0.019 / 2 is below 1 %
+    assert mf.INTACT_SHARE == 0.01
+
+
+def union_find_groups(n, pairs):
+    parent = list(range(n))
+
+    def root(i):
+        while parent[i] != i:
+            i = parent[i]
+        return i
+
+    for a, b in pairs:
+        parent[root(a)] = root(b)
+    return [root(i) for i in range(n)]
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_macro_blocks_are_the_groups_joined_by_intact_joints(seed):
+    rng = np.random.default_rng(seed)
+    n = 40
+    pairs = rng.integers(0, n, size=(60, 2))
+    state = rng.choice([STATE["intact"], STATE["open"], STATE["slide"]], size=60)
+    labels = mf.macro_blocks(n, pairs, state)
+    groups = union_find_groups(n, pairs[state == STATE["intact"]])
+    same = np.equal.outer(labels, labels)
+    assert np.array_equal(same, np.equal.outer(groups, groups))
+
+
+# ---------------------------------------------------------------- derived once by mf.solve, for any solver
+
+class Plugin:
+    def __init__(self, solver):
+        self.solver = solver
+
+    @mf.hookimpl
+    def masonryfw_solvers(self):
+        return [self.solver]
+
+
+@pytest.fixture
+def registered(monkeypatch):
+    from masonryfw import plugins
+
+    plugins.reset()
+    manager = mf.plugin_manager()
+
+    def register(solve, name="tipping"):
+        manager.register(Plugin(mf.Solver(name, "hand mechanism", solve)), name=name)
+    yield register
+    plugins.reset()
+
+
+def test_a_third_party_mechanism_gets_the_core_s_fields(registered):
+    """B tips about its left corner: its bed joint opens (state open, indicator 1), B is its own macro-block."""
+    theta = 0.01
+
+    def tipping(model, options, progress):
+        u = np.zeros((2, 3))
+        u[1] = (-theta * 0.25, theta * 0.5, theta)
+        return xr.Dataset(mf.motion_variables(u), attrs={"rotations": "small", "flow_rule": "associative"})
+
+    registered(tipping)
+    result = mf.solve(two_blocks(), "tipping")
+    assert result.interface_opening.values[0] == pytest.approx([0.0, theta])
+    assert result.interface_state.values.tolist() == [STATE["open"]]
+    assert result.crack_indicator.values.tolist() == [1.0]
+    assert result.macro_block.values.tolist() == [0, 1]
+
+
+@pytest.mark.parametrize("attrs, returned, message", [
+    ({"flow_rule": "associative"}, {}, "without the attribute 'rotations'"),
+    ({"rotations": "small", "flow_rule": "associative"}, {"crack_indicator": ("interface", [0.5])},
+     "returned crack_indicator with block_displacement"),
+])
+def test_the_core_refuses_a_mechanism_it_cannot_read(registered, attrs, returned, message):
+    def solve(model, options, progress):
+        return xr.Dataset({**mf.motion_variables(np.zeros((2, 3))), **returned}, attrs=attrs)
+
+    registered(solve)
+    with pytest.raises(mf.SolveError, match=message):
+        mf.solve(two_blocks(), "tipping")
+
+
+# ---------------------------------------------------------------- key numbers
+
+def history_result(settlement, reaction):
+    model = two_blocks()
+    return model.assign(step_settlement=("step", settlement), step_reaction=("step", reaction))
+
+
+def test_key_numbers_of_a_history_by_hand():
+    """Gravity at s = 0 (R0 = 100 N), a dip to 40 N at 2 mm, then 50.4, 50, 49.8, 50.3 N: within 1 N of the last from 4 mm."""
+    settlement = np.array([0.0, 0.0, 0.001, 0.002, 0.003, 0.004, 0.005, 0.006, 0.007])
+    reaction = np.array([0.0, 100.0, 70.0, 40.0, 45.0, 50.4, 50.0, 49.8, 50.3])
+    numbers = {n.name: n.value for n in mf.key_numbers(history_result(settlement, reaction))}
+    assert numbers["dead_reaction"] == 100.0
+    assert (numbers["minimum_reaction"], numbers["minimum_reaction_settlement"]) == (40.0, 0.002)
+    assert numbers["plateau_settlement"] == 0.004
+    assert numbers["plateau_reaction"] == pytest.approx((50.4 + 50.0 + 49.8 + 50.3) / 4)
+    assert numbers["final_settlement"] == 0.007
+
+
+def test_key_numbers_of_a_limit_analysis_are_alpha_and_the_reaction_at_collapse():
+    model = mt.rectangles_model([(0.0, -0.2, 0.5, 0.0), (0.5, -0.2, 1.0, 0.0), (0.0, 0.0, 1.0, 0.5)],
+                                ["fixed_support", "moving_support", "unit"])
+    result = model.assign(collapse_multiplier=((), 0.25))
+    numbers = {n.name: n.value for n in mf.key_numbers(result)}
+    r0 = 12e3 * 0.5 * 0.1 * 0.5  # weight times the moving support's half of the contact
+    assert numbers == pytest.approx({"alpha": 0.25, "collapse_reaction": 0.75 * r0})

@@ -145,7 +145,6 @@ def jmm_result(
         failure[qy > rows * H - dx * 0.5] = 1
     steps = np.linspace(0.0, 0.005, 6)
     return model.assign(
-        mesh=((), np.int32(0), _attrs("mesh")),
         mesh_node_x=("mesh_node", gx.ravel(), _attrs("mesh_node_x")),
         mesh_node_y=("mesh_node", gy.ravel(), _attrs("mesh_node_y")),
         mesh_face_nodes=(("mesh_face", "mesh_face_node"), faces.astype(np.int32), _attrs("mesh_face_nodes")),

@@ -5,10 +5,9 @@ from itertools import combinations
 
 import numpy as np
 import pytest
-
-import masonryfw as mf
 from scipy.stats import spearmanr
 
+import masonryfw as mf
 from masonryfw_compare import scores
 from masonryfw_compare.shapes import distance_to_segments
 

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import masonryfw as mf
-from masonryfw_fdem.deformable import cst_forces, fan_triangles, shape_gradients
+from masonryfw_fdem.deformable import cst_element_forces, element_constants, fan_triangles, shape_gradients
 
 ROLE = mf.flags("block_role")
 
@@ -31,8 +31,9 @@ def internal_forces(x, y, x0, y0, triangles, young, nu):
     grad_x, grad_y, area = shape_gradients(x0, y0, triangles)
     n_tri = triangles.shape[0]
     force = np.zeros((x0.size, 2))
-    energy = cst_forces(x, y, triangles, grad_x, grad_y, area, np.full(n_tri, young), np.full(n_tri, nu),
-                        np.ones(n_tri, dtype=np.bool_), force)
+    packed, constants = element_constants(triangles, grad_x, grad_y, area, np.full(n_tri, young),
+                                          np.full(n_tri, nu), np.ones(n_tri, dtype=np.bool_))
+    energy = cst_element_forces(x, y, packed, constants, force)  # the time loop's kernel
     return force, energy
 
 

@@ -25,11 +25,10 @@ def result(model):
 
 
 def test_result_has_the_format_variables(result):
-    for name in ["mesh", "mesh_node_x", "mesh_node_y", "mesh_face_nodes", "mesh_node_ux", "mesh_node_uy",
+    for name in ["mesh_node_x", "mesh_node_y", "mesh_face_nodes", "mesh_node_ux", "mesh_node_uy",
                  "qp_x", "qp_y", "qp_failure", "step_settlement", "step_reaction", "step_newton_iterations",
                  "crack_indicator"]:
         assert name in result, name
-    assert result["mesh"].attrs["cf_role"] == "mesh_topology"
     assert mf.check(result) == []
     assert set(np.unique(result.qp_failure.values)) <= {0, 1, 2, 3}
     assert ((result.crack_indicator.values >= 0) & (result.crack_indicator.values <= 1)).all()

@@ -51,8 +51,8 @@ def static_alpha(model) -> float:
     Maximise alpha with HiGHS. By the static theorem (and LP duality) this is the
     collapse multiplier of the associative kinematic programme.
     """
-    from scipy.optimize import linprog
     import scipy.sparse as sp
+    from scipy.optimize import linprog
 
     blocks = model.interface_blocks.values.astype(int)
     n_if, n_block = blocks.shape[0], model.sizes["block"]

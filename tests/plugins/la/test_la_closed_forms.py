@@ -61,7 +61,7 @@ def test_la_unit_over_a_settling_support(walls, backend, a):
     model = unit_on_two_supports(walls, a, b)
     result = walls.solve(model, solver=backend)
     assert float(result.collapse_multiplier) == pytest.approx(expected, abs=1e-7)
-    # the moving support moves a unit distance down (FORMAT.md normalisation)
+    # the moving support moves a unit distance down (docs/format.md normalisation)
     np.testing.assert_allclose(mf.block_motion(result)[1], [0.0, -1.0, 0.0], atol=1e-12)
     dead_reaction = float(model.dead_load.values[1, 1])
     assert float(result.moving_support_reaction) == pytest.approx(
