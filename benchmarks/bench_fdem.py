@@ -44,7 +44,7 @@ def timed(model, options):
 
 
 def dead_reaction(model) -> float:
-    return float(model.dead_load.values[model.block_role.values == ROLE["moving_support"], 1].sum())
+    return mf.dead_reaction(model)
 
 
 def throughput_row(case: str, options: dict) -> str:
@@ -54,7 +54,7 @@ def throughput_row(case: str, options: dict) -> str:
     pairs = result.attrs["fdem_face_pairs"]
     settled = 1e3 * result.step_settlement.values[-1]
     return (f"| {case} | {int((model.block_role.values < 2).sum())} | {options or 'defaults'} | {settled:.1f} | "
-            f"{result.attrs['fdem_stop_reason']} | {steps} | {result.attrs['fdem_dt_s']:.2e} | {seconds:.1f} | "
+            f"{result.attrs['stop_reason']} | {steps} | {result.attrs['fdem_dt_s']:.2e} | {seconds:.1f} | "
             f"{seconds / steps * 1e6:.0f} | {pairs * steps / seconds / 1e6:.1f} |")
 
 
@@ -214,7 +214,7 @@ def mode_rows(case: str) -> list[str]:
         scores = mf.compare(rigid, result)
         rows.append(
             f"| {case} | {mode} | {result.attrs['fdem_steps']} | {result.attrs['fdem_dt_s']:.2e} | {seconds:.1f} | "
-            f"{result.attrs['fdem_stop_reason']} | {result.step_reaction.values[phase].min() / r0:.3f} | "
+            f"{result.attrs['stop_reason']} | {result.step_reaction.values[phase].min() / r0:.3f} | "
             f"{result.step_reaction.values[-1] / r0:.3f} | {scores.crack_f1.item():.2f} | "
             f"{scores.macro_block_ari.item():.2f} | {abs(result.step_energy_error.values).max():.1e} |")
         print(rows[-1], flush=True)

@@ -78,13 +78,13 @@ def model_dataset(node_x, node_y, counts, found) -> xr.Dataset:
             "interface_friction": var("interface_friction", "interface", np.full(ni, 0.6)),
             "interface_cohesion": var("interface_cohesion", "interface", np.zeros(ni)),
             "interface_tensile_strength": var("interface_tensile_strength", "interface", np.zeros(ni)),
-            "dead_load": var("dead_load", ("block", "dof"), dead),
-            "live_load": var("live_load", ("block", "dof"), live),
+            **mf.load_variables("dead", dead),
+            **mf.load_variables("live", live),
             "block_fixed": var("block_fixed", ("block", "dof"), fixed),
             "settlement_direction": var("settlement_direction", ("block", "dof"), direction),
         },
         coords={"dof": ("dof", ["ux", "uy", "rz"], mf.variable_attrs("dof"))},
-        attrs={"Conventions": "CF-1.11", "masonryfw_format": "model", "masonryfw_format_version": 1,
+        attrs={"Conventions": "CF-1.11", "masonryfw_format": "model", "masonryfw_format_version": mf.FORMAT_VERSION,
                "title": "running bond benchmark"},
     )
 

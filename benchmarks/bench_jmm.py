@@ -16,10 +16,10 @@ from _report import write_section
 import masonryfw as mf
 from masonryfw_jmm.material import JointStrength, ReturnMap, elastic_matrix
 from masonryfw_jmm.newton import NewtonSolver, State
-from masonryfw_jmm.options import OPTIONS
+from masonryfw_jmm.options import INCREMENTAL_OPTIONS
 from masonryfw_jmm.problem import build_problem
 
-DEFAULT = {o.name: o.default for o in OPTIONS}
+DEFAULT = {o.name: o.default for o in INCREMENTAL_OPTIONS}
 
 
 def median_time(function, repeat: int = 5) -> float:
@@ -74,7 +74,7 @@ def whole_run(spec: str) -> str:
     reaction = result.step_reaction.values
     iterations = result.step_newton_iterations.values[1:]
     return (f"| {result.attrs['title']} {given} | {result.attrs['jmm_dofs']} | {seconds:.0f} | {reaction.size - 1} | "
-            f"{iterations.mean():.1f} | {reaction[0]:.1f} | {reaction[-1]:.1f} | {result.attrs['jmm_stop_reason']} |")
+            f"{iterations.mean():.1f} | {reaction[0]:.1f} | {reaction[-1]:.1f} | {result.attrs['stop_reason']} |")
 
 
 CONVERGENCE_SETTLEMENT = 1e-5  # m: past the 1 % plateau of Test 12C (6.5e-6 m at 25 mm), where R creeps slowly
@@ -89,7 +89,7 @@ def fixed_settlement_run(case: str, **given):
     result = mf.solve(mf.open_model(case), "jmm", options)
     seconds = time.perf_counter() - start
     if not np.isclose(result.step_settlement.values[-1], CONVERGENCE_SETTLEMENT):
-        raise RuntimeError(f"{case} {given}: stopped early ({result.attrs['jmm_stop_reason']})")
+        raise RuntimeError(f"{case} {given}: stopped early ({result.attrs['stop_reason']})")
     return result, seconds
 
 
@@ -109,13 +109,13 @@ def convergence(case: str = "test-12c") -> str:
     """Reaction and plastic-zone pattern at a fixed settlement against mesh size and first load step.
 
     The reaction's reference is independent of the incremental solver: the static limit LP
-    on the same continuum (method=limit), whose value on Test 12C is the closed-form wedge
+    on the same continuum (the jmm-limit solver), whose value on Test 12C is the closed-form wedge
     reaction W_moving - gamma t h^2 tan(phi) / 2 (docs/jmm.md). The pattern is the
     crack_indicator on the block model's joints (mesh-independent), scored by the compare
     plugin against the finest run's.
     """
     start = time.perf_counter()
-    collapse = mf.solve(mf.open_model(case), "jmm", {"method": "limit"})
+    collapse = mf.solve(mf.open_model(case), "jmm-limit")
     limit_seconds = time.perf_counter() - start
     reference = float(collapse.moving_support_reaction)
     mesh = {h: fixed_settlement_run(case, mesh_size=h) for h in MESH_SIZES}
@@ -136,7 +136,7 @@ def convergence(case: str = "test-12c") -> str:
         f"**Convergence on Test 12C**: reaction on the moving support at a settlement of "
         f"{CONVERGENCE_SETTLEMENT * 1000:.3f} mm (the plateau stop turned off, so every run ends at the same "
         f"settlement), against the collapse reaction of the same continuum from the static limit LP "
-        f"(`method=limit`, 25 mm: {reference:.2f} N in {limit_seconds:.1f} s; the closed-form wedge gives 345.61 N "
+        f"(`jmm-limit`, 25 mm: {reference:.2f} N in {limit_seconds:.1f} s; the closed-form wedge gives 345.61 N "
         "at apex_shift 0). Displacement elements let the wall arch too easily, so the reaction comes out "
         "low and rises towards the collapse value as the mesh is refined; the cells follow the 200 x 50 mm "
         "units, so the nominal sizes are not a geometric sequence. The plastic-zone pattern is the "

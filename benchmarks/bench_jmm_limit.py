@@ -1,4 +1,4 @@
-"""Benchmark of ``jmm`` method=limit (the static LP on the mesh): LP size, times, alpha, against LA.
+"""Benchmark of the ``jmm-limit`` solver (the static LP on the mesh): LP size, times, alpha, against LA.
 
 Run from the benchmarks folder: ``python bench_jmm_limit.py [case ...]`` (default: test-8c test-12c facade-3;
 ``--incremental`` also runs the incremental solver to its plateau on the same mesh, up to a minute per wall).
@@ -15,19 +15,16 @@ import numpy as np
 from _report import write_section
 
 import masonryfw as mf
-from masonryfw_jmm.limit import solve_limit
-from masonryfw_jmm.options import OPTIONS
 
 FLAG = mf.flags("qp_failure")
 
 
 def limit_row(case: str, repeat: int, incremental: bool) -> str:
-    model = mf.derive_geometry(mf.open_model(case))
-    options = {o.name: o.default for o in OPTIONS}
+    model = mf.open_model(case)
     times, result = [], None
     for _ in range(repeat):
         start = time.perf_counter()
-        result = solve_limit(model, options, mf.no_progress)
+        result = mf.solve(model, "jmm-limit")
         times.append(time.perf_counter() - start)
     a = result.attrs
     flags = np.bincount(result.qp_failure.values, minlength=4)
@@ -57,11 +54,11 @@ def main() -> None:
         "`--incremental`), its alpha = 1 - plateau / R_0. "
         "Plastic points: tensile/shear/tensile_shear among 3 points per triangle.\n\n"
         "| wall | LP variables | equalities | inequalities | nonzeros | IPM iterations | assembly [s] | "
-        "LP solve [s] | whole solve_limit [s] | R_0 [N] | R_min [N] | alpha (limit) | incremental plateau [N] (alpha) | "
+        "LP solve [s] | whole solve [s] | R_0 [N] | R_min [N] | alpha (limit) | incremental plateau [N] (alpha) | "
         "LA alpha | plastic t/s/ts |\n"
         "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n" + "\n".join(rows)
     )
-    write_section("jmm_limit", "jmm method=limit: the static LP of the JMM continuum on the mesh", body)
+    write_section("jmm_limit", "jmm-limit: the static LP of the JMM continuum on the mesh", body)
 
 
 if __name__ == "__main__":

@@ -157,7 +157,7 @@ def main() -> None:
         assert len(plan.points) == 40
         one, cpu_one, sweep_one = timed_sweep(plan, 1, folder)
         two, cpu_two, sweep_two = timed_sweep(plan, 2, folder)
-        assert (sweep_one.collapse_multiplier == sweep_two.collapse_multiplier).all()
+        assert (sweep_one.alpha == sweep_two.alpha).all()
         local = in_process(plan, folder)
         memory = scheduler_memory(folder)
     load_after = os.getloadavg()[0]

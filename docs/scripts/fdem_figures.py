@@ -32,12 +32,6 @@ def masonry_macro_blocks(result) -> int:
     return int(np.unique(result.macro_block.values[masonry]).size)
 
 
-def model_dead_reaction(ds) -> float:
-    """The moving supports' upward dead load: the paper's R0 (uniform distribution of the weight)."""
-    moving = ds.block_role.values == mf.flags("block_role")["moving_support"]
-    return float(ds.dead_load.values[moving, 1].sum())
-
-
 def largest_share(result, count: int) -> float:
     masonry = result.block_role.values < 2
     sizes = np.sort(np.bincount(result.macro_block.values[masonry]))[::-1]
@@ -49,7 +43,7 @@ def history_figure(fdem, la, path: Path) -> None:
     ax = figure.add_subplot()
     phase = fdem.step_phase.values == 1
     ax.plot(fdem.step_settlement.values[phase] * 1e3, fdem.step_reaction.values[phase], label="fdem")
-    dead = model_dead_reaction(fdem)
+    dead = mf.dead_reaction(fdem)
     alpha = la.collapse_multiplier.item()
     ax.axhline((1 - alpha) * dead, color="k", ls="--", lw=0.8, label=f"la: (1 - alpha) R0, alpha = {alpha:.3f}")
     ax.axhline(dead, color="0.5", ls=":", lw=0.8, label="R0 (dead reaction of the model)")
@@ -69,7 +63,7 @@ def run_case(case: str, options: dict) -> dict:
     scores = mf.compare(la, fdem)
     mf.render([la, fdem], "compare").savefig(OUT / f"{case}.png", dpi=100)
     history_figure(fdem, la, OUT / f"{case}-history.png")
-    dead = model_dead_reaction(model)
+    dead = mf.dead_reaction(model)
     settlement = fdem.step_settlement.values
     phase = fdem.step_phase.values == 1
     return {
@@ -77,7 +71,7 @@ def run_case(case: str, options: dict) -> dict:
         "blocks": int((model.block_role.values < 2).sum()),
         "time_s": seconds,
         "steps": int(fdem.attrs["fdem_steps"]),
-        "stop": fdem.attrs["fdem_stop_reason"],
+        "stop": fdem.attrs["stop_reason"],
         "settlement_mm": 1e3 * float(settlement.max()),
         "r0_fdem": float(fdem.step_reaction.values[~phase][-1] / dead),
         "reaction_min_fdem": float(fdem.step_reaction.values[phase].min() / dead),

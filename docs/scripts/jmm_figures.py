@@ -35,7 +35,7 @@ def figures(case: str, options: dict) -> dict:
         "plateau": float(reaction[-1]), "alpha_jmm": float(1 - reaction[-1] / reaction[0]),
         "settlement_mm": float(jmm.step_settlement.values[-1] * 1e3), "steps": int(reaction.size - 1),
         "newton": float(jmm.attrs["jmm_mean_newton_iterations"]), "dofs": int(jmm.attrs["jmm_dofs"]),
-        "seconds": seconds, "stop": jmm.attrs["jmm_stop_reason"],
+        "seconds": seconds, "stop": jmm.attrs["stop_reason"],
     }
 
 

@@ -26,7 +26,7 @@ def deformed_polygons(result, scale: float) -> list[np.ndarray]:
     counts = result.block_node_count.values
     start = mf.block_offsets(counts)
     x, y = result.node_x.values, result.node_y.values
-    u = result.block_displacement.values * scale
+    u = mf.block_motion(result) * scale
     cx, cy = result.block_centroid_x.values, result.block_centroid_y.values
     owner = mf.node_block(counts)
     dx = u[owner, 0] - u[owner, 2] * (y - cy[owner])
@@ -37,7 +37,7 @@ def deformed_polygons(result, scale: float) -> list[np.ndarray]:
 def joint_segments(result, scale: float, cracked: np.ndarray) -> np.ndarray:
     """Cracked joints drawn on the side-0 block's deformed position, shape (k, 2, 2)."""
     side0 = result.interface_blocks.values[cracked, 0]
-    u = result.block_displacement.values[side0] * scale
+    u = mf.block_motion(result)[side0] * scale
     cx, cy = result.block_centroid_x.values[side0], result.block_centroid_y.values[side0]
     px, py = result.interface_x.values[cracked], result.interface_y.values[cracked]
     dx = u[:, :1] - u[:, 2:3] * (py - cy[:, None])
@@ -48,7 +48,7 @@ def joint_segments(result, scale: float, cracked: np.ndarray) -> np.ndarray:
 def draw(result, ax) -> None:
     """One mechanism on ``ax``."""
     size = mf.model_scale(result.node_x.values, result.node_y.values)
-    translation = np.hypot(*result.block_displacement.values[:, :2].T).max()
+    translation = np.hypot(*mf.block_motion(result)[:, :2].T).max()
     scale = DISPLAY_SHIFT * size / translation if translation > 0 else 0.0
     polys = deformed_polygons(result, scale)
     macro = result.macro_block.values

@@ -58,14 +58,14 @@ def zone_params(width: float) -> list[str]:
 def draw(sweep, spec: dict, path: Path) -> None:
     start = sweep.supports_settling_start.values
     length = np.round(sweep.supports_settling_end.values - start, 10)
-    alpha = sweep.collapse_multiplier.values
+    alpha = sweep.alpha.values
     figure = Figure(figsize=(7.5, 5.2), layout="constrained")
     top, bottom = figure.subplots(2, 1, sharex=True, height_ratios=(3, 1.3))
     for value in LENGTHS:
         rows = np.isclose(length, value)
         centre = start[rows] + value / 2
         top.plot(centre, alpha[rows], "o-", ms=3.5, label=f"L = {value:g} m")
-        bottom.plot(centre, sweep.macro_block_count.values[rows], "o-", ms=3)
+        bottom.plot(centre, sweep.macro_blocks.values[rows], "o-", ms=3)
     for opening in spec.get("openings", []):
         for axes in (top, bottom):
             axes.axvspan(opening["x"], opening["x"] + opening["width"], color="0.9", zorder=0)
@@ -85,7 +85,7 @@ def table(sweep) -> str:
     """Markdown: per length, the smallest and largest alpha and where the zone sits."""
     start = sweep.supports_settling_start.values
     length = np.round(sweep.supports_settling_end.values - start, 10)
-    alpha = sweep.collapse_multiplier.values
+    alpha = sweep.alpha.values
     lines = ["| L [m] | points | min alpha | zone at min [m] | max alpha | zone at max [m] |", "|---:|---:|---:|---|---:|---|"]
     for value in LENGTHS:
         rows = np.flatnonzero(np.isclose(length, value) & np.isfinite(alpha))
@@ -99,7 +99,7 @@ def mirror_gap(sweep, width: float) -> float:
     """Largest difference of alpha between a zone a..a+L and its mirror image width-a-L..width-a."""
     start = np.round(sweep.supports_settling_start.values, 10)
     end = np.round(sweep.supports_settling_end.values, 10)
-    alpha = dict(zip(zip(start, end), sweep.collapse_multiplier.values))
+    alpha = dict(zip(zip(start, end), sweep.alpha.values))
     gaps = [abs(value - alpha[(np.round(width - e, 10), np.round(width - a, 10))])
             for (a, e), value in alpha.items() if np.isfinite(value)]
     return max(gaps)

@@ -13,7 +13,6 @@ except ModuleNotFoundError:  # pragma: no cover - Python 3.10
     import tomli as tomllib
 
 import numpy as np
-import xarray as xr
 
 import masonryfw as mf
 
