@@ -77,6 +77,8 @@ from .semantics import (
     masonry_blocks,
     masonry_joints,
     model_scales,
+    nearest_interface,
+    plastic_crack_indicator,
     point_motion,
     polar_moment,
     relative_motion,

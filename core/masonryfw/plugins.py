@@ -33,8 +33,8 @@ from .hookspecs import resolved as resolved_function
 from .io import CONVENTIONS, add_history, content_sha256
 from .model import checked_model
 from .progress import ProgressCallback, no_progress
-from .schema import FORMAT_VERSION
-from .semantics import DERIVED_RESULT_VARIABLES, FLOW_RULES, ROTATIONS, derived_variables
+from .schema import FORMAT_VERSION, variable_attrs
+from .semantics import DERIVED_RESULT_VARIABLES, FLOW_RULES, ROTATIONS, derived_variables, plastic_crack_indicator
 
 #: record kind -> (hook name, record type)
 _HOOKS = {
@@ -335,15 +335,20 @@ def solver_version(name: str) -> str:
 
 
 def _derive_comparable_fields(name: str, model: xr.Dataset, produced: xr.Dataset) -> xr.Dataset:
-    """``produced`` with the fields :mod:`.semantics` derives from its ``block_displacement``."""
-    if "block_displacement" not in produced:
+    """``produced`` with the fields :mod:`.semantics` derives from its ``block_displacement`` or ``qp_failure``."""
+    primary = "block_displacement" if "block_displacement" in produced else "qp_failure"
+    if primary not in produced:
         return produced
     derived_too = sorted(map(str, set(produced.data_vars) & set(DERIVED_RESULT_VARIABLES)))
     if derived_too:
         raise SolveError(
-            f"solver {name} returned {', '.join(derived_too)} with block_displacement; the core derives "
-            "them from block_displacement (docs/format.md): return only the primary fields"
+            f"solver {name} returned {', '.join(derived_too)} with {primary}; the core derives "
+            f"them from {primary} (docs/format.md): return only the primary fields"
         )
+    if primary == "qp_failure":
+        indicator = plastic_crack_indicator(model, produced.qp_x.values, produced.qp_y.values,
+                                            produced.qp_failure.values > 0)
+        return produced.assign(crack_indicator=("interface", indicator, variable_attrs("crack_indicator")))
     for attribute, choices in (("rotations", ROTATIONS), ("flow_rule", FLOW_RULES)):
         if produced.attrs.get(attribute) not in choices:
             raise SolveError(

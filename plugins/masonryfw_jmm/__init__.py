@@ -3,7 +3,8 @@
 Registration only (scikit-fem is imported when a solve starts); the method lives in
 :mod:`.material` (the JMM return mapping), :mod:`.mesh`, :mod:`.fem`, :mod:`.problem`,
 :mod:`.newton`, :mod:`.solver` (incremental settlement) and :mod:`.limit` (the static
-limit LP on the same mesh), and :mod:`.cracks`.
+limit LP on the same mesh). Their plastic points (``qp_failure``) become
+``crack_indicator`` in the core, like every continuum result's.
 """
 from __future__ import annotations
 

@@ -51,7 +51,6 @@ from skfem import MeshTri
 
 import masonryfw as mf
 
-from .cracks import crack_indicator
 from .material import failure_mode
 from .output import mesh_variables, point_variables, variable
 from .problem import Domain, wall_domain
@@ -342,7 +341,7 @@ def collapse_points(field: StaticField, stress: np.ndarray) -> tuple[np.ndarray,
     return xy.transpose(0, 2, 1).reshape(2, -1), at_points.reshape(-1, 3)
 
 
-def limit_dataset(model: xr.Dataset, domain: Domain, lp: SettlementLP, sol: LPSolution, names: tuple[str, ...],
+def limit_dataset(domain: Domain, lp: SettlementLP, sol: LPSolution, names: tuple[str, ...],
                   assembly: float) -> xr.Dataset:
     """The result variables (physical units) of the limit LP (docs/format.md)."""
     field, H, S = lp.field, domain.length, domain.stress
@@ -363,8 +362,6 @@ def limit_dataset(model: xr.Dataset, domain: Domain, lp: SettlementLP, sol: LPSo
                                     "alpha = 1 - R_min / (W L_moving / L_contact), lower bound on the mesh"),
         "moving_support_reaction": variable((), reaction, "N",
                                         "smallest upward vertical reaction of the moving support (static LP)"),
-        "crack_indicator": variable("interface", crack_indicator(model, qx, qy, failure > 0, domain.mesh_size / 4), "1",
-                                "fraction of the nearest points that are plastic in the collapse mechanism"),
     }
     attrs = {
         "jmm_beta": domain.beta,
@@ -393,6 +390,6 @@ def solve(model: xr.Dataset, options, progress) -> xr.Dataset:
     progress(0.2, f"solving the limit LP: {lp.field.n_var} variables, {lp.equalities.shape[0]} equalities, "
              f"{lp.inequalities.shape[0]} inequalities")
     sol = solve_lp(lp.cost, lp.equalities, lp.rhs, lp.inequalities, lp.bounds)
-    result = limit_dataset(model, domain, lp, sol, names, assembly)
+    result = limit_dataset(domain, lp, sol, names, assembly)
     progress(1.0, f"limit LP {sol.status}: alpha = {float(result.collapse_multiplier):.4f}")
     return result

@@ -8,7 +8,6 @@ import xarray as xr
 
 import masonryfw as mf
 
-from .cracks import crack_indicator
 from .newton import NewtonSolver, State
 from .output import mesh_variables, point_variables, variable
 from .problem import Problem, build_problem
@@ -136,8 +135,7 @@ def run(problem: Problem, options, progress) -> tuple[State, History, dict]:
     return state, history, info
 
 
-def result_dataset(model: xr.Dataset, problem: Problem, state: State, history: History, info: dict,
-                   spacing: float) -> xr.Dataset:
+def result_dataset(problem: Problem, state: State, history: History, info: dict) -> xr.Dataset:
     """docs/format.md result variables (physical units) from the final converged state and the history."""
     p, disc = problem, problem.disc
     H, U = p.length, p.displacement
@@ -158,8 +156,6 @@ def result_dataset(model: xr.Dataset, problem: Problem, state: State, history: H
                                        "Newton iterations of the step (step 0: the whole gravity stage)"),
         "step_plastic_points": variable("step", np.asarray(history.plastic_points, dtype=np.int32), "1",
                                     "quadrature points yielding in the step"),
-        "crack_indicator": variable("interface", crack_indicator(model, qx, qy, failure > 0, spacing / 4), "1",
-                                "fraction of the nearest quadrature points that yield in the last step"),
     }
     iterations = np.asarray(history.iterations[1:], dtype=float)
     attrs = {
@@ -181,4 +177,4 @@ def solve(model: xr.Dataset, options, progress) -> xr.Dataset:
     if info["interrupted"] and len(history.settlement) == 0:
         raise KeyboardInterrupt  # interrupted before the gravity stage converged: nothing to keep
     progress(1.0, info["stop_reason"])
-    return result_dataset(model, problem, state, history, info, problem.mesh_size)
+    return result_dataset(problem, state, history, info)

@@ -126,6 +126,63 @@ def test_crack_indicator_is_relative_to_the_largest_masonry_joint():
     assert mf.INTACT_SHARE == 0.01
 
 
+def segment_distances(model, x, y):
+    """Exact distance of every point to every interface segment (points, interfaces)."""
+    ix, iy = model.interface_x.values, model.interface_y.values
+    a = np.stack([ix[:, 0], iy[:, 0]], axis=1)
+    d = np.stack([ix[:, 1] - ix[:, 0], iy[:, 1] - iy[:, 0]], axis=1)
+    p = np.stack([x, y], axis=1)[:, None, :]
+    t = np.clip(((p - a) * d).sum(-1) / (d * d).sum(-1), 0.0, 1.0)
+    return np.linalg.norm(p - (a + t[..., None] * d), axis=-1)
+
+
+def brick_wall():
+    """Two courses of two 0.4 x 0.2 units, the lower half-bond shifted, on a fixed base: 8 joints."""
+    rects = [(0.0, -0.1, 0.8, 0.0), (0.0, 0.0, 0.4, 0.2), (0.4, 0.0, 0.8, 0.2),
+             (0.0, 0.2, 0.2, 0.4), (0.2, 0.2, 0.6, 0.4), (0.6, 0.2, 0.8, 0.4)]
+    return mt.rectangles_model(rects, ["fixed_support"] + ["unit"] * 5, loading="tilt")
+
+
+@pytest.mark.parametrize("spacing", [0.05, 0.01])
+def test_points_go_to_their_nearest_joint_within_half_the_sampling(spacing):
+    model = brick_wall()
+    rng = np.random.default_rng(3)
+    x, y = rng.uniform(0, 0.8, 2000), rng.uniform(-0.05, 0.4, 2000)
+    exact = segment_distances(model, x, y)
+    found = mf.nearest_interface(model, x, y, spacing)
+    assert (exact[np.arange(x.size), found] <= exact.min(axis=1) + spacing / 2 + 1e-12).all()
+    assert (found == exact.argmin(axis=1)).mean() > (0.95 if spacing == 0.01 else 0.8)
+
+
+def test_a_continuum_s_crack_indicator_is_the_yielding_share_of_the_nearest_points():
+    """Points on a 0.01 grid, yielding in the upper-right unit: its joints get the yielding share by hand."""
+    model = brick_wall()
+    gx, gy = np.meshgrid(np.arange(0.005, 0.8, 0.01), np.arange(0.005, 0.4, 0.01))
+    x, y = gx.ravel(), gy.ravel()
+    plastic = (x > 0.6) & (y > 0.2)
+    indicator = mf.plastic_crack_indicator(model, x, y, plastic)
+    nearest = segment_distances(model, x, y).argmin(axis=1)
+    by_hand = np.array([plastic[nearest == i].mean() if (nearest == i).any() else 0.0
+                        for i in range(model.sizes["interface"])])
+    base = mf.masonry_joints(model.block_role.values, model.interface_blocks.values)
+    np.testing.assert_allclose(indicator, np.where(base, by_hand, 0.0), atol=0.03)
+    assert indicator.max() > 0.3 and (indicator[by_hand == 0] == 0).all()
+
+
+def test_a_continuum_result_gets_the_core_s_crack_indicator(registered):
+    model = brick_wall()
+    x, y = np.array([0.7, 0.1]), np.array([0.19, 0.01])  # by the upper-right unit's bed, on the base
+
+    def continuum(model, options, progress):
+        return xr.Dataset({"qp_x": ("qp", x), "qp_y": ("qp", y), "qp_failure": ("qp", np.array([2, 0], np.int8))})
+
+    registered(continuum)
+    result = mf.solve(model, "tipping")
+    cracked = mf.nearest_interface(model, x[:1], y[:1], 0.01)[0]
+    assert np.flatnonzero(result.crack_indicator.values).tolist() == [cracked]
+    assert result.crack_indicator.values[cracked] == 1.0
+
+
 def union_find_groups(n, pairs):
     parent = list(range(n))
 
