@@ -30,7 +30,7 @@ from . import scores
 from .shapes import distance_to_points, distance_to_segments, segment_samples
 
 # Option names under which solvers record their numerical backend (la: "solver").
-BACKEND_OPTION_NAMES = ("solver", "backend", "method")
+BACKEND_OPTION_NAMES = ("solver", "backend")
 # Model variables that must be present to tell two models apart and to score them.
 GEOMETRY_VARIABLES = (
     "node_x", "node_y", "block_node_count", "block_role",

@@ -156,9 +156,15 @@ def test_every_writing_command_checks_its_output_folder_first(la_files, args):
 
 # ---------------------------------------------------------------- Ctrl-C
 
+def default_sigint() -> None:
+    """A process started in the background inherits SIGINT ignored, and Python then never raises
+    KeyboardInterrupt: give the child the default disposition, as a terminal would."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 def start(args, cwd):
     return subprocess.Popen([sys.executable, "-m", "masonryfw", *map(str, args)], cwd=cwd, text=True,
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, preexec_fn=default_sigint)
 
 
 def wait_for(process, pattern: str, timeout: float = 240.0) -> str:
