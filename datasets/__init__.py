@@ -1,4 +1,5 @@
-"""The paper's ten walls as bundled specs (``datasets/<name>.toml``, package ``masonryfw.datasets``).
+"""The bundled walls: the paper's ten as specs (``datasets/<name>.toml``) and drawn examples
+(``datasets/drawings/<name>.toml`` with their drawings), package ``masonryfw.datasets``.
 
 This package is both the data and its accessors: a module ``masonryfw/datasets.py``
 next to a data package of the same name would shadow it (or be shadowed by it,
@@ -19,11 +20,19 @@ CASE_NAMES = (
 )
 
 
+#: Drawn example walls (``datasets/drawings``, see its ``generate.py``): a spec with ``[geometry]`` each.
+DRAWN_NAMES = ("lact3-wall", "lact3-portal", "lact3-arch", "arch-settlement", "stepped-units")
+#: Every name :func:`bundled_spec_path` knows.
+BUNDLED_NAMES = CASE_NAMES + DRAWN_NAMES
+
+
 def bundled_spec_path(name: str):
-    """The spec file of a bundled case (an ``importlib.resources`` Traversable)."""
-    if name not in CASE_NAMES:
-        raise ModelError(f"unknown bundled case {name!r}; valid names: {', '.join(CASE_NAMES)}")
-    return resources.files(__name__).joinpath(f"{name}.toml")
+    """The spec file of a bundled case or drawn example (an ``importlib.resources`` Traversable)."""
+    if name in CASE_NAMES:
+        return resources.files(__name__).joinpath(f"{name}.toml")
+    if name in DRAWN_NAMES:
+        return resources.files(__name__).joinpath("drawings", f"{name}.toml")
+    raise ModelError(f"unknown bundled case {name!r}; valid names: {', '.join(BUNDLED_NAMES)}")
 
 
 def bundled_cases() -> dict[str, str]:

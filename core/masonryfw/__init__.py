@@ -16,9 +16,9 @@ try:
 except PackageNotFoundError:  # running from a source tree that is not installed
     __version__ = "0+unknown"
 
-from .builder import build, dump_toml, load_spec
+from .builder import build, load_spec
 from .checks import Problem, check
-from .datasets import CASE_NAMES, bundled_cases, bundled_spec_path
+from .datasets import BUNDLED_NAMES, CASE_NAMES, DRAWN_NAMES, bundled_cases, bundled_spec_path
 from .dofs import block_loads, block_motion, load_variables, motion_variables, upgrade
 from .errors import MasonryError, ModelError, PluginError, SolveError, SpecError, listed
 from .geometry import (
@@ -85,5 +85,6 @@ from .semantics import (
     states_at,
     support_blocks,
 )
+from .spec import dump_toml
 
 __all__ = [name for name in dir() if not name.startswith("_")]

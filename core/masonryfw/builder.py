@@ -33,11 +33,7 @@ Generation rules (the model is always in SI; ``length_unit`` only scales input):
 """
 from __future__ import annotations
 
-import difflib
-import json
 import math
-import os
-import re
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -45,22 +41,23 @@ import xarray as xr
 
 from . import blocks
 from .errors import SpecError
+from .imported import build_drawn, is_drawn, parse_drawn_spec, resolved_drawing
 from .model import checked_model
 from .schema import flags
+from .spec import (
+    LENGTH_UNITS,
+    SpecTable,
+    check_pivot,
+    read_loading,
+    read_material,
+    read_motion,
+    read_spec,
+)
 
-try:  # Python >= 3.11
-    import tomllib
-except ModuleNotFoundError:  # pragma: no cover - Python 3.10
-    import tomli as tomllib
-
-LENGTH_UNITS = {"m": 1.0, "mm": 1.0e-3}
 #: Relative tolerance on "a whole number of courses" (heights divided by the unit height).
 COURSE_TOLERANCE = 1.0e-6
 #: Position tolerance, relative to the wall size.
 POSITION_TOLERANCE = 1.0e-9
-
-_REQUIRED = object()
-
 
 # --------------------------------------------------------------------------- reading
 
@@ -68,43 +65,18 @@ _REQUIRED = object()
 def load_spec(path_or_text) -> dict:
     """Read and validate a spec: a path (str or PathLike or Traversable) or the TOML text itself.
 
-    Returns the spec as a plain dict (as written, not normalised), ready to be
-    modified (e.g. by a parameter sweep) and passed to :func:`build`.
+    Returns the spec as a plain dict (as written, except that a drawn wall's
+    drawing path is made absolute), ready to be modified (e.g. by a parameter
+    sweep) and passed to :func:`build`.
     """
-    spec, _ = _read_spec(path_or_text)
-    parse_spec(spec)
-    return spec
-
-
-def _read_spec(source) -> tuple[dict, str]:
-    """``(spec dict, TOML text)`` from a path, a Traversable, TOML text or a dict."""
-    if isinstance(source, dict):
-        return source, dump_toml(source)
-    if isinstance(source, os.PathLike) or hasattr(source, "read_text"):  # a path or a Traversable
-        text = _read_text(source)
-    elif isinstance(source, str):
-        if os.path.isfile(source):
-            text = _read_text(source)
-        elif "=" in source or "\n" in source:
-            text = source
-        else:
-            raise SpecError(f"spec file {source!r} not found (and the text is not TOML)")
+    spec, _, base_dir = read_spec(path_or_text)
+    if is_drawn(spec):
+        drawn = parse_drawn_spec(spec)
+        key = drawn.drawing_key.split(".")[1]
+        spec = {**spec, "geometry": {**spec["geometry"], key: str(resolved_drawing(drawn, base_dir).resolve())}}
     else:
-        raise SpecError(f"a spec is a path, TOML text or a dict, not {type(source).__name__}")
-    try:
-        return tomllib.loads(text), text
-    except tomllib.TOMLDecodeError as exc:
-        raise SpecError(f"spec is not valid TOML: {exc}") from None
-
-
-def _read_text(path) -> str:
-    try:
-        if hasattr(path, "read_text"):
-            return path.read_text(encoding="utf-8")
-        with open(path, encoding="utf-8") as handle:
-            return handle.read()
-    except OSError as exc:
-        raise SpecError(f"cannot read spec file {str(path)!r}: {exc.strerror}") from None
+        parse_spec(spec)
+    return spec
 
 
 # --------------------------------------------------------------------------- validation
@@ -147,12 +119,7 @@ class Wall:
     unit_height: float
     pattern: str
     first_course: str
-    unit_weight: float
-    friction: float
-    cohesion: float
-    tensile_strength: float
-    young_modulus: float | None
-    poisson_ratio: float | None
+    material: blocks.Material
     openings: tuple[Opening, ...]
     supports: tuple[Support, ...]
     loading: str
@@ -167,85 +134,15 @@ class Wall:
         return POSITION_TOLERANCE * max(self.width, self.height)
 
 
-class _Table:
-    """One table of a spec: typed access to its keys; unknown keys are rejected up front."""
-
-    def __init__(self, table, path: str, allowed: tuple[str, ...], scale: float = 1.0):
-        if not isinstance(table, dict):
-            raise SpecError(f"spec key {path!r} must be a table, got {table!r}")
-        self.table, self.path, self.scale = table, path, scale
-        for name in table:
-            if name not in allowed:
-                guess = difflib.get_close_matches(name, allowed, n=1)
-                hint = f" (did you mean {self.key(guess[0])!r}?)" if guess else f" (known keys: {', '.join(allowed)})"
-                raise SpecError(f"unknown spec key {self.key(name)!r}{hint}")
-
-    def key(self, name: str) -> str:
-        return f"{self.path}.{name}" if self.path else name
-
-    def has(self, name: str) -> bool:
-        return name in self.table
-
-    def raw(self, name: str, default=_REQUIRED):
-        if name not in self.table:
-            if default is _REQUIRED:
-                raise SpecError(f"missing spec key {self.key(name)!r}")
-            return default
-        return self.table[name]
-
-    def number(self, name: str, default=_REQUIRED, *, length=False, positive=False,
-               minimum=None, below=None):
-        value = self.raw(name, default)
-        if value is None:
-            return None
-        if isinstance(value, bool) or not isinstance(value, (int, float)):
-            raise SpecError(f"spec key {self.key(name)!r} = {value!r}: must be a number")
-        if not math.isfinite(value):
-            raise SpecError(f"spec key {self.key(name)!r} = {value!r}: must be finite")
-        if positive and value <= 0:
-            raise SpecError(f"spec key {self.key(name)!r} = {value!r}: must be positive")
-        if minimum is not None and value < minimum:
-            raise SpecError(f"spec key {self.key(name)!r} = {value!r}: must be at least {minimum}")
-        if below is not None and value >= below:
-            raise SpecError(f"spec key {self.key(name)!r} = {value!r}: must be less than {below}")
-        return float(value) * (self.scale if length else 1.0)
-
-    def choice(self, name: str, choices: tuple[str, ...], default=_REQUIRED) -> str:
-        value = self.raw(name, default)
-        if value not in choices:
-            raise SpecError(
-                f"spec key {self.key(name)!r} = {value!r}: must be one of {', '.join(map(repr, choices))}"
-            )
-        return value
-
-    def text(self, name: str, default=_REQUIRED) -> str:
-        value = self.raw(name, default)
-        if not isinstance(value, str):
-            raise SpecError(f"spec key {self.key(name)!r} = {value!r}: must be a string")
-        return value
-
-    def point(self, name: str) -> tuple[float, float]:
-        value = self.raw(name)
-        if (not isinstance(value, list) or len(value) != 2
-                or any(isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v) for v in value)):
-            raise SpecError(f"spec key {self.key(name)!r} = {value!r}: must be a pair of numbers [x, y]")
-        return float(value[0]) * self.scale, float(value[1]) * self.scale
-
-    def sub(self, name: str, allowed: tuple[str, ...], default=_REQUIRED) -> _Table:
-        return _Table(self.raw(name, default), self.key(name), allowed, self.scale)
-
-
 _TOP_KEYS = ("title", "description", "length_unit", "wall", "unit", "bond", "material",
              "openings", "supports", "loading")
-_MATERIAL_KEYS = ("unit_weight", "friction_angle", "friction", "cohesion", "tensile_strength",
-                  "young_modulus", "poisson_ratio")
 _OPENING_KEYS = ("x", "y", "width", "height", "lintel_bearing")
 _SUPPORT_KEYS = ("kind", "start", "end", "motion", "pivot")
 
 
 def parse_spec(spec: dict) -> Wall:
     """Validate a spec dict and return it in SI; a :class:`SpecError` names the offending key."""
-    top = _Table(spec, "", _TOP_KEYS)
+    top = SpecTable(spec, "", _TOP_KEYS)
     unit_name = top.choice("length_unit", tuple(LENGTH_UNITS), "m")
     top.scale = LENGTH_UNITS[unit_name]
 
@@ -259,22 +156,9 @@ def parse_spec(spec: dict) -> Wall:
     courses = _whole_courses(height, unit_height, wall.key("height"), wall.raw("height"))
     bond = top.sub("bond", ("pattern", "first_course"), {})
 
-    material = top.sub("material", _MATERIAL_KEYS)
-    friction = _friction(material)
-
+    material = read_material(top)
     supports = _supports(top, width)
-    loading = top.sub("loading", ("type", "direction"))
-    kind = loading.choice("type", ("settlement", "tilt"))
-    direction = 0
-    if kind == "tilt":
-        direction = loading.raw("direction")
-        if direction not in (1, -1) or isinstance(direction, bool):
-            raise SpecError(f"spec key 'loading.direction' = {direction!r}: must be +1 (towards +x) or -1")
-        direction = int(direction)
-    elif loading.has("direction"):
-        raise SpecError("spec key 'loading.direction' only applies to loading.type = 'tilt'")
-    elif not any(s.kind == "moving" for s in supports):
-        raise SpecError("spec key 'loading.type' = 'settlement': needs at least one support with kind = 'moving'")
+    kind, direction = read_loading(top, any(s.kind == "moving" for s in supports))
 
     result = Wall(
         title=top.text("title"),
@@ -286,12 +170,7 @@ def parse_spec(spec: dict) -> Wall:
         unit_height=unit_height,
         pattern=bond.choice("pattern", ("running", "stack"), "running"),
         first_course=bond.choice("first_course", ("full", "half"), "full"),
-        unit_weight=material.number("unit_weight", positive=True),
-        friction=friction,
-        cohesion=material.number("cohesion", 0.0, minimum=0.0),
-        tensile_strength=material.number("tensile_strength", 0.0, minimum=0.0),
-        young_modulus=material.number("young_modulus", None, positive=True),
-        poisson_ratio=material.number("poisson_ratio", None, minimum=-1.0, below=0.5),
+        material=material,
         openings=(),
         supports=supports,
         loading=kind,
@@ -311,25 +190,14 @@ def _whole_courses(value: float, unit_height: float, key: str, shown) -> int:
     return int(count)
 
 
-def _friction(material: _Table) -> float:
-    if material.has("friction_angle") and material.has("friction"):
-        raise SpecError("spec keys 'material.friction_angle' and 'material.friction': give one of them, not both")
-    if material.has("friction"):
-        return material.number("friction", minimum=0.0)
-    if not material.has("friction_angle"):
-        raise SpecError("missing spec key 'material.friction_angle' (or 'material.friction')")
-    angle = material.number("friction_angle", minimum=0.0, below=90.0)
-    return math.tan(math.radians(angle))
-
-
-def _supports(top: _Table, width: float) -> tuple[Support, ...]:
+def _supports(top: SpecTable, width: float) -> tuple[Support, ...]:
     table = top.raw("supports")
     if not isinstance(table, dict) or not table:
         raise SpecError(f"spec key 'supports' = {table!r}: must hold at least one [supports.<name>] table")
     tol = POSITION_TOLERANCE * width
     supports = []
     for name in table:
-        entry = _Table(table[name], f"supports.{name}", _SUPPORT_KEYS, top.scale)
+        entry = SpecTable(table[name], f"supports.{name}", _SUPPORT_KEYS, top.scale)
         kind = entry.choice("kind", ("fixed", "moving"))
         start = entry.number("start", length=True, minimum=0.0)
         end = entry.number("end", length=True)
@@ -337,21 +205,8 @@ def _supports(top: _Table, width: float) -> tuple[Support, ...]:
             raise SpecError(f"spec key {entry.key('end')!r} = {entry.raw('end')!r}: beyond the wall's right end")
         if end <= start + tol:
             raise SpecError(f"spec key {entry.key('end')!r} = {entry.raw('end')!r}: must exceed start")
-        motion, pivot = "none", None
-        if kind == "moving":
-            motion = entry.choice("motion", ("translation", "rotation"), "translation")
-            if motion == "rotation":
-                pivot = entry.point("pivot")
-                if abs(pivot[0] - 0.5 * (start + end)) <= tol:
-                    raise SpecError(
-                        f"spec key {entry.key('pivot')!r} = {entry.raw('pivot')!r}: the pivot must lie left or "
-                        "right of the support's centre (a rotation about it must move the support down)"
-                    )
-            elif entry.has("pivot"):
-                raise SpecError(f"spec key {entry.key('pivot')!r} only applies to motion = 'rotation'")
-        elif entry.has("motion") or entry.has("pivot"):
-            bad = "motion" if entry.has("motion") else "pivot"
-            raise SpecError(f"spec key {entry.key(bad)!r} only applies to kind = 'moving'")
+        motion, pivot = read_motion(entry, kind)
+        check_pivot(entry, pivot, 0.5 * (start + end), tol)
         supports.append(Support(name, kind, min(start, width), min(end, width), motion, pivot))
     ordered = sorted(supports, key=lambda s: s.start)
     for left, right in zip(ordered, ordered[1:]):
@@ -360,14 +215,14 @@ def _supports(top: _Table, width: float) -> tuple[Support, ...]:
     return tuple(supports)
 
 
-def _openings(top: _Table, wall: Wall) -> tuple[Opening, ...]:
+def _openings(top: SpecTable, wall: Wall) -> tuple[Opening, ...]:
     entries = top.raw("openings", [])
     if not isinstance(entries, list):
         raise SpecError(f"spec key 'openings' must be an array of tables ([[openings]]), got {entries!r}")
     tol = wall.tol
     openings = []
     for index, table in enumerate(entries):
-        entry = _Table(table, f"openings[{index}]", _OPENING_KEYS, top.scale)
+        entry = SpecTable(table, f"openings[{index}]", _OPENING_KEYS, top.scale)
         x0 = entry.number("x", length=True, minimum=0.0)
         y0 = entry.number("y", length=True, minimum=0.0)
         width = entry.number("width", length=True, positive=True)
@@ -523,13 +378,18 @@ def masonry_blocks(wall: Wall):
 def build(spec, *, validate: bool = True) -> xr.Dataset:
     """Build the model dataset of a wall spec (a dict, a path, a Traversable or TOML text).
 
+    A spec with a ``[geometry]`` table is a drawn wall (:mod:`masonryfw.imported`;
+    its drawing's path is relative to the spec file, else to the working folder).
+
     Blocks come course by course, left to right (units and lintels), then the
     supports in spec order; interfaces, kinds and loads as every model gets them
     (:mod:`masonryfw.blocks`). Raises :class:`SpecError` naming the key at fault.
     The model is returned checked (:func:`masonryfw.checked_model`), unless
     ``validate`` is False.
     """
-    spec_dict, text = _read_spec(spec)
+    spec_dict, text, base_dir = read_spec(spec)
+    if is_drawn(spec_dict):
+        return build_drawn(spec_dict, text, base_dir, validate)
     wall = parse_spec(spec_dict)
     mx0, mx1, my0, my1, m_role = masonry_blocks(wall)
     s_x0 = np.array([s.start for s in wall.supports])
@@ -539,8 +399,7 @@ def build(spec, *, validate: bool = True) -> xr.Dataset:
     y1 = np.concatenate((my1, np.zeros(s_x0.size)))
     role = np.concatenate((m_role, np.full(s_x0.size, flags("block_role")["fixed_support"], dtype=np.int8)))
     supports = [blocks.Support(f"spec key 'supports.{s.name}'", s.kind, s.motion, s.pivot) for s in wall.supports]
-    material = blocks.Material(wall.unit_weight, wall.friction, wall.cohesion, wall.tensile_strength,
-                               wall.young_modulus, wall.poisson_ratio)
+    material = wall.material
     attrs = {"title": wall.title, "source_spec": text}
     if wall.description:
         attrs["comment"] = wall.description
@@ -549,51 +408,3 @@ def build(spec, *, validate: bool = True) -> xr.Dataset:
     return checked_model(ds, repr(wall.title)) if validate else ds
 
 
-# --------------------------------------------------------------------------- TOML output
-
-_BARE_KEY = re.compile(r"^[A-Za-z0-9_-]+$")
-
-
-def _toml_key(key: str) -> str:
-    return key if _BARE_KEY.match(key) else json.dumps(key)
-
-
-def _toml_value(value) -> str:
-    if isinstance(value, bool):
-        return "true" if value else "false"
-    if isinstance(value, int):
-        return str(value)
-    if isinstance(value, float):
-        if math.isnan(value):
-            return "nan"
-        if math.isinf(value):
-            return "inf" if value > 0 else "-inf"
-        return repr(value)
-    if isinstance(value, str):
-        return json.dumps(value, ensure_ascii=False)
-    if isinstance(value, (list, tuple)):
-        return "[" + ", ".join(_toml_value(v) for v in value) + "]"
-    raise SpecError(f"cannot write a {type(value).__name__} value ({value!r}) to TOML")
-
-
-def dump_toml(spec: dict, _prefix: str = "") -> str:
-    """TOML text of a spec dict (scalars, arrays, tables, arrays of tables): the ``source_spec`` of a dict."""
-    lines, tables = [], []
-    for key, value in spec.items():
-        if isinstance(value, dict):
-            tables.append((key, value, False))
-        elif isinstance(value, list) and value and all(isinstance(v, dict) for v in value):
-            tables.append((key, value, True))
-        else:
-            lines.append(f"{_toml_key(key)} = {_toml_value(value)}")
-    text = "\n".join(lines) + ("\n" if lines else "")
-    for key, value, is_array in tables:
-        name = _prefix + _toml_key(key)
-        if is_array:
-            for item in value:
-                text += f"\n[[{name}]]\n" + dump_toml(item, name + ".")
-        else:
-            body = dump_toml(value, name + ".")
-            has_scalars = not value or not all(isinstance(v, dict) for v in value.values())
-            text += (f"\n[{name}]\n" if has_scalars else "") + body
-    return text

@@ -6,7 +6,8 @@
    and their fixed values, the format version, required variables, their dims,
    fixed dim sizes, dtype class, finite values, bounds and flag values;
 2. **geometry**: every polygon (vertex count, repeated and collinear vertices,
-   orientation, area, self-intersection, convexity), overlapping blocks, and
+   orientation, area, self-intersection; simple non-convex polygons are fine),
+   overlapping blocks, and
    every interface (block indices, length, lying on an edge of both blocks);
 3. **mechanics**: blocks and supports connected to nothing, settlement
    directions of moving and other blocks, the live load.
@@ -25,7 +26,17 @@ import numpy as np
 import xarray as xr
 
 from .dofs import upgrade
-from .geometry import block_offsets, model_scale, next_node, node_block, polygon_area_centroid
+from .geometry import (
+    block_bounds,
+    block_offsets,
+    carrying_edges,
+    convex_pieces,
+    model_scale,
+    next_node,
+    node_block,
+    point_segment_distance,
+    polygon_area_centroid,
+)
 from .schema import FORMAT_VERSION, KINDS, READABLE_VERSIONS, load_schema
 
 RELATIVE_TOLERANCE = 1e-6  # lengths below this fraction of the model scale count as zero
@@ -372,7 +383,7 @@ def _format_value(value) -> str:
 # ---------------------------------------------------------------- geometry layer
 
 def _polygon_problems(model) -> list[Problem]:
-    """Repeated and collinear vertices, self-intersection, area, orientation and convexity.
+    """Repeated and collinear vertices, self-intersection, area and orientation.
 
     Each test runs only on the polygons the tests before it let through (a
     self-intersecting polygon has no meaningful area or orientation); the blocks
@@ -416,17 +427,6 @@ def _polygon_problems(model) -> list[Problem]:
         for b in np.flatnonzero(clockwise)
     ]
     simple &= ~zero_area
-    # A re-entrant corner turns against the polygon's own orientation (so a clockwise
-    # convex polygon is reported only as clockwise).
-    reflex = simple[owner] & (np.sign(model.area)[owner] * offset < -tol)
-    reflex_blocks, first = np.unique(owner[reflex], return_index=True)
-    first_vertex = np.flatnonzero(reflex)[first]
-    problems += [
-        Problem(f"block {b}", f"non-convex polygon (re-entrant corner at vertex {v}); the solvers assume convex "
-                "blocks: split it into convex blocks", *_point(x[v], y[v]))
-        for b, v in zip(reflex_blocks, first_vertex)
-    ]
-    simple[reflex_blocks] = False
     model.good_polygon = simple & ~clockwise
     return problems
 
@@ -456,10 +456,10 @@ def _segment_distance(p0x, p0y, p1x, p1y, q0x, q0y, q1x, q1y):
     d4 = side(p0x, p0y, p1x, p1y, q1x, q1y)
     crosses = (d1 * d2 < 0) & (d3 * d4 < 0)
     candidates = [  # (distance of an end point from the other segment, that end point)
-        (_point_segment(p0x, p0y, q0x, q0y, q1x, q1y), p0x, p0y),
-        (_point_segment(p1x, p1y, q0x, q0y, q1x, q1y), p1x, p1y),
-        (_point_segment(q0x, q0y, p0x, p0y, p1x, p1y), q0x, q0y),
-        (_point_segment(q1x, q1y, p0x, p0y, p1x, p1y), q1x, q1y),
+        (point_segment_distance(p0x, p0y, q0x, q0y, q1x, q1y), p0x, p0y),
+        (point_segment_distance(p1x, p1y, q0x, q0y, q1x, q1y), p1x, p1y),
+        (point_segment_distance(q0x, q0y, p0x, p0y, p1x, p1y), q0x, q0y),
+        (point_segment_distance(q1x, q1y, p0x, p0y, p1x, p1y), q1x, q1y),
     ]
     dist = np.stack([c[0] for c in candidates])
     which = np.argmin(dist, axis=0)
@@ -471,16 +471,6 @@ def _segment_distance(p0x, p0y, p1x, p1y, q0x, q0y, q1x, q1y):
         cross_y = p0y + t * (p1y - p0y)
     distance = np.where(crosses, 0.0, dist.min(axis=0))
     return distance, np.where(crosses, cross_x, near_x), np.where(crosses, cross_y, near_y)
-
-
-def _point_segment(px, py, ax, ay, bx, by):
-    """Distance from points p to segments ab."""
-    dx, dy = bx - ax, by - ay
-    length2 = dx * dx + dy * dy
-    with np.errstate(invalid="ignore", divide="ignore"):
-        t = np.clip(((px - ax) * dx + (py - ay) * dy) / length2, 0.0, 1.0)
-    t = np.where(length2 > 0, t, 0.0)
-    return np.hypot(ax + t * dx - px, ay + t * dy - py)
 
 
 def _self_intersections(model, candidates):
@@ -559,56 +549,84 @@ def _candidate_block_pairs(xmin, xmax, ymin, ymax, blocks, tol):
     return blocks[a[boxes_meet]], blocks[b[boxes_meet]]
 
 
-def _penetration(model, a, b):
+@dataclass(frozen=True)
+class _Polygons:
+    """Convex polygons in the ragged layout, for the separating-axis test."""
+
+    x: np.ndarray
+    y: np.ndarray
+    counts: np.ndarray
+    owner: np.ndarray  # block of every polygon
+
+    @property
+    def start(self) -> np.ndarray:
+        return block_offsets(self.counts)[:-1]
+
+    @property
+    def next(self) -> np.ndarray:
+        return next_node(self.counts)
+
+
+def _penetration(pieces: _Polygons, a, b):
     """Separating-axis depth of convex counter-clockwise polygon b into a, over a's edge normals.
 
     For each edge of ``a`` (outward unit normal n, support value h = n . edge
     start) the depth is ``h - min_j n . q_j`` over the vertices q of ``b``; the
     polygons overlap by at most the smallest of these (<= 0: separated or touching).
     """
-    x, y, nxt = model.x, model.y, model.next
-    pair, k = _ragged_expand(model.counts[a])
-    edge = model.start[a][pair] + k
+    x, y, nxt, start, counts = pieces.x, pieces.y, pieces.next, pieces.start, pieces.counts
+    pair, k = _ragged_expand(counts[a])
+    edge = start[a][pair] + k
     ex, ey = x[nxt[edge]] - x[edge], y[nxt[edge]] - y[edge]
     length = np.hypot(ex, ey)
     nx, ny = ey / length, -ex / length
     h = nx * x[edge] + ny * y[edge]
-    row, j = _ragged_expand(model.counts[b][pair])
-    vertex = model.start[b][pair][row] + j
+    row, j = _ragged_expand(counts[b][pair])
+    vertex = start[b][pair][row] + j
     projection = nx[row] * x[vertex] + ny[row] * y[vertex]
-    row_start = np.concatenate(([0], np.cumsum(model.counts[b][pair])[:-1]))
+    row_start = np.concatenate(([0], np.cumsum(counts[b][pair])[:-1]))
     depth_per_edge = h - np.minimum.reduceat(projection, row_start)
-    pair_start = np.concatenate(([0], np.cumsum(model.counts[a])[:-1]))
+    pair_start = np.concatenate(([0], np.cumsum(counts[a])[:-1]))
     return np.minimum.reduceat(depth_per_edge, pair_start)
 
 
 def _overlap_problems(model) -> list[Problem]:
-    """Blocks that interpenetrate by more than tol (bounding-box grid, then separating axes)."""
+    """Blocks that interpenetrate by more than tol (bounding-box grid, then separating axes).
+
+    Non-convex blocks are tested through their convex pieces (:func:`convex_pieces`);
+    two blocks overlap by the deepest overlap of any two of their pieces.
+    """
     blocks = np.flatnonzero(model.good_polygon)
     if blocks.size < 2:
         return []
-    counts = model.counts[blocks]
-    nodes = np.repeat(model.start[blocks], counts) + _ragged_expand(counts)[1]
-    first = np.concatenate(([0], np.cumsum(counts)[:-1]))
-    bounds = [np.full(model.nblock, np.nan) for _ in range(4)]
-    bounds[0][blocks] = np.minimum.reduceat(model.x[nodes], first)
-    bounds[1][blocks] = np.maximum.reduceat(model.x[nodes], first)
-    bounds[2][blocks] = np.minimum.reduceat(model.y[nodes], first)
-    bounds[3][blocks] = np.maximum.reduceat(model.y[nodes], first)
-    a, b = _candidate_block_pairs(*bounds, blocks, model.tol)
+    nodes = np.repeat(model.start[blocks], model.counts[blocks]) + _ragged_expand(model.counts[blocks])[1]
+    px, py, pc, owner = convex_pieces(model.x[nodes], model.y[nodes], model.counts[blocks], model.tol)
+    pieces = _Polygons(px, py, pc, blocks[owner])
+    everyone = np.arange(pc.size)
+    bounds = block_bounds(px, py, pc)
+    a, b = _candidate_block_pairs(*bounds, everyone, model.tol)
+    other = pieces.owner[a] != pieces.owner[b]
+    a, b = a[other], b[other]
     if a.size == 0:
         return []
-    depth = np.minimum(_penetration(model, a, b), _penetration(model, b, a))
+    depth = np.minimum(_penetration(pieces, a, b), _penetration(pieces, b, a))
     overlapping = depth > model.tol
+    p_block = np.minimum(pieces.owner[a], pieces.owner[b])[overlapping]
+    q_block = np.maximum(pieces.owner[a], pieces.owner[b])[overlapping]
+    depth = depth[overlapping]
+    if depth.size == 0:
+        return []
+    order = np.lexsort((-depth, q_block, p_block))
+    first = np.concatenate(([True], (np.diff(p_block[order]) != 0) | (np.diff(q_block[order]) != 0)))
     problems = []
-    xmin, xmax, ymin, ymax = bounds
-    for p, q, d in zip(a[overlapping], b[overlapping], depth[overlapping]):
-        px = 0.5 * (max(xmin[p], xmin[q]) + min(xmax[p], xmax[q]))
-        py = 0.5 * (max(ymin[p], ymin[q]) + min(ymax[p], ymax[q]))
+    xmin, xmax, ymin, ymax = block_bounds(model.x, model.y, model.counts)
+    for p, q, d in zip(p_block[order][first], q_block[order][first], depth[order][first]):
+        px_ = 0.5 * (max(xmin[p], xmin[q]) + min(xmax[p], xmax[q]))
+        py_ = 0.5 * (max(ymin[p], ymin[q]) + min(ymax[p], ymax[q]))
         problems.append(Problem(
             f"block {p}",
             f"overlaps block {q} (interpenetration {d:.6g} m); move or trim one of them",
-            *_point(px, py),
+            *_point(px_, py_),
         ))
     return problems
 
@@ -659,14 +677,12 @@ def _segment_on_block_edge(model, ix, iy, block):
     """True where both end points lie within tol of one and the same edge of ``block``."""
     if block.size == 0:
         return np.zeros(0, bool)
-    row, k = _ragged_expand(model.counts[block])
-    edge = model.start[block][row] + k
+    edge = carrying_edges(ix, iy, block, model.x, model.y, model.counts)
     ax, ay = model.x[edge], model.y[edge]
     bx, by = model.x[model.next[edge]], model.y[model.next[edge]]
-    d0 = _point_segment(ix[row, 0], iy[row, 0], ax, ay, bx, by)
-    d1 = _point_segment(ix[row, 1], iy[row, 1], ax, ay, bx, by)
-    hit = (d0 <= model.tol) & (d1 <= model.tol)
-    return np.bincount(row, hit, minlength=block.size) > 0
+    d0 = point_segment_distance(ix[:, 0], iy[:, 0], ax, ay, bx, by)
+    d1 = point_segment_distance(ix[:, 1], iy[:, 1], ax, ay, bx, by)
+    return (d0 <= model.tol) & (d1 <= model.tol)
 
 
 # ---------------------------------------------------------------- mechanics layer

@@ -149,11 +149,11 @@ def build(spec: str, output: str | None) -> None:
 
 def _bundled_spec(name: str):
     """The spec of a bundled case; a name that looks like a path is a missing file."""
-    if name in mf.CASE_NAMES:
+    if name in mf.BUNDLED_NAMES:
         return mf.bundled_spec_path(name)
     if "/" in name or Path(name).suffix:
         raise mf.SpecError(f"{name}: no such file")
-    raise mf.SpecError(f"{name}: no such file, and not a bundled case; bundled cases: {', '.join(mf.CASE_NAMES)}")
+    raise mf.SpecError(f"{name}: no such file, and not a bundled case; bundled cases: {', '.join(mf.BUNDLED_NAMES)}")
 
 
 def _input_files(*names: str) -> list[Path]:
@@ -245,10 +245,10 @@ def info(model: str) -> None:
 
 @cli.command()
 def datasets() -> None:
-    """List the bundled cases with their titles and block counts."""
-    for name in mf.CASE_NAMES:
+    """List the bundled cases (the paper's walls, then the drawn examples) with their titles and block counts."""
+    for name in mf.BUNDLED_NAMES:
         model = mf.build(mf.bundled_spec_path(name), validate=False)
-        click.echo(f"{name:<12} {model.attrs.get('title', ''):<12} {model.sizes['block']:>5} blocks")
+        click.echo(f"{name:<16} {model.attrs.get('title', ''):<24} {model.sizes['block']:>5} blocks")
 
 
 # ---------------------------------------------------------------- plugins
@@ -291,12 +291,13 @@ def _scalar_summary(ds, names) -> str:
     return ", ".join(parts)
 
 
-def _open_input(path_or_name: str):
-    """A dataset file as it is (model, result); a spec file or a bundled case name as its model."""
+def _open_input(path_or_name: str, validate: bool = True):
+    """A dataset file as it is (model, result); a spec file or a bundled case name as its model
+    (not checked with ``validate`` False: to draw a model that is wrong)."""
     path = Path(path_or_name)
     if path.is_file() and path.suffix.lower() not in mf.model.SPEC_SUFFIXES:
         return mf.open_dataset(path)
-    return mf.open_model(path_or_name)
+    return mf.open_model(path_or_name, validate=validate)
 
 
 class Interrupted(mf.MasonryError):
@@ -381,7 +382,7 @@ def plot(results: tuple[str, ...], kind: str | None, output: str, options: dict[
     """Plot one or more RESULTS (result or model files, spec files, bundled case names) with a plotter plugin."""
     inputs = _input_files(*results)
     mf.check_output_path(output, inputs, mf.io.FIGURE_FORMATS)
-    figure = render([_open_input(r) for r in results], kind, options)
+    figure = render([_open_input(r, validate=kind != "model") for r in results], kind, options)
     mf.save_figure(figure, output, protect=inputs)
     click.echo(f"plot: {output}")
 

@@ -6,7 +6,7 @@ repeated). Everything here works on all blocks at once.
 
 Conventions (used by every solver):
 - interface normal ``n`` points from side 0 into side 1 (the outward normal of
-  the side-0 block's edge);
+  the side-0 block's edge that carries the interface);
 - interface tangent ``t = (n_y, -n_x)``: ``n`` rotated by -90 deg, so a bed
   joint (n = +y) has t = +x;
 - end 0 / end 1 of an interface are its two stored end points.
@@ -81,6 +81,66 @@ def block_bounds(node_x, node_y, block_node_count):
     return tuple(out)
 
 
+def convex_blocks(node_x, node_y, block_node_count, tol: float = 0.0) -> np.ndarray:
+    """Whether every polygon is convex: no vertex turns against the polygon's orientation by more than ``tol``.
+
+    ``tol`` is a length: the distance of a vertex from the chord of its two neighbours.
+    """
+    x = np.asarray(node_x, dtype=float)
+    y = np.asarray(node_y, dtype=float)
+    counts = np.asarray(block_node_count, dtype=np.int64)
+    nxt = next_node(counts)
+    prev = np.empty_like(nxt)
+    prev[nxt] = np.arange(nxt.size)
+    ax, ay = x - x[prev], y - y[prev]
+    bx, by = x[nxt] - x, y[nxt] - y
+    chord = np.hypot(x[nxt] - x[prev], y[nxt] - y[prev])
+    with np.errstate(invalid="ignore", divide="ignore"):
+        offset = (ax * by - ay * bx) / chord
+    owner = node_block(counts)
+    sign = np.sign(polygon_area_centroid(x, y, counts)[0])[owner]
+    reflex = np.nan_to_num(sign * offset, nan=0.0) < -tol
+    return np.bincount(owner, reflex, minlength=counts.size) == 0
+
+
+def convex_pieces(node_x, node_y, block_node_count, tol: float = 0.0):
+    """Convex counter-clockwise polygons that tile every block: ``(x, y, counts, owner)`` in the ragged layout.
+
+    A convex block is its own piece; a non-convex one is split into the triangles
+    of its constrained Delaunay triangulation (GEOS, through shapely), which use its
+    vertices only. ``tol`` as in :func:`convex_blocks`.
+    """
+    x = np.asarray(node_x, dtype=float)
+    y = np.asarray(node_y, dtype=float)
+    counts = np.asarray(block_node_count, dtype=np.int64)
+    convex = convex_blocks(x, y, counts, tol)
+    if convex.all():
+        return x, y, counts, np.arange(counts.size)
+    import shapely  # here, not at the top: most models are convex and the CLI starts faster without it
+
+    concave = np.flatnonzero(~convex)
+    on_concave = ~convex[node_block(counts)]
+    rings = shapely.linearrings(np.c_[x[on_concave], y[on_concave]],
+                                indices=np.repeat(np.arange(concave.size), counts[concave]))
+    triangulated = shapely.constrained_delaunay_triangles(shapely.polygons(rings))
+    parts, which = shapely.get_parts(triangulated, return_index=True)
+    corners = shapely.get_coordinates(shapely.get_exterior_ring(parts)).reshape(-1, 4, 2)[:, :3]
+    tx, ty = corners[..., 0], corners[..., 1]
+    clockwise = (tx[:, 1] - tx[:, 0]) * (ty[:, 2] - ty[:, 0]) - (tx[:, 2] - tx[:, 0]) * (ty[:, 1] - ty[:, 0]) < 0
+    tx[clockwise] = tx[clockwise][:, ::-1]
+    ty[clockwise] = ty[clockwise][:, ::-1]
+    keep = convex[node_block(counts)]
+    owner = np.concatenate((np.flatnonzero(convex), concave[which]))
+    out_counts = np.concatenate((counts[convex], np.full(which.size, 3)))
+    order = np.argsort(owner, kind="stable")
+    px = np.concatenate((x[keep], tx.ravel()))
+    py = np.concatenate((y[keep], ty.ravel()))
+    sorted_counts = out_counts[order]
+    first = np.repeat(block_offsets(out_counts)[:-1][order], sorted_counts)
+    nodes = first + np.arange(sorted_counts.sum()) - np.repeat(block_offsets(sorted_counts)[:-1], sorted_counts)
+    return px[nodes], py[nodes], sorted_counts, owner[order]
+
+
 def model_scale(node_x, node_y) -> float:
     """Characteristic length of a model: the diagonal of its bounding box."""
     x = np.asarray(node_x, dtype=float)
@@ -91,11 +151,45 @@ def model_scale(node_x, node_y) -> float:
     return diag if diag > 0 else 1.0
 
 
-def interface_frame(interface_x, interface_y, side0_cx, side0_cy):
+def point_segment_distance(px, py, ax, ay, bx, by):
+    """Distance from points p to segments ab (a degenerate segment is its point)."""
+    dx, dy = bx - ax, by - ay
+    length2 = dx * dx + dy * dy
+    with np.errstate(invalid="ignore", divide="ignore"):
+        t = np.clip(((px - ax) * dx + (py - ay) * dy) / length2, 0.0, 1.0)
+    t = np.where(length2 > 0, t, 0.0)
+    return np.hypot(ax + t * dx - px, ay + t * dy - py)
+
+
+def carrying_edges(interface_x, interface_y, blocks, node_x, node_y, block_node_count) -> np.ndarray:
+    """Node index of the edge of ``blocks[i]`` that interface ``i`` lies on (the nearest to both its ends).
+
+    The edge runs from that node to the next vertex of its polygon.
+    """
+    ix = np.asarray(interface_x, dtype=float).reshape(-1, 2)
+    iy = np.asarray(interface_y, dtype=float).reshape(-1, 2)
+    x, y = np.asarray(node_x, dtype=float), np.asarray(node_y, dtype=float)
+    counts = np.asarray(block_node_count, dtype=np.int64)
+    blocks = np.asarray(blocks, dtype=np.int64)
+    nxt = next_node(counts)
+    per = counts[blocks]
+    row = np.repeat(np.arange(blocks.size), per)
+    edge = np.repeat(block_offsets(counts)[:-1][blocks], per) + np.arange(per.sum()) - np.repeat(
+        np.cumsum(per) - per, per)
+    ax, ay, bx, by = x[edge], y[edge], x[nxt[edge]], y[nxt[edge]]
+    far = np.maximum(point_segment_distance(ix[row, 0], iy[row, 0], ax, ay, bx, by),
+                     point_segment_distance(ix[row, 1], iy[row, 1], ax, ay, bx, by))
+    order = np.lexsort((far, row))
+    first = np.searchsorted(row[order], np.arange(blocks.size))
+    return edge[order[np.minimum(first, max(edge.size - 1, 0))]] if edge.size else np.zeros(0, np.int64)
+
+
+def interface_frame(interface_x, interface_y, side0, node_x, node_y, block_node_count):
     """Length, unit normal (from side 0 into side 1) and unit tangent of every interface.
 
-    The normal is perpendicular to the segment and oriented away from the side-0
-    block's centroid (for convex blocks, the outward normal of its edge).
+    The normal is the outward normal of the side-0 block's edge that carries the
+    interface (by the polygon's orientation), so it is right for non-convex blocks
+    too, whose centroid may lie on either side of an interface's line.
     """
     ix = np.asarray(interface_x, dtype=float).reshape(-1, 2)
     iy = np.asarray(interface_y, dtype=float).reshape(-1, 2)
@@ -104,8 +198,14 @@ def interface_frame(interface_x, interface_y, side0_cx, side0_cy):
     length = np.hypot(dx, dy)
     with np.errstate(divide="ignore", invalid="ignore"):
         nx, ny = dy / length, -dx / length
-    mx, my = ix.mean(axis=1), iy.mean(axis=1)
-    flip = nx * (mx - side0_cx) + ny * (my - side0_cy) < 0
+    x, y = np.asarray(node_x, dtype=float), np.asarray(node_y, dtype=float)
+    counts = np.asarray(block_node_count, dtype=np.int64)
+    edge = carrying_edges(ix, iy, side0, x, y, counts)
+    nxt = next_node(counts)
+    ex, ey = x[nxt[edge]] - x[edge], y[nxt[edge]] - y[edge]
+    area = polygon_area_centroid(x, y, counts)[0]
+    outward = np.sign(area[np.asarray(side0, dtype=np.int64)])  # (ey, -ex) is outward on a counter-clockwise polygon
+    flip = outward * (nx * ey - ny * ex) < 0
     nx = np.where(flip, -nx, nx)
     ny = np.where(flip, -ny, ny)
     return length, nx, ny, ny, -nx
@@ -141,7 +241,8 @@ def derive_geometry(ds: xr.Dataset) -> xr.Dataset:
         ok = (side0 >= 0) & (side0 < cx.size)
         s0 = np.where(ok, side0, 0)
         length, nx, ny, tx, ty = interface_frame(
-            ds.interface_x.values, ds.interface_y.values, cx[s0], cy[s0]
+            ds.interface_x.values, ds.interface_y.values, s0, ds.node_x.values, ds.node_y.values,
+            ds.block_node_count.values,
         )
         nx, ny, tx, ty = (np.where(ok, a, np.nan) for a in (nx, ny, tx, ty))
     else:

@@ -100,7 +100,7 @@ def open_model(path_or_name: str | os.PathLike, *, validate: bool = True) -> xr.
     draw a broken one); its derived geometry is still computed.
     """
     from .builder import build
-    from .datasets import CASE_NAMES, bundled_spec_path
+    from .datasets import BUNDLED_NAMES, bundled_spec_path
 
     where = str(path_or_name)
     path = Path(path_or_name)
@@ -108,12 +108,12 @@ def open_model(path_or_name: str | os.PathLike, *, validate: bool = True) -> xr.
         return build(path) if validate else derive_geometry(build(path, validate=False))
     if path.exists():
         ds = open_dataset(path)
-    elif where in CASE_NAMES:
+    elif where in BUNDLED_NAMES:
         ds = build(bundled_spec_path(where), validate=False)
     elif _looks_like_a_path(where):
         raise ModelError(f"{where}: no such file")
     else:
-        raise ModelError(f"{where}: no such file, and not a bundled case; bundled cases: {', '.join(CASE_NAMES)}")
+        raise ModelError(f"{where}: no such file, and not a bundled case; bundled cases: {', '.join(BUNDLED_NAMES)}")
     if validate:
         return checked_model(ds, where)
     model = model_part(ds)

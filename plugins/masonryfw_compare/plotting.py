@@ -112,6 +112,50 @@ def default_amplification(geo: xr.Dataset, displacement) -> float:
     return DRAWN_MOTION_SHARE * size / largest if largest > 0 else 1.0
 
 
+ROLE_COLOURS = {"unit": "#f3e3c8", "lintel": "#8c6d46", "fixed_support": SUPPORT_COLOUR, "moving_support": "#e0a020"}
+KIND_COLOURS = {"bed": "tab:blue", "head": "tab:green", "other": "tab:purple", "support": "tab:red"}
+
+
+def draw_model(datasets: Sequence[xr.Dataset], ax, options: Mapping[str, Any]) -> None:
+    """A model as imported: blocks by role (supports hatched, a moving one with an arrow along its
+    settlement direction), interfaces coloured by kind, block numbers on request."""
+    ds = _single(datasets, "model")
+    geo = ds if "block_centroid_x" in ds else mf.derive_geometry(ds)
+    names = {value: name for name, value in mf.flags("block_role").items()}
+    roles = np.array([names[int(r)] for r in geo.block_role.values])
+    verts = _block_verts(geo, geo.node_x.values, geo.node_y.values)
+    support = _supports(geo)
+    fill = np.array([ROLE_COLOURS[r] for r in roles], dtype=object)
+    ax.add_collection(PolyCollection(list(verts[~support]), facecolors=list(fill[~support]), edgecolors="0.35",
+                                     linewidths=0.4, zorder=1))
+    if support.any():
+        ax.add_collection(PolyCollection(list(verts[support]), facecolors=list(fill[support]), edgecolors="0.2",
+                                         linewidths=0.4, hatch="////", zorder=1))
+    kinds = {value: name for name, value in mf.flags("interface_kind").items()}
+    kind = np.array([kinds[int(k)] for k in geo.interface_kind.values]) if "interface_kind" in geo else np.array([])
+    handles = []
+    for name, colour in KIND_COLOURS.items():
+        chosen = kind == name
+        if chosen.any():
+            segments = _segments(geo.interface_x.values[chosen], geo.interface_y.values[chosen])
+            ax.add_collection(LineCollection(segments, colors=colour, linewidths=1.2, zorder=2))
+            handles.append(Line2D([], [], color=colour, lw=1.5, label=f"{name} ({int(chosen.sum())})"))
+    size = mf.model_scale(geo.node_x.values, geo.node_y.values)
+    for block in np.flatnonzero(roles == "moving_support"):
+        direction = geo.settlement_direction.values[block, :2]
+        if np.linalg.norm(direction) > 0:
+            start = np.array([geo.block_centroid_x.values[block], geo.block_centroid_y.values[block]])
+            ax.annotate("", xy=start + 0.06 * size * direction / np.linalg.norm(direction), xytext=start,
+                        arrowprops={"arrowstyle": "-|>", "color": "#b00000", "lw": 1.6}, zorder=3)
+    if options["numbers"]:
+        for block in range(geo.sizes["block"]):
+            ax.text(geo.block_centroid_x.values[block], geo.block_centroid_y.values[block], str(block),
+                    ha="center", va="center", fontsize=options["font_size"], zorder=4)
+    if handles:
+        ax.legend(handles=handles, title="interfaces", fontsize="small", loc="upper left", bbox_to_anchor=(1.01, 1.0))
+    _finish(ax, ds)
+
+
 def draw_mechanism(datasets: Sequence[xr.Dataset], ax, options: Mapping[str, Any]) -> None:
     """The wall in its amplified deformed configuration, blocks coloured by macro-block, cracks heavy."""
     ds = _single(datasets, "mechanism")

@@ -38,6 +38,9 @@ def _plotter(name: str, summary: str, options: tuple = ()) -> mf.Plotter:
 PLOTTERS = {
     plotter.name: plotter
     for plotter in (
+        _plotter("model", "the model as built or imported: blocks by role, interfaces by kind, block numbers",
+                 (mf.Option("numbers", bool, False, "write every block's number at its centroid"),
+                  mf.Option("font_size", float, 5.0, "size of the block numbers [pt]", above=0.0))),
         _plotter("mechanism", "amplified deformed wall, macro-blocks coloured, cracks heavy",
                  (AMPLIFICATION_OPTION, THRESHOLD_OPTION)),
         _plotter("cracks", "joints that open, slide or both, in colours", (THRESHOLD_OPTION,)),

@@ -84,7 +84,6 @@ MODEL_CASES = {  # name: (breaker, what the message must say)
     "self-intersection": (_block0_vertices([(0, 0), (0.4, 0.2), (0.4, 0), (0, 0.2)]), r"block 0: .*intersects itself"),
     "zero area": (_block0_vertices([(0, 0), (0.2, 0), (0.4, 0), (0.3, 0)]), r"block 0: "),
     "collinear vertices": (_block0_vertices([(0, 0), (0.2, 0), (0.4, 0), (0, 0.2)]), r"block 0: .*straight line"),
-    "non-convex": (_block0_vertices([(0, 0), (0.4, 0), (0.1, 0.05), (0, 0.2)]), r"block 0: .*convex"),
     "overlap": (_shift_block2_down, r"block \d: .*overlap"),
     "NaN vertex": (_set("node_x", 5, np.nan), r"node_x.*(NaN|not finite)"),
     "inf load": (_set("dead_load", (1, 1), np.inf), r"dead_load.*(inf|not finite)"),

@@ -11,7 +11,7 @@ import tomllib
 
 import masonryfw
 from masonryfw import SpecError, build, flags, load_spec
-from masonryfw.builder import dump_toml
+from masonryfw.spec import dump_toml
 
 GAMMA = 12000.0
 THICKNESS = 0.1
@@ -314,7 +314,7 @@ SECOND_OPENING = {"x": 0.3, "y": 0.1, "width": 0.1, "height": 0.05, "lintel_bear
         (_set("unit.length", -0.2), "unit.length"),
         (_set("wall.thickness", 0.0), "wall.thickness"),
         (_set("wall.height", 0.23), "wall.height"),
-        (_set("length_unit", "cm"), "length_unit"),
+        (_set("length_unit", "km"), "length_unit"),
         (_set("bond", {"pattern": "flemish"}), "bond.pattern"),
         (_set("material.friction", 0.4), "material.friction"),
         (_set("material.friction_angle", DELETE), "material.friction_angle"),

@@ -291,12 +291,27 @@ def test_zero_area_block():
     assert any(p.where == "block 1" and "zero area" in p.message for p in problems)
 
 
-def test_non_convex_block():
+NOTCHED = [(0.0, 0.0), (1.0, 0.0), (1.0, 0.5), (0.5, 0.3), (0.0, 0.5)]  # unit 0 with a notch in its top
+
+
+def test_a_non_convex_block_is_a_block():
     polygons = [rectangle(*b) for b in BOXES]
-    polygons[0] = [(0.0, 0.0), (1.0, 0.0), (1.0, 0.5), (0.5, 0.3), (0.0, 0.5)]  # notch in the top
-    problem = the_only(check(with_nodes(model_dataset(), polygons)), "block 0")
-    assert "non-convex" in problem.message
-    assert (problem.x, problem.y) == (0.5, 0.3)
+    polygons[0] = NOTCHED
+    assert [p for p in check(with_nodes(model_dataset(), polygons)) if p.where == "block 0"] == []
+
+
+@pytest.mark.parametrize("drop, overlaps", [(0.0, False), (0.05, True)])
+def test_a_block_in_a_notch_touches_it_and_one_pushed_in_overlaps(drop, overlaps):
+    """The wedge filling the notch exactly touches it; pushed down by 0.05 m it overlaps by 0.05 cos(angle of the notch's side)."""
+    wedge = [(0.5, 0.3 - drop), (1.0, 0.5 - drop), (0.0, 0.5 - drop)]
+    polygons = [rectangle(*b) for b in BOXES] + [wedge]
+    polygons[0] = NOTCHED
+    found = [p for p in check(model_dataset(polygons=polygons, roles=ROLES + [0])) if "overlaps" in p.message]
+    assert bool(found) == overlaps
+    if overlaps:
+        assert found[0].where == "block 0" and "overlaps block 4" in found[0].message
+        depth = float(found[0].message.split("interpenetration ")[1].split(" ")[0])
+        assert depth == pytest.approx(drop * 0.5 / np.hypot(0.5, 0.2))
 
 
 def test_overlapping_blocks_report_the_penetration_depth():

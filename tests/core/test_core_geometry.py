@@ -48,16 +48,29 @@ def test_offsets_bounds_and_scale():
     assert mf.model_scale(x, y) == pytest.approx(5.0)
 
 
-def test_interface_normal_points_away_from_side0_and_tangent_is_n_rotated_minus_90():
-    # a bed joint y = 1 between a lower block (centroid below) and an upper one,
-    # and an inclined joint stored in the "wrong" end order
+def test_interface_normal_points_out_of_side0_and_tangent_is_n_rotated_minus_90():
+    # a bed joint y = 1 on a 2 x 1 block, and an inclined joint of a triangle stored in the "wrong" end order
+    x, y, n = _ragged([[(0, 0), (2, 0), (2, 1), (0, 1)], [(0, 0), (1, 0), (0, 1)]])
     ix = np.array([[0.0, 2.0], [1.0, 0.0]])
     iy = np.array([[1.0, 1.0], [0.0, 1.0]])
-    length, nx, ny, tx, ty = mf.interface_frame(ix, iy, np.array([1.0, 0.0]), np.array([0.5, 0.0]))
+    length, nx, ny, tx, ty = mf.interface_frame(ix, iy, np.array([0, 1]), x, y, n)
     np.testing.assert_allclose(length, [2.0, np.sqrt(2)])
     np.testing.assert_allclose([nx[0], ny[0], tx[0], ty[0]], [0, 1, 1, 0], atol=1e-15)
     np.testing.assert_allclose([nx[1], ny[1]], [np.sqrt(0.5), np.sqrt(0.5)])
     np.testing.assert_allclose([tx[1], ty[1]], [np.sqrt(0.5), -np.sqrt(0.5)])
+
+
+def test_the_normal_of_a_non_convex_block_follows_its_edge_not_its_centroid():
+    """An L (centroid (1.1, 1.1)) with a block in its notch: the centroid lies beyond both joint lines."""
+    ell = [(0, 0), (3, 0), (3, 1), (1, 1), (1, 3), (0, 3)]
+    notch = [(1, 1), (3, 1), (3, 2), (1, 2)]
+    x, y, n = _ragged([ell, notch])
+    assert mf.polygon_area_centroid(x, y, n)[1][0] == pytest.approx(1.1)
+    found = mf.detect_interfaces(x, y, n)
+    _, nx, ny, _, _ = mf.interface_frame(found["x"], found["y"], found["blocks"][:, 0], x, y, n)
+    assert found["blocks"].tolist() == [[0, 1], [0, 1]]
+    normals = sorted(zip(np.round(nx, 12).tolist(), np.round(ny, 12).tolist()))
+    assert normals == [(0.0, 1.0), (1.0, 0.0)]  # out of the L: up through its notch floor, right through its wall
 
 
 def test_degenerate_blocks_get_the_vertex_mean_and_nan_bounds():

@@ -1,0 +1,337 @@
+"""Blocks from drawings: CAD files (DXF), polygon tables (CSV) and GeoJSON, cleaned into simple polygons.
+
+One block per closed polyline (DXF ``LWPOLYLINE`` or 2D ``POLYLINE``, also inside
+block references), per ``block`` id of a CSV table (``block, x, y`` rows, an
+optional ``layer`` column) or per GeoJSON Polygon (``properties.layer``). What a
+drawing holds besides (text, points, lines, hatches) is left out and counted.
+
+Cleaning, in this order (every length in metres from here on):
+
+1. **snap**: vertices closer than the snap tolerance (default 1e-6 of the
+   drawing's size, the interface detection's tolerance) become one, the first
+   drawn, so two blocks drawn to the same corner share it exactly;
+2. **per polygon**: drop repeated vertices and a closing repeat of the first one
+   (a polyline that goes round twice is cut after its first round), drop
+   vertices on the straight line between their neighbours (T-junction marks,
+   redundant points, spikes), turn the vertex order counter-clockwise;
+3. **refuse** with the entity and its coordinates: an open polyline, arcs
+   without a chord tolerance, fewer than three vertices left, zero area, a
+   polygon that crosses or touches itself.
+
+Overlapping blocks are found afterwards by :func:`masonryfw.check`, like in
+every model. Arcs (DXF bulges) become chords no farther than
+``chord_tolerance`` from the arc; two blocks sharing an arc get the same chords.
+"""
+from __future__ import annotations
+
+import csv
+import json
+from collections import Counter
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from .errors import SpecError
+from .geometry import block_offsets, polygon_area_centroid
+from .semantics import connected_components
+
+#: Metres per drawing unit.
+DRAWING_UNITS = {"m": 1.0, "cm": 0.01, "mm": 0.001}
+#: DXF ``$INSUNITS`` codes of the drawing units above.
+INSUNITS = {4: "mm", 5: "cm", 6: "m"}
+#: Snap tolerance, relative to the drawing's bounding-box diagonal.
+RELATIVE_SNAP = 1e-6
+SUFFIXES = {".dxf": "dxf", ".csv": "csv", ".geojson": "geojson", ".json": "geojson"}
+
+
+@dataclass(frozen=True)
+class Drawing:
+    """Cleaned blocks of a drawing in the ragged layout (metres, counter-clockwise)."""
+
+    node_x: np.ndarray
+    node_y: np.ndarray
+    block_node_count: np.ndarray
+    layers: tuple[str, ...]  # per block
+    sources: tuple[str, ...]  # per block: what it was in the drawing, for messages
+    ignored: dict[str, int]  # entity types left out, and how many
+
+    def label(self, block: int) -> str:
+        """``"LWPOLYLINE #2BE on layer 0"``: where block ``block`` came from."""
+        return f"{self.sources[block]} on layer {self.layers[block]}"
+
+
+@dataclass(frozen=True)
+class _Ring:
+    x: np.ndarray
+    y: np.ndarray
+    layer: str
+    source: str
+
+
+def read_drawing(path: str | Path, drawing_unit: str | None = None, chord_tolerance: float | None = None,
+                 snap_tolerance: float | None = None) -> Drawing:
+    """The cleaned blocks of a drawing file (``.dxf``, ``.csv``, ``.geojson``/``.json``).
+
+    ``drawing_unit`` (m, cm, mm) overrides the DXF ``$INSUNITS`` and is required
+    for the other formats; ``chord_tolerance`` and ``snap_tolerance`` are in
+    drawing units. Raises :class:`SpecError` naming the entity (DXF handle, CSV
+    row, GeoJSON feature) and its coordinates.
+    """
+    path = Path(path)
+    kind = SUFFIXES.get(path.suffix.lower())
+    if kind is None:
+        raise SpecError(f"drawing {str(path)!r}: unknown file type {path.suffix!r}; "
+                        f"use {', '.join(sorted(SUFFIXES))}")
+    if not path.is_file():
+        raise SpecError(f"drawing {str(path)!r}: no such file")
+    if drawing_unit is not None and drawing_unit not in DRAWING_UNITS:
+        raise SpecError(f"drawing unit {drawing_unit!r}: must be one of {', '.join(DRAWING_UNITS)}")
+    if kind == "dxf":
+        rings, unit, ignored = _read_dxf(path, drawing_unit, chord_tolerance)
+    else:
+        if drawing_unit is None:
+            raise SpecError(f"drawing {str(path)!r}: a {kind.upper()} file carries no unit; "
+                            "give geometry.drawing_unit (m, cm or mm)")
+        rings, unit, ignored = (_read_csv(path) if kind == "csv" else _read_geojson(path)), drawing_unit, {}
+    if not rings:
+        raise SpecError(f"drawing {str(path)!r}: no closed polyline or polygon in it"
+                        + (f" (left out: {_counted(ignored)})" if ignored else ""))
+    scale = DRAWING_UNITS[unit]
+    rings = [_Ring(r.x * scale, r.y * scale, r.layer, r.source) for r in rings]
+    snap = None if snap_tolerance is None else snap_tolerance * scale
+    return clean(rings, snap, ignored)
+
+
+def _counted(ignored: dict[str, int]) -> str:
+    return ", ".join(f"{n} {kind}" for kind, n in sorted(ignored.items()))
+
+
+# ---------------------------------------------------------------- readers
+
+def _read_dxf(path: Path, drawing_unit: str | None, chord_tolerance: float | None):
+    import ezdxf  # here, not at the top: only a drawing needs it
+    from ezdxf import recover
+
+    try:
+        doc, _ = recover.readfile(str(path))
+    except (OSError, ezdxf.DXFStructureError) as exc:
+        raise SpecError(f"drawing {str(path)!r}: not a readable DXF file ({exc})") from None
+    unit = drawing_unit
+    if unit is None:
+        code = int(doc.header.get("$INSUNITS", 0))
+        unit = INSUNITS.get(code)
+        if unit is None:
+            raise SpecError(f"drawing {str(path)!r}: its $INSUNITS = {code} is not m, cm or mm "
+                            "(1 = inches is common in drawings made in mm); give geometry.drawing_unit")
+    rings: list[_Ring] = []
+    ignored: Counter = Counter()
+    for entity in _flat_entities(doc.modelspace()):
+        kind = entity.dxftype()
+        if kind in ("LWPOLYLINE", "POLYLINE"):
+            rings.append(_polyline_ring(entity, path, chord_tolerance))
+        else:
+            ignored[kind] += 1
+    return rings, unit, dict(ignored)
+
+
+def _flat_entities(layout):
+    """Every entity of ``layout``, block references (INSERT) exploded into their entities."""
+    for entity in layout:
+        if entity.dxftype() == "INSERT":
+            yield from _flat_entities(entity.virtual_entities())
+        else:
+            yield entity
+
+
+def _polyline_ring(entity, path: Path, chord_tolerance: float | None) -> _Ring:
+    from ezdxf import path as dxf_path
+
+    handle = entity.dxf.get("handle", "?")
+    layer = str(entity.dxf.get("layer", "0"))
+    source = f"{entity.dxftype()} #{handle}"
+    where = f"drawing {path.name!r}: {source} on layer {layer}"
+    if entity.dxftype() == "POLYLINE" and not entity.is_2d_polyline:
+        raise SpecError(f"{where}: a 3D polyline or mesh, not a block outline; draw each block as a closed 2D polyline")
+    has_arcs = entity.has_arc
+    if has_arcs and chord_tolerance is None:
+        raise SpecError(f"{where}: has arc segments (bulges); give geometry.chord_tolerance (drawing units) "
+                        "to replace them by chords, or draw straight segments")
+    if chord_tolerance is not None and not chord_tolerance > 0:
+        raise SpecError(f"geometry.chord_tolerance = {chord_tolerance!r}: must be > 0")
+    outline = dxf_path.make_path(entity)
+    points = np.array([(v.x, v.y, v.z) for v in outline.flattening(distance=chord_tolerance or 1.0)])
+    if points.shape[0] and np.ptp(points[:, 2]) > 0:
+        raise SpecError(f"{where}: its vertices are not in one plane parallel to the drawing (z varies)")
+    x, y = points[:, 0], points[:, 1]
+    closed = bool(entity.closed) or (x.size > 2 and x[0] == x[-1] and y[0] == y[-1])
+    if not closed:
+        raise SpecError(f"{where}: open (it starts at ({x[0]:.6g}, {y[0]:.6g}) and ends at "
+                        f"({x[-1]:.6g}, {y[-1]:.6g}) in drawing units); close it")
+    return _Ring(x, y, layer, source)
+
+
+def _number(text: str, where: str, column: str) -> float:
+    try:
+        value = float(text)
+    except (TypeError, ValueError):
+        raise SpecError(f"{where}: {column} = {text!r} is not a number") from None
+    if not np.isfinite(value):
+        raise SpecError(f"{where}: {column} = {text!r} is not finite")
+    return value
+
+
+def _read_csv(path: Path) -> list[_Ring]:
+    with open(path, newline="", encoding="utf-8-sig") as handle:
+        reader = csv.DictReader(handle)
+        columns = [c.strip() for c in (reader.fieldnames or [])]
+        missing = [c for c in ("block", "x", "y") if c not in columns]
+        if missing:
+            raise SpecError(f"drawing {path.name!r}: needs the columns block, x, y (and optionally layer) in "
+                            f"its first row; {', '.join(missing)} missing (found {', '.join(columns) or 'none'})")
+        points: dict[str, list] = {}
+        layers: dict[str, str] = {}
+        for number, row in enumerate(reader, start=2):
+            row = {k.strip(): (v or "").strip() for k, v in row.items() if k is not None}
+            where = f"drawing {path.name!r} row {number}"
+            block = row["block"]
+            if not block:
+                raise SpecError(f"{where}: the block column is empty")
+            points.setdefault(block, []).append((_number(row["x"], where, "x"), _number(row["y"], where, "y")))
+            layer = row.get("layer") or "0"
+            if layers.setdefault(block, layer) != layer:
+                raise SpecError(f"{where}: block {block!r} is on layer {layers[block]!r} in an earlier row, "
+                                f"{layer!r} here")
+    return [_Ring(np.array([p[0] for p in pts]), np.array([p[1] for p in pts]), layers[name], f"block {name!r}")
+            for name, pts in points.items()]
+
+
+def _read_geojson(path: Path) -> list[_Ring]:
+    try:
+        data = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, ValueError) as exc:
+        raise SpecError(f"drawing {path.name!r}: not readable JSON ({exc})") from None
+    features = data.get("features") if isinstance(data, dict) and data.get("type") == "FeatureCollection" else [data]
+    rings = []
+    for index, feature in enumerate(features or []):
+        geometry = feature.get("geometry", feature) if isinstance(feature, dict) else None
+        properties = (feature.get("properties") or {}) if isinstance(feature, dict) else {}
+        where = f"drawing {path.name!r} feature {index}"
+        if not isinstance(geometry, dict) or geometry.get("type") != "Polygon":
+            kind = geometry.get("type") if isinstance(geometry, dict) else type(geometry).__name__
+            raise SpecError(f"{where}: a {kind}, not a Polygon; one Polygon per block")
+        coordinates = geometry.get("coordinates") or []
+        if len(coordinates) != 1:
+            raise SpecError(f"{where}: a polygon with {max(len(coordinates) - 1, 0)} hole(s); "
+                            "a block is one outline without holes")
+        try:
+            ring = np.asarray(coordinates[0], dtype=float)[:, :2]
+        except (TypeError, ValueError, IndexError):
+            raise SpecError(f"{where}: its coordinates are not [x, y] pairs") from None
+        name = properties.get("name", properties.get("id", index))
+        rings.append(_Ring(ring[:, 0], ring[:, 1], str(properties.get("layer", "0")), f"feature {name}"))
+    return rings
+
+
+# ---------------------------------------------------------------- cleaning
+
+def clean(rings: list[_Ring], snap: float | None = None, ignored: dict[str, int] | None = None) -> Drawing:
+    """Snap, simplify, orient and validate ``rings`` (metres): the steps of the module docstring."""
+    x = np.concatenate([r.x for r in rings])
+    y = np.concatenate([r.y for r in rings])
+    size = float(np.hypot(np.ptp(x), np.ptp(y))) or 1.0
+    snap = RELATIVE_SNAP * size if snap is None else snap
+    if not snap > 0:
+        raise SpecError(f"geometry.snap_tolerance: must be > 0, got {snap!r}")
+    x, y = snapped(x, y, snap)
+    counts = np.array([r.x.size for r in rings])
+    starts = block_offsets(counts)
+    cleaned_x, cleaned_y, cleaned_counts = [], [], []
+    for i, ring in enumerate(rings):
+        rx, ry = _simplified(x[starts[i]:starts[i + 1]], y[starts[i]:starts[i + 1]], snap, ring)
+        cleaned_x.append(rx)
+        cleaned_y.append(ry)
+        cleaned_counts.append(rx.size)
+    node_x, node_y = np.concatenate(cleaned_x), np.concatenate(cleaned_y)
+    counts = np.array(cleaned_counts, dtype=np.int32)
+    _refuse_self_intersections(node_x, node_y, counts, rings)
+    node_x, node_y = _counter_clockwise(node_x, node_y, counts, rings, snap)
+    return Drawing(node_x, node_y, counts, tuple(r.layer for r in rings), tuple(r.source for r in rings),
+                   dict(ignored or {}))
+
+
+def snapped(x: np.ndarray, y: np.ndarray, tol: float) -> tuple[np.ndarray, np.ndarray]:
+    """Vertices within ``tol`` of each other (chains included) moved onto the first of them."""
+    from scipy.spatial import cKDTree
+
+    pairs = cKDTree(np.c_[x, y]).query_pairs(tol, output_type="ndarray")
+    label = connected_components(x.size, pairs)
+    first = np.full(label.max(initial=-1) + 1, x.size)
+    np.minimum.at(first, label, np.arange(x.size))
+    return x[first[label]], y[first[label]]
+
+
+def _simplified(x: np.ndarray, y: np.ndarray, tol: float, ring: _Ring) -> tuple[np.ndarray, np.ndarray]:
+    """One polygon without repeats, retraces and straight-line vertices."""
+    where = ring.source + f" on layer {ring.layer}"
+    keep = np.r_[True, (x[1:] != x[:-1]) | (y[1:] != y[:-1])]
+    x, y = x[keep], y[keep]
+    back = np.flatnonzero((x[1:] == x[0]) & (y[1:] == y[0])) + 1
+    if back.size:  # closed by repeating the first vertex, perhaps going on round again
+        tail = set(zip(x[back[0]:], y[back[0]:]))
+        if not tail <= set(zip(x[:back[0]], y[:back[0]])):
+            raise SpecError(f"{where}: passes through its first vertex ({x[0]:.6g}, {y[0]:.6g}) m and goes on "
+                            "elsewhere: it touches itself; draw one closed outline per block")
+        x, y = x[:back[0]], y[:back[0]]
+    while x.size >= 3:
+        distinct = (x != np.roll(x, 1)) | (y != np.roll(y, 1))
+        x, y = x[distinct], y[distinct]
+        straight = _straight_vertices(x, y, tol)
+        if not straight.any():
+            break
+        straight &= ~np.roll(straight, 1)  # never two neighbours in one pass: each goes against its own chord
+        x, y = x[~straight], y[~straight]
+    if x.size < 3:
+        raise SpecError(f"{where}: fewer than 3 distinct vertices after snapping (near ({ring.x[0]:.6g}, "
+                        f"{ring.y[0]:.6g}) m): not a block")
+    return x, y
+
+
+def _counter_clockwise(x, y, counts, rings, tol):
+    """Every polygon turned counter-clockwise; one with (nearly) no area is refused."""
+    area = polygon_area_centroid(x, y, counts)[0]
+    starts = block_offsets(counts)
+    for b in np.flatnonzero(area < 0):
+        x[starts[b]:starts[b + 1]] = x[starts[b]:starts[b + 1]][::-1].copy()
+        y[starts[b]:starts[b + 1]] = y[starts[b]:starts[b + 1]][::-1].copy()
+    owner = np.repeat(np.arange(counts.size), counts)
+    following = np.arange(x.size) + 1
+    following[starts[1:] - 1] = starts[:-1]
+    perimeter = np.bincount(owner, np.hypot(x[following] - x, y[following] - y), minlength=counts.size)
+    for b in np.flatnonzero(np.abs(area) <= tol * perimeter):
+        raise SpecError(f"{rings[b].source} on layer {rings[b].layer}: zero area near ({x[starts[b]]:.6g}, "
+                        f"{y[starts[b]]:.6g}) m: not a block")
+    return x, y
+
+
+def _straight_vertices(x: np.ndarray, y: np.ndarray, tol: float) -> np.ndarray:
+    """Vertices within ``tol`` of the straight line through their neighbours, and spike tips."""
+    px, py = np.roll(x, 1), np.roll(y, 1)
+    nx, ny = np.roll(x, -1), np.roll(y, -1)
+    chord = np.hypot(nx - px, ny - py)
+    cross = (x - px) * (ny - py) - (y - py) * (nx - px)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        offset = np.where(chord > 0, np.abs(cross) / chord, 0.0)
+    return offset <= tol
+
+
+def _refuse_self_intersections(x, y, counts, rings) -> None:
+    """A SpecError naming the first polygon whose edges cross or touch (other than at its vertices in turn)."""
+    import shapely
+
+    rings_of = shapely.linearrings(np.c_[x, y], indices=np.repeat(np.arange(counts.size), counts))
+    simple = shapely.is_simple(rings_of)
+    for b in np.flatnonzero(~simple):
+        reason = shapely.is_valid_reason(shapely.polygons(rings_of[b]))
+        raise SpecError(f"{rings[b].source} on layer {rings[b].layer}: the outline crosses or touches itself "
+                        f"({reason}, coordinates in m); draw each block as one simple closed outline")

@@ -1,0 +1,319 @@
+"""Walls drawn elsewhere: a spec whose ``[geometry]`` table points at a drawing.
+
+The drawing gives the blocks (:mod:`masonryfw.drawing`); the spec gives what a
+drawing cannot: the wall thickness, the material, which blocks are supports and
+how they move, and the loading. The keys (``docs/import.md``)::
+
+    [geometry]
+    dxf = "wall.dxf"          # or polygons = "blocks.csv" / "blocks.geojson"; relative to the spec file
+    drawing_unit = "mm"       # m, cm or mm; overrides the DXF's $INSUNITS
+    chord_tolerance = 0.5     # optional, drawing units: arcs become chords this close to them
+    snap_tolerance = 0.001    # optional, drawing units (default 1e-6 of the drawing's size)
+    [geometry.layers]         # optional: the role of the blocks on a layer
+    LINTELS = "lintel"        # unit (default), lintel, or ignore (left out)
+    [supports.base]
+    kind = "fixed"
+    select = "lowest"         # lowest, leftmost or rightmost block; or layer = "BASE"; or at = [x, y]
+    [supports.settling]
+    kind = "moving"
+    layer = "SETTLE"          # every block on this layer is this support
+    motion = "translation"    # or "rotation" with pivot = [x, y]
+
+Lengths written in the spec (``wall.thickness``, ``pivot``, ``at``) are in its
+``length_unit`` (m unless said); the drawing's are in ``drawing_unit``. The
+parametric keys (``[unit]``, ``[bond]``, ``[openings]``, ``wall.width``,
+``wall.height``, support ``start``/``end``) do not apply and are refused.
+Blocks come in drawing order (units and lintels), then the supports in spec
+order; loads, interfaces and kinds as for every model (:mod:`masonryfw.blocks`).
+"""
+from __future__ import annotations
+
+import hashlib
+import os
+import re
+from dataclasses import dataclass, replace
+from pathlib import Path
+
+import numpy as np
+import xarray as xr
+
+from . import blocks
+from .drawing import DRAWING_UNITS, Drawing, read_drawing
+from .errors import ModelError, SpecError
+from .geometry import block_bounds, polygon_area_centroid
+from .model import checked_model
+from .schema import flags
+from .spec import LENGTH_UNITS, SpecTable, check_pivot, read_loading, read_material, read_motion
+
+LAYER_ROLES = ("unit", "lintel", "ignore")
+_BLOCK = re.compile(r"\bblock (\d+)\b")
+SELECTIONS = ("lowest", "leftmost", "rightmost")
+_TOP_KEYS = ("title", "description", "length_unit", "geometry", "wall", "material", "supports", "loading")
+_GEOMETRY_KEYS = ("dxf", "polygons", "drawing_unit", "chord_tolerance", "snap_tolerance", "layers")
+_SUPPORT_KEYS = ("kind", "select", "layer", "at", "motion", "pivot")
+_PARAMETRIC = {
+    "unit": "the drawing gives the blocks",
+    "bond": "the drawing gives the blocks",
+    "openings": "openings are drawn (left empty) in the drawing",
+}
+
+
+@dataclass(frozen=True)
+class DrawnSupport:
+    """A support of a drawn wall: how its blocks are chosen and how they move (SI)."""
+
+    name: str
+    kind: str
+    how: str  # select, layer or at
+    what: object  # the selection keyword, the layer name or the point (m)
+    motion: str
+    pivot: tuple[float, float] | None
+    table: SpecTable
+
+
+@dataclass(frozen=True)
+class DrawnSpec:
+    """A validated ``[geometry]`` spec, lengths in metres (the drawing not read yet)."""
+
+    title: str
+    description: str
+    drawing: str  # path as written
+    drawing_key: str  # dxf or polygons
+    drawing_unit: str | None
+    chord_tolerance: float | None
+    snap_tolerance: float | None
+    layers: dict[str, str]
+    thickness: float
+    material: blocks.Material
+    supports: tuple[DrawnSupport, ...]
+    loading: str
+    tilt_direction: int
+
+
+def is_drawn(spec: dict) -> bool:
+    """Whether a spec dict describes a drawn wall (it has a ``[geometry]`` table)."""
+    return isinstance(spec, dict) and "geometry" in spec
+
+
+def parse_drawn_spec(spec: dict) -> DrawnSpec:
+    """Validate a ``[geometry]`` spec; a :class:`SpecError` names the key at fault."""
+    for key, why in _PARAMETRIC.items():
+        if key in spec:
+            raise SpecError(f"spec key {key!r} does not apply to a wall drawn in [geometry] ({why})")
+    top = SpecTable(spec, "", _TOP_KEYS)
+    unit_name = top.choice("length_unit", tuple(LENGTH_UNITS), "m")
+    top.scale = LENGTH_UNITS[unit_name]
+    geometry = top.sub("geometry", _GEOMETRY_KEYS)
+    sources = [k for k in ("dxf", "polygons") if geometry.has(k)]
+    if len(sources) != 1:
+        raise SpecError("spec table 'geometry': give exactly one of 'geometry.dxf' (a DXF drawing) and "
+                        "'geometry.polygons' (a CSV or GeoJSON file of block outlines)"
+                        + (", not both" if sources else ""))
+    drawing_unit = geometry.raw("drawing_unit", None)
+    if drawing_unit is not None and drawing_unit not in DRAWING_UNITS:
+        geometry.choice("drawing_unit", tuple(DRAWING_UNITS))
+    layers_table = geometry.raw("layers", {})
+    if not isinstance(layers_table, dict):
+        raise SpecError(f"spec key 'geometry.layers' = {layers_table!r}: must be a table of layer = role")
+    layers = {}
+    for layer, role in layers_table.items():
+        if role not in LAYER_ROLES:
+            raise SpecError(f"spec key 'geometry.layers.{layer}' = {role!r}: must be one of "
+                            f"{', '.join(map(repr, LAYER_ROLES))}")
+        layers[str(layer)] = role
+    wall = top.raw("wall", {})
+    for key in ("width", "height"):
+        if isinstance(wall, dict) and key in wall:
+            raise SpecError(f"spec key 'wall.{key}' does not apply to a wall drawn in [geometry] "
+                            "(the drawing gives its size)")
+    wall = top.sub("wall", ("thickness",))
+    material = read_material(top)
+    supports = _drawn_supports(top, layers)
+    loading, direction = read_loading(top, any(s.kind == "moving" for s in supports))
+    return DrawnSpec(
+        title=top.text("title"),
+        description=top.text("description", ""),
+        drawing=geometry.text(sources[0]),
+        drawing_key=f"geometry.{sources[0]}",
+        drawing_unit=drawing_unit,
+        chord_tolerance=geometry.number("chord_tolerance", None, positive=True),
+        snap_tolerance=geometry.number("snap_tolerance", None, positive=True),
+        layers=layers,
+        thickness=wall.number("thickness", length=True, positive=True),
+        material=material,
+        supports=supports,
+        loading=loading,
+        tilt_direction=direction,
+    )
+
+
+def _drawn_supports(top: SpecTable, layers: dict[str, str]) -> tuple[DrawnSupport, ...]:
+    table = top.raw("supports")
+    if not isinstance(table, dict) or not table:
+        raise SpecError(f"spec key 'supports' = {table!r}: must hold at least one [supports.<name>] table")
+    supports = []
+    for name in table:
+        entry = table[name]
+        for key in ("start", "end"):
+            if isinstance(entry, dict) and key in entry:
+                raise SpecError(f"spec key 'supports.{name}.{key}' does not apply to a wall drawn in [geometry]: "
+                                "choose the support's blocks by select, layer or at")
+        entry = SpecTable(entry, f"supports.{name}", _SUPPORT_KEYS, top.scale)
+        kind = entry.choice("kind", ("fixed", "moving"))
+        ways = [k for k in ("select", "layer", "at") if entry.has(k)]
+        if len(ways) != 1:
+            raise SpecError(f"spec table 'supports.{name}': choose its blocks with exactly one of select "
+                            f"({', '.join(SELECTIONS)}), layer or at" + (f" (found {', '.join(ways)})" if ways else ""))
+        how = ways[0]
+        if how == "select":
+            what: object = entry.choice("select", SELECTIONS)
+        elif how == "layer":
+            what = entry.text("layer")
+            if what in layers:
+                raise SpecError(f"spec keys 'supports.{name}.layer' and 'geometry.layers.{what}': the layer "
+                                f"{what!r} cannot be both a support and {layers[what]!r}")
+        else:
+            what = entry.point("at")
+        motion, pivot = read_motion(entry, kind)
+        supports.append(DrawnSupport(name, kind, how, what, motion, pivot, entry))
+    return tuple(supports)
+
+
+def resolved_drawing(spec: DrawnSpec, base_dir: Path | None) -> Path:
+    """The drawing's path: as written if absolute, else relative to ``base_dir`` (the spec file's folder)."""
+    path = Path(os.path.expanduser(spec.drawing))
+    return path if path.is_absolute() or base_dir is None else base_dir / path
+
+
+def build_drawn(spec_dict: dict, text: str, base_dir: Path | None, validate: bool = True) -> xr.Dataset:
+    """The model of a drawn wall (see the module docstring); checked unless ``validate`` is False."""
+    spec = parse_drawn_spec(spec_dict)
+    path = resolved_drawing(spec, base_dir)
+    if not path.is_file():
+        raise SpecError(f"spec key {spec.drawing_key!r} = {spec.drawing!r}: no such file ({path})")
+    drawing = read_drawing(path, spec.drawing_unit, spec.chord_tolerance, spec.snap_tolerance)
+    kept = np.array([spec.layers.get(layer, "unit") != "ignore" for layer in drawing.layers])
+    chosen = _support_blocks(spec, drawing, kept)
+    role_flag = flags("block_role")
+    supports_of = np.full(len(drawing.layers), -1)
+    for index, members in enumerate(chosen):
+        supports_of[members] = index
+    masonry = np.flatnonzero(kept & (supports_of < 0))
+    if masonry.size == 0:
+        raise SpecError(f"drawing {path.name!r}: every block is a support or ignored; nothing to analyse")
+    support_order = np.concatenate([members for members in chosen])
+    order = np.concatenate((masonry, support_order))
+    roles = np.array([role_flag["lintel"] if spec.layers.get(drawing.layers[b]) == "lintel" else role_flag["unit"]
+                      for b in masonry] + [role_flag["fixed_support"]] * support_order.size, dtype=np.int8)
+    described = [blocks.Support(f"spec key 'supports.{s.name}'", s.kind, s.motion, s.pivot)
+                 for s, members in zip(spec.supports, chosen) for _ in members]
+    node_x, node_y, counts = _reordered(drawing, order)
+    _check_pivots(spec, chosen, drawing)
+    attrs = {
+        "title": spec.title,
+        "source_spec": text,
+        "source_drawing": path.name,
+        "source_drawing_sha256": hashlib.sha256(path.read_bytes()).hexdigest(),
+    }
+    if spec.description:
+        attrs["comment"] = spec.description
+    labels = [drawing.label(b) for b in order]
+    ds = blocks.model_from_blocks(node_x, node_y, counts, roles, spec.thickness, spec.material, described,
+                                  spec.loading, spec.tilt_direction, attrs)
+    _refuse_lonely_supports(ds, spec, chosen, masonry.size, labels)
+    if not validate:
+        return ds
+    try:
+        return checked_model(ds, repr(spec.title))
+    except ModelError as exc:
+        raise ModelError(f"model {spec.title!r} from drawing {path.name!r} is invalid "
+                         f"({len(exc.problems)} problem(s))",
+                         [_labelled(p, labels) for p in exc.problems]) from None
+
+
+def _support_blocks(spec: DrawnSpec, drawing: Drawing, kept: np.ndarray) -> list[np.ndarray]:
+    """The drawing's blocks of every support, in spec order; a selection matching nothing or twice is refused."""
+    xmin, xmax, ymin, _ = block_bounds(drawing.node_x, drawing.node_y, drawing.block_node_count)
+    taken = np.full(kept.size, -1)
+    chosen = []
+    tol = 1e-6 * float(np.hypot(np.ptp(drawing.node_x), np.ptp(drawing.node_y)))
+    for index, support in enumerate(spec.supports):
+        key = f"supports.{support.name}.{support.how}"
+        candidates = kept & (taken < 0)
+        if support.how == "layer":
+            members = np.flatnonzero(candidates & (np.array(drawing.layers) == support.what))
+            if members.size == 0:
+                layers = sorted(set(drawing.layers))
+                raise SpecError(f"spec key {key!r} = {support.what!r}: no block of the drawing (left) on this "
+                                f"layer; the drawing's layers: {', '.join(layers)}")
+        elif support.how == "at":
+            members = _blocks_containing(drawing, support.what, candidates)
+            if members.size == 0:
+                raise SpecError(f"spec key {key!r} = {list(support.what)!r}: the point lies in no block of the "
+                                "drawing (lengths in the spec's length_unit)")
+        else:
+            value = {"lowest": ymin, "leftmost": xmin, "rightmost": -xmax}[support.what]
+            value = np.where(candidates, value, np.inf)
+            best = np.flatnonzero(value <= value.min() + tol)
+            if best.size > 1:
+                names = "; ".join(drawing.label(b) for b in best[:3])
+                raise SpecError(f"spec key {key!r} = {support.what!r}: {best.size} blocks tie ({names}); "
+                                "choose by layer or at")
+            members = best
+        clash = members[taken[members] >= 0]
+        if clash.size:
+            raise SpecError(f"spec key {key!r}: {drawing.label(clash[0])} is already support "
+                            f"{spec.supports[taken[clash[0]]].name!r}")
+        taken[members] = index
+        chosen.append(members)
+    return chosen
+
+
+def _blocks_containing(drawing: Drawing, point, candidates: np.ndarray) -> np.ndarray:
+    import shapely
+
+    polygons = shapely.polygons(
+        shapely.linearrings(np.c_[drawing.node_x, drawing.node_y],
+                            indices=np.repeat(np.arange(drawing.block_node_count.size), drawing.block_node_count)))
+    inside = shapely.contains_xy(polygons, point[0], point[1]) | shapely.touches(polygons, shapely.points(point))
+    return np.flatnonzero(inside & candidates)
+
+
+def _reordered(drawing: Drawing, order: np.ndarray):
+    """The drawing's polygons in block order ``order``."""
+    counts = drawing.block_node_count[order]
+    first = np.repeat(np.concatenate(([0], np.cumsum(drawing.block_node_count)))[order], counts)
+    nodes = first + np.arange(counts.sum()) - np.repeat(np.cumsum(counts) - counts, counts)
+    return drawing.node_x[nodes], drawing.node_y[nodes], counts
+
+
+def _check_pivots(spec: DrawnSpec, chosen: list[np.ndarray], drawing: Drawing) -> None:
+    cx = polygon_area_centroid(drawing.node_x, drawing.node_y, drawing.block_node_count)[1]
+    tol = 1e-9 * float(np.hypot(np.ptp(drawing.node_x), np.ptp(drawing.node_y)))
+    for support, members in zip(spec.supports, chosen):
+        for block in members:
+            check_pivot(support.table, support.pivot, float(cx[block]), tol)
+
+
+def _refuse_lonely_supports(ds: xr.Dataset, spec: DrawnSpec, chosen, n_masonry: int, labels: list[str]) -> None:
+    """Every support block must touch the masonry: one that does not is named with its entity."""
+    sides = ds.interface_blocks.values
+    touched = np.zeros(ds.sizes["block"], dtype=bool)
+    touched[sides.ravel()] = True
+    first = n_masonry
+    for support, members in zip(spec.supports, chosen):
+        for offset in range(members.size):
+            block = first + offset
+            if not touched[block]:
+                raise SpecError(f"spec table 'supports.{support.name}': {labels[block]} touches no masonry "
+                                "(no common edge with a unit or lintel)")
+        first += members.size
+
+
+def _labelled(problem, labels: list[str]):
+    """``problem`` with every ``block N`` it names followed by the drawing entity the block came from."""
+    def named(match: re.Match) -> str:
+        block = int(match.group(1))
+        return f"{match.group(0)} ({labels[block]})" if block < len(labels) else match.group(0)
+
+    return replace(problem, where=_BLOCK.sub(named, problem.where), message=_BLOCK.sub(named, problem.message))
