@@ -25,11 +25,15 @@ from .geometry import (
     DERIVED_GEOMETRY_VARIABLES,
     block_bounds,
     block_offsets,
+    convex_blocks,
+    convex_pieces,
     derive_geometry,
     interface_frame,
     model_scale,
     node_block,
+    point_segment_distance,
     polygon_area_centroid,
+    triangulated,
 )
 from .hookspecs import (
     AUTO,

@@ -103,12 +103,40 @@ def convex_blocks(node_x, node_y, block_node_count, tol: float = 0.0) -> np.ndar
     return np.bincount(owner, reflex, minlength=counts.size) == 0
 
 
+def triangulated(node_x, node_y, block_node_count, blocks) -> tuple[np.ndarray, np.ndarray]:
+    """Triangles ``(n, 3)`` of node indices, counter-clockwise, and their block: the constrained
+    Delaunay triangulation (GEOS, through shapely) of every polygon in ``blocks``, on its own vertices."""
+    import shapely  # here, not at the top: most models are convex and the CLI starts faster without it
+
+    x = np.asarray(node_x, dtype=float)
+    y = np.asarray(node_y, dtype=float)
+    counts = np.asarray(block_node_count, dtype=np.int64)
+    blocks = np.asarray(blocks, dtype=np.int64)
+    if blocks.size == 0:
+        return np.zeros((0, 3), np.int64), np.zeros(0, np.int64)
+    owner = node_block(counts)
+    chosen = np.isin(owner, blocks)
+    nodes = np.flatnonzero(chosen)
+    position = {(int(owner[k]), x[k], y[k]): int(k) for k in nodes}
+    present, rank = np.unique(owner[chosen], return_inverse=True)
+    rings = shapely.linearrings(np.c_[x[chosen], y[chosen]], indices=rank)
+    parts, which = shapely.get_parts(shapely.constrained_delaunay_triangles(shapely.polygons(rings)),
+                                     return_index=True)
+    block_of = present[which]
+    corners = shapely.get_coordinates(shapely.get_exterior_ring(parts)).reshape(-1, 4, 2)[:, :3]
+    triangles = np.array([[position[(int(b), cx, cy)] for cx, cy in corner] for b, corner in zip(block_of, corners)],
+                         dtype=np.int64).reshape(-1, 3)
+    tx, ty = x[triangles], y[triangles]
+    clockwise = (tx[:, 1] - tx[:, 0]) * (ty[:, 2] - ty[:, 0]) - (tx[:, 2] - tx[:, 0]) * (ty[:, 1] - ty[:, 0]) < 0
+    triangles[clockwise] = triangles[clockwise][:, ::-1]
+    return triangles, block_of
+
+
 def convex_pieces(node_x, node_y, block_node_count, tol: float = 0.0):
     """Convex counter-clockwise polygons that tile every block: ``(x, y, counts, owner)`` in the ragged layout.
 
     A convex block is its own piece; a non-convex one is split into the triangles
-    of its constrained Delaunay triangulation (GEOS, through shapely), which use its
-    vertices only. ``tol`` as in :func:`convex_blocks`.
+    of :func:`triangulated`, which use its vertices only. ``tol`` as in :func:`convex_blocks`.
     """
     x = np.asarray(node_x, dtype=float)
     y = np.asarray(node_y, dtype=float)
@@ -116,25 +144,13 @@ def convex_pieces(node_x, node_y, block_node_count, tol: float = 0.0):
     convex = convex_blocks(x, y, counts, tol)
     if convex.all():
         return x, y, counts, np.arange(counts.size)
-    import shapely  # here, not at the top: most models are convex and the CLI starts faster without it
-
-    concave = np.flatnonzero(~convex)
-    on_concave = ~convex[node_block(counts)]
-    rings = shapely.linearrings(np.c_[x[on_concave], y[on_concave]],
-                                indices=np.repeat(np.arange(concave.size), counts[concave]))
-    triangulated = shapely.constrained_delaunay_triangles(shapely.polygons(rings))
-    parts, which = shapely.get_parts(triangulated, return_index=True)
-    corners = shapely.get_coordinates(shapely.get_exterior_ring(parts)).reshape(-1, 4, 2)[:, :3]
-    tx, ty = corners[..., 0], corners[..., 1]
-    clockwise = (tx[:, 1] - tx[:, 0]) * (ty[:, 2] - ty[:, 0]) - (tx[:, 2] - tx[:, 0]) * (ty[:, 1] - ty[:, 0]) < 0
-    tx[clockwise] = tx[clockwise][:, ::-1]
-    ty[clockwise] = ty[clockwise][:, ::-1]
+    triangles, which = triangulated(x, y, counts, np.flatnonzero(~convex))
     keep = convex[node_block(counts)]
-    owner = np.concatenate((np.flatnonzero(convex), concave[which]))
+    owner = np.concatenate((np.flatnonzero(convex), which))
     out_counts = np.concatenate((counts[convex], np.full(which.size, 3)))
     order = np.argsort(owner, kind="stable")
-    px = np.concatenate((x[keep], tx.ravel()))
-    py = np.concatenate((y[keep], ty.ravel()))
+    px = np.concatenate((x[keep], x[triangles].ravel()))
+    py = np.concatenate((y[keep], y[triangles].ravel()))
     sorted_counts = out_counts[order]
     first = np.repeat(block_offsets(out_counts)[:-1][order], sorted_counts)
     nodes = first + np.arange(sorted_counts.sum()) - np.repeat(block_offsets(sorted_counts)[:-1], sorted_counts)

@@ -10,8 +10,10 @@ rewrites every ``<name>.dxf``/``.geojson`` and ``<name>.toml`` in this folder.
   coordinates to 0.001 mm; the wall and the arch are parametric) and not copied.
   LACT3's solver test gives their tilting-table collapse angles: 16.73 deg
   (wall, phi = 26 deg), 27.30 deg (portal) and 17.10 deg (arch, phi = 30 deg),
-  c = 0. The quirks of the originals are kept on purpose, as import tests: every
-  block on layer 0, the wall's ``$INSUNITS`` says inches for a drawing in mm,
+  c = 0. The quirks of the originals are kept on purpose, as import tests: the
+  blocks on layer 0 (but the blocks that bridge an opening, on layer LINTEL: for
+  the limit analysis and fdem a lintel is a block like any other, for jmm an
+  elastic one), the wall's ``$INSUNITS`` says inches for a drawing in mm,
   mid-edge vertices marking T-junctions, polylines closed by repeating their
   first vertex instead of the closed flag, one that goes on past its start, a
   non-convex base that carries the arch's springers, and POINT entities.
@@ -65,7 +67,12 @@ def lact3_wall() -> tuple[list[Polygon], list[str]]:
                      (1625, y0), (1125, y0), (1000, y0)])  # the lintel, closed by its repeated first vertex
     base = [(2250, 150), (2520.731, 150), (2520.731, 0), (0, 0), (0, 150)] + [(250.0 * i, 150) for i in range(1, 10)]
     polygons.append(base)
-    return polygons, ["0"] * len(polygons)
+    layers = ["0"] * len(polygons)
+    layers[-2] = "LINTEL"  # the drawn lintel over the window
+    for i, polygon in enumerate(polygons):  # the two units of course 25 that bridge the door
+        if polygon[0][1] == 150.0 + 25 * h and polygon[0][0] in (375.0, 625.0):
+            layers[i] = "LINTEL"
+    return polygons, layers
 
 
 #: The portal's blocks [mm], in the order of the original drawing; the base first.
@@ -123,10 +130,14 @@ PORTAL = [
 ]
 
 
+#: The portal's lintel (the block over the opening) in :data:`PORTAL`.
+PORTAL_LINTEL = 23
+
+
 def lact3_portal() -> tuple[list[Polygon], list[str]]:
     """Two jambs of irregular stones, a lintel on inclined bearings, a wall above, on one base."""
     polygons = [list(p) for p in PORTAL]
-    return polygons, ["0"] * len(polygons)
+    return polygons, ["LINTEL" if i == PORTAL_LINTEL else "0" for i in range(len(polygons))]
 
 
 def _on_circle(centre, radius: float, angle: float) -> tuple[float, float]:

@@ -1,10 +1,12 @@
 """The ``deformable`` mode: every block a fan of constant-strain triangles (CST), joints as in
 the rigid mode.
 
-Mesh: each convex block is split into a fan of triangles from an extra node at its centroid,
-so its boundary nodes are exactly the model's polygon nodes (same indices as
-``Scene.lx``), and the rigid mode's face-pair detection and contact law apply unchanged to
-the current boundary. Nodes ``0 .. n_polygon_node - 1`` are the polygon nodes, followed by one
+Mesh: each block is split into a fan of triangles from an extra node at its centroid (a
+non-convex block that its centroid does not see whole: into the constrained Delaunay
+triangles of its own nodes, its centroid node left massless and out of every element), so
+its boundary nodes are exactly the model's polygon nodes (same indices as ``Scene.lx``),
+and the rigid mode's face-pair detection and contact law apply unchanged to the current
+boundary. Nodes ``0 .. n_polygon_node - 1`` are the polygon nodes, followed by one
 centroid node per block.
 
 Elements: plane stress, total Lagrangian with the Green-Lagrange strain and a Saint
@@ -38,6 +40,7 @@ from .kernels import (
     WORK_SUPPORT,
     face_geometry,
     settlement_rate,
+    smooth_share,
 )
 from .scene import Scene
 
@@ -76,6 +79,29 @@ def fan_triangles(offs: np.ndarray) -> np.ndarray:
     return np.stack((n_poly + block, k, nxt), axis=1).astype(np.int64)
 
 
+#: A fan triangle thinner than this share of its block's area makes the block triangulated instead.
+FAN_MIN_SHARE = 1e-3
+
+
+def block_triangles(x0: np.ndarray, y0: np.ndarray, offs: np.ndarray) -> np.ndarray:
+    """(tri, 3) counter-clockwise elements of every block: the fan from its centroid node where every
+    fan triangle is positive (convex blocks, and star-shaped ones seen from their centroid), else the
+    constrained Delaunay triangulation of its polygon nodes (its centroid node is then left out)."""
+    fan = fan_triangles(offs)
+    px, py = x0[fan], y0[fan]
+    area = 0.5 * ((px[:, 1] - px[:, 0]) * (py[:, 2] - py[:, 0]) - (px[:, 2] - px[:, 0]) * (py[:, 1] - py[:, 0]))
+    counts = np.diff(offs)
+    block = np.repeat(np.arange(counts.size), counts)
+    block_area = np.bincount(block, weights=area, minlength=counts.size)
+    thin = area <= FAN_MIN_SHARE * block_area[block]
+    bad = np.unique(block[thin])
+    if bad.size == 0:
+        return fan
+    n_poly = int(offs[-1])
+    triangles, _ = mf.triangulated(x0[:n_poly], y0[:n_poly], counts, bad)
+    return np.concatenate((fan[~np.isin(block, bad)], triangles))
+
+
 def shape_gradients(x: np.ndarray, y: np.ndarray, triangles: np.ndarray):
     """Constant shape-function gradients (tri, 3) and signed areas (tri,) of linear triangles."""
     px, py = x[triangles], y[triangles]
@@ -111,8 +137,8 @@ def build_mesh(model, scene: Scene) -> Mesh:
     x0 = np.concatenate((scene.pos0[owner, 0] + scene.lx, scene.pos0[:, 0]))
     y0 = np.concatenate((scene.pos0[owner, 1] + scene.ly, scene.pos0[:, 1]))
     node_block = np.concatenate((owner, np.arange(n_block)))
-    triangles = fan_triangles(scene.offs)
-    tri_block = node_block[triangles[:, 0]]
+    triangles = block_triangles(x0, y0, scene.offs)
+    tri_block = node_block[triangles[:, 1]]
     grad_x, grad_y, area0 = shape_gradients(x0, y0, triangles)
     block_area = np.bincount(tri_block, weights=area0, minlength=n_block)
     young, nu = elastic_constants(model, n_block)
@@ -124,7 +150,7 @@ def build_mesh(model, scene: Scene) -> Mesh:
     driven = scene.driven[node_block]
     return Mesh(x0=x0, y0=y0, node_block=node_block, triangles=triangles, grad_x=grad_x, grad_y=grad_y,
                 area0=area0, young=young_scaled[tri_block], poisson=nu[tri_block], mass=mass,
-                inv_mass=np.where(driven, 0.0, 1.0 / mass), driven=driven,
+                inv_mass=np.where(driven | (mass <= 0), 0.0, 1.0 / np.where(mass > 0, mass, 1.0)), driven=driven,
                 active_tri=~scene.driven[tri_block])
 
 
@@ -162,7 +188,9 @@ def critical_time_step(mesh: Mesh, scene: Scene, kn: float) -> float:
     wave = mesh.young / (density * (1.0 - mesh.poisson**2))
     omega_element = (4.0 * wave / altitude**2)[free_tri].max(initial=0.0)
     n_poly = scene.lx.size
-    edge = np.hypot(np.diff(px[:, 1:], axis=1)[:, 0], np.diff(py[:, 1:], axis=1)[:, 0])  # polygon edges
+    following = np.arange(n_poly) + 1
+    following[scene.offs[1:] - 1] = scene.offs[:-1]
+    edge = np.hypot(mesh.x0[following] - mesh.x0[:n_poly], mesh.y0[following] - mesh.y0[:n_poly])  # polygon edges
     tributary = 0.5 * (edge + edge[prev_edge(scene.offs)])
     free_poly = ~mesh.driven[:n_poly]
     omega_contact = (kn * tributary / mesh.mass[:n_poly])[free_poly].max(initial=0.0)
@@ -360,8 +388,8 @@ def driven_motion(settlement, rate, x0, y0, node_block, driven_nodes, pos0, dire
 @jit
 def advance(n_steps, dt, x, y, vel, x0, y0, x_detect, y_detect, offs, node_block, triangles, grad_x, grad_y,
             area0, young, poisson, active_tri, mass, inv_mass, driven, moving, pos0, direction, faces, props,
-            kn, kt, min_half, contact_damping, shear, bonded, normal, energy, load, load_ramp, damping, rate,
-            ramp_time, start_time, target, half_buffer, acc, out):
+            kn, kt, min_half, contact_damping, shear, bonded, normal, energy, load, load_ramp, added_load,
+            added_start, added_time, damping, rate, ramp_time, start_time, target, half_buffer, acc, out):
     """Up to ``n_steps`` central-difference steps of the nodes (see :func:`.kernels.advance` for the
     damping, the loads, the supports, the stop conditions and ``out``; stored energy = strain + springs)."""
     n_node = x.size
@@ -372,10 +400,11 @@ def advance(n_steps, dt, x, y, vel, x0, y0, x_detect, y_detect, offs, node_block
     rebuild = 0
     load_norm = 0.0
     for k in range(n_node):
-        load_norm += abs(load[k, 0]) + abs(load[k, 1])
+        load_norm += abs(load[k, 0] + added_load[k, 0]) + abs(load[k, 1] + added_load[k, 1])
     limit = half_buffer * half_buffer
     for _ in range(n_steps):
         time = acc[TIME]
+        added_share = smooth_share(time - added_start, added_time)
         rate_now = settlement_rate(time + 0.5 * dt, rate, ramp_time, start_time)
         driven_motion(acc[SETTLEMENT], rate_now, x0, y0, node_block, driven_nodes, pos0, direction, x, y, vel)
         cst_element_forces(x, y, elements, constants, force)
@@ -393,13 +422,14 @@ def advance(n_steps, dt, x, y, vel, x0, y0, x_detect, y_detect, offs, node_block
             if driven[k]:
                 continue
             for d in range(2):
-                f = force[k, d] + load_share * load[k, d]
+                applied = load_share * load[k, d] + added_share * added_load[k, d]
+                f = force[k, d] + applied
                 force[k, d] = 0.0
                 v_old = vel[k, d]
                 damp = -damping * abs(f) * np.sign(v_old)  # branch-free (0 at rest)
                 v_new = v_old + dt * (f + damp) * inv_mass[k]
                 vel[k, d] = v_new
-                work_gravity += load_share * load[k, d] * v_new
+                work_gravity += applied * v_new
                 damping_work -= damp * v_new
             x[k] += dt * vel[k, 0]
             y[k] += dt * vel[k, 1]
@@ -434,7 +464,8 @@ def advance(n_steps, dt, x, y, vel, x0, y0, x_detect, y_detect, offs, node_block
             reaction -= force[k, 1]
         if not driven[k]:
             kinetic += 0.5 * mass[k] * (vel[k, 0] * vel[k, 0] + vel[k, 1] * vel[k, 1])
-            unbalanced += abs(force[k, 0] + load[k, 0]) + abs(force[k, 1] + load[k, 1])
+            unbalanced += (abs(force[k, 0] + load[k, 0] + added_load[k, 0])
+                           + abs(force[k, 1] + load[k, 1] + added_load[k, 1]))
     out[0] = steps
     out[1] = rebuild
     out[2] = reaction

@@ -24,6 +24,14 @@ class DeformableState(State):
     x_detect: np.ndarray | None = None
     y_detect: np.ndarray | None = None
     node_load: np.ndarray | None = None
+    node_added: np.ndarray | None = None
+
+    def set_loads(self, scene: Scene, load: np.ndarray, added: np.ndarray | None = None,
+                  start: float = 0.0, duration: float = 0.0) -> None:
+        """As for the rigid state, the loads shared among the nodes (:func:`.deformable.nodal_load`)."""
+        super().set_loads(scene, load, added, start, duration)
+        self.node_load = deformable.nodal_load(self.mesh, scene, self.load)
+        self.node_added = deformable.nodal_load(self.mesh, scene, self.added)
 
     def fit_blocks(self, scene: Scene) -> None:
         """``pos``: the block positions of the rigid-body fit of the nodes."""
@@ -65,8 +73,9 @@ class DeformableState(State):
                            m.young, m.poisson, m.active_tri, m.mass, m.inv_mass, m.driven, scene.moving,
                            scene.pos0, scene.direction, self.faces, self.props, controls.kn, controls.kt,
                            controls.min_half, controls.contact_damping, self.shear, self.bonded, self.normal,
-                           self.energy, self.node_load, controls.load_ramp, controls.damping, rate,
-                           controls.ramp_time, self.settlement_start, target, 0.5 * controls.buffer, self.acc, out)
+                           self.energy, self.node_load, controls.load_ramp, self.node_added, self.added_start,
+                           self.added_time, controls.damping, rate, controls.ramp_time, self.settlement_start, target,
+                           0.5 * controls.buffer, self.acc, out)
         self.fit_blocks(scene)
 
 
@@ -86,7 +95,7 @@ def initial_state(scene: Scene, controls: Controls, mesh: deformable.Mesh, load:
         bonded=np.zeros((0, 2), np.int64), normal=np.zeros((0, 2)), energy=np.zeros((0, 2)),
         acc=np.zeros(kernels.N_ACC), active=(~scene.driven).astype(np.int64),
         calm=np.zeros(scene.driven.size, dtype=np.int64),
-        mesh=mesh, x=mesh.x0.copy(), y=mesh.y0.copy(), node_vel=np.zeros((mesh.x0.size, 2)),
-        node_load=deformable.nodal_load(mesh, scene, load))
+        mesh=mesh, x=mesh.x0.copy(), y=mesh.y0.copy(), node_vel=np.zeros((mesh.x0.size, 2)))
+    state.set_loads(scene, load)
     state.detect(scene, controls, first=True)
     return state

@@ -359,16 +359,28 @@ def settlement_rate(time, rate, ramp_time, start_time):
 
 
 @jit
+def smooth_share(tau, duration):
+    """0 before ``tau = 0``, a half cosine up to 1 over ``duration``, then 1 (1 at once if duration <= 0)."""
+    if tau <= 0.0:
+        return 0.0 if duration > 0.0 else 1.0
+    if tau >= duration:
+        return 1.0
+    return 0.5 * (1.0 - np.cos(np.pi * tau / duration))
+
+
+@jit
 def advance(n_steps, dt, pos, vel, pos0, pos_detect, radius, lx, ly, offs, faces, props, kn, kt,
             min_half, contact_damping, inv_mass, shear, bonded, normal, energy, mass, free, driven, moving,
-            direction, load, load_ramp, damping, rate, ramp_time, start_time, target, half_buffer,
-            active, calm, sleep_speed, sleep_steps, acc, out):
+            direction, load, load_ramp, added_load, added_start, added_time, damping, rate, ramp_time,
+            start_time, target, half_buffer, active, calm, sleep_speed, sleep_steps, acc, out):
     """Up to ``n_steps`` explicit central-difference steps.
 
     Local non-viscous damping (Cundall): each free component of the unbalanced
     force is reduced by ``damping * |F|`` against its velocity. Driven blocks
     (supports) follow ``pos0 + settlement * direction``. The loads grow with a smooth
-    ramp over ``load_ramp`` from time 0 (applied at once if 0). Stops early when some
+    ramp over ``load_ramp`` from time 0 (applied at once if 0); ``added_load`` comes on
+    top of them with a smooth ramp from ``added_start`` over ``added_time`` (the steps
+    of a load-factor search, :func:`smooth_share`). Stops early when some
     block has moved more than ``half_buffer`` since the last detection (the pair
     list must be rebuilt) or the settlement reached ``target``.
 
@@ -389,11 +401,12 @@ def advance(n_steps, dt, pos, vel, pos0, pos_detect, radius, lx, ly, offs, faces
     rebuild = 0
     load_norm = 0.0
     for i in range(n_block):
-        load_norm += abs(load[i, 0]) + abs(load[i, 1])
+        load_norm += abs(load[i, 0] + added_load[i, 0]) + abs(load[i, 1] + added_load[i, 1])
     for _ in range(n_steps):
         force[:, :] = 0.0
         place_vertices(pos, lx, ly, offs, vx, vy)
         time = acc[TIME]
+        added_share = smooth_share(time - added_start, added_time)
         rate_now = settlement_rate(time + 0.5 * dt, rate, ramp_time, start_time)
         sleeping = sleep_speed > 0.0 and rate_now > 0.0
         for i in range(n_block):
@@ -418,7 +431,8 @@ def advance(n_steps, dt, pos, vel, pos0, pos_detect, radius, lx, ly, offs, faces
                 if not free[i, d]:
                     vel[i, d] = 0.0
                     continue
-                f = force[i, d] + load_share * load[i, d]
+                applied = load_share * load[i, d] + added_share * added_load[i, d]
+                f = force[i, d] + applied
                 v_old = vel[i, d]
                 damp = 0.0
                 if v_old > 0.0:
@@ -427,7 +441,7 @@ def advance(n_steps, dt, pos, vel, pos0, pos_detect, radius, lx, ly, offs, faces
                     damp = damping * abs(f)
                 v_new = v_old + dt * (f + damp) / mass[i, d]
                 vel[i, d] = v_new
-                acc[WORK_GRAVITY] += load_share * load[i, d] * v_new * dt
+                acc[WORK_GRAVITY] += applied * v_new * dt
                 acc[DISSIPATED_DAMPING] -= damp * v_new * dt
         acc[SETTLEMENT] += rate_now * dt
         for i in range(n_block):
@@ -474,7 +488,7 @@ def advance(n_steps, dt, pos, vel, pos0, pos_detect, radius, lx, ly, offs, faces
                 if free[i, d]:
                     kinetic += 0.5 * mass[i, d] * vel[i, d] * vel[i, d]
                     if d < 2:
-                        unbalanced += abs(force[i, d] + load[i, d])
+                        unbalanced += abs(force[i, d] + load[i, d] + added_load[i, d])
     out[0] = steps
     out[1] = rebuild
     out[2] = reaction

@@ -36,7 +36,17 @@ OPTIONS = (
               "two faces overlapping less than this share of the median unit height are not in contact "
               "(blocks meeting corner to corner carry nothing)", above=0.0),
     mf.Option("shear_stiffness_ratio", float, 0.5, "tangential / normal contact stiffness", above=0.0),
-    mf.Option("load_factor", float, 0.0, "multiplier of live_load applied to the masonry blocks with the dead load"),
+    mf.Option("load_factor", float, None,
+              "multiplier of live_load applied to the masonry blocks with the dead load; auto: 0, and a model "
+              "without a moving support but with a live load (a tilting table) gets the load-factor search"),
+    mf.Option("search_first", float, 0.1, "load-factor search: the first trial multiplier (then doubled until "
+              "one is unstable, then bisected)", above=0.0),
+    mf.Option("search_tolerance", float, 1e-3, "load-factor search: stop when the stable and the unstable "
+              "multipliers are this close", above=0.0),
+    mf.Option("search_limit", float, 10.0, "load-factor search: the largest multiplier tried", above=0.0),
+    mf.Option("collapse_motion", float, 1.0,
+              "load-factor search: a trial is unstable once a block has moved this share of the median unit "
+              "height from where it rested (centroid plus rotation times radius)", above=0.0),
     mf.Option("gravity_time", float, None,
               "duration of the gravity phase [s]; auto: until the unbalanced-force ratio is below rest_tolerance",
               above=0.0),

@@ -60,22 +60,6 @@ class Scene:
     default_friction: float
 
 
-def check_convex(lx: np.ndarray, ly: np.ndarray, offs: np.ndarray) -> None:
-    """Face-pair contact needs convex blocks: raise naming the ones that are not."""
-    idx = np.arange(lx.size)
-    nxt = idx + 1
-    nxt[offs[1:] - 1] = offs[:-1]
-    ex, ey = lx[nxt] - lx, ly[nxt] - ly
-    cross = ex * ey[nxt] - ey * ex[nxt]
-    size = np.hypot(ex, ey).max(initial=1.0)
-    concave = np.minimum.reduceat(cross, offs[:-1]) < -1e-9 * size**2
-    if np.any(concave):
-        raise mf.ModelError(
-            f"block(s) {mf.listed(np.flatnonzero(concave))}: not convex; the fdem solver's "
-            "face-pair contact needs convex blocks (split them into convex parts)"
-        )
-
-
 def build_scene(model: xr.Dataset) -> Scene:
     """The non-dimensional arrays of ``model``; raises ModelError on what the method cannot take."""
     role = model.block_role.values.astype(np.int64)
@@ -102,7 +86,6 @@ def build_scene(model: xr.Dataset) -> Scene:
     owner = mf.node_block(model.block_node_count.values)
     lx = (model.node_x.values - cx[owner]) / length
     ly = (model.node_y.values - cy[owner]) / length
-    check_convex(lx, ly, offs)
     radius = np.maximum.reduceat(np.hypot(lx, ly), offs[:-1])
     nxt = np.arange(lx.size) + 1
     nxt[offs[1:] - 1] = offs[:-1]

@@ -1,4 +1,14 @@
-"""The time loop: gravity until rest, then the settlement ramp, in numba chunks.
+"""The time loop: gravity until rest, then the settlement ramp or the load-factor search, in numba chunks.
+
+Without a moving support, a model with a live load (a tilting table: the weight
+acting sideways) gets the **load-factor search** instead: from the state at rest,
+the live load is raised smoothly to a trial multiplier and held until the wall is at
+rest again (stable: the trial becomes the new lower bound and the new start) or some
+block has moved ``collapse_motion`` from where it rested (unstable: the upper bound;
+the start is restored). Trials double from ``search_first`` until one is unstable,
+then bisect the bracket to ``search_tolerance``. The largest stable multiplier is the
+collapse multiplier; the final state is the last unstable trial's, which shows the
+mechanism.
 
 Python only decides between chunks: rebuilds the face-pair list when the
 kernel asks for it, records the history, checks the rest and plateau criteria,
@@ -7,6 +17,7 @@ with the state reached so far (``interrupted``).
 """
 from __future__ import annotations
 
+import copy
 import logging
 from dataclasses import dataclass, field
 
@@ -18,7 +29,7 @@ from . import kernels
 from .scene import Scene, face_properties
 
 LOG = logging.getLogger("masonryfw.fdem")
-GRAVITY_PHASE, SETTLEMENT_PHASE = 0, 1
+GRAVITY_PHASE, SETTLEMENT_PHASE, SEARCH_PHASE = 0, 1, 2
 # Kinetic energy (in units of the wall's weight times the model size) no run can reach by falling:
 # the whole wall falling a thousand times its own size. Beyond it the integration has blown up.
 UNSTABLE_KINETIC_ENERGY = 1e3
@@ -52,6 +63,13 @@ class Controls:
     plateau_tolerance: float
     plateau_window: float
     snapshots: tuple[float, ...]
+    search: bool = False  # the load-factor search instead of a settlement
+    search_first: float = 0.1
+    search_limit: float = 10.0
+    search_tolerance: float = 1e-3
+    search_step_time: float = 1.0  # ramp to a trial multiplier
+    search_trial_time: float = 20.0  # longest hold of one trial
+    collapse_motion: float = 0.0  # block motion (centroid + rotation x radius) that makes a trial unstable
 
 
 @dataclass
@@ -62,13 +80,14 @@ class History:
     snapshots: list = field(default_factory=list)  # (settlement, positions)
 
     COLUMNS = ("phase", "time", "settlement", "reaction", "kinetic", "stored", "work_gravity",
-               "work_support", "dissipated_damping", "dissipated_friction", "released", "unbalanced")
+               "work_support", "dissipated_damping", "dissipated_friction", "released", "unbalanced", "load_factor")
 
-    def add(self, phase: int, acc: np.ndarray, out: np.ndarray) -> None:
+    def add(self, phase: int, acc: np.ndarray, out: np.ndarray, load_factor: float = 0.0) -> None:
         self.rows.append((
             phase, acc[kernels.TIME], acc[kernels.SETTLEMENT], out[2], out[3], out[4],
             acc[kernels.WORK_GRAVITY], acc[kernels.WORK_SUPPORT],
             acc[kernels.DISSIPATED_DAMPING], acc[kernels.DISSIPATED_FRICTION], acc[kernels.RELEASED], out[5],
+            load_factor,
         ))
 
     def table(self) -> dict[str, np.ndarray]:
@@ -96,6 +115,20 @@ class State:
     settlement_start: float = 0.0
     stop_reason: str = ""
     interrupted: bool = False
+    collapse_bracket: tuple = ()  # (largest stable, smallest unstable load factor) of the search
+    last_stable: State | None = None  # the search's state at rest under the largest stable load factor
+    trials: list = field(default_factory=list)  # (load factor, stable, motion) of the load-factor search
+    load: np.ndarray | None = None  # (block, 3) applied with the smooth start of the run
+    added: np.ndarray | None = None  # (block, 3) applied on top, ramped from added_start over added_time
+    added_start: float = 0.0
+    added_time: float = 0.0
+
+    def set_loads(self, scene: Scene, load: np.ndarray, added: np.ndarray | None = None,
+                  start: float = 0.0, duration: float = 0.0) -> None:
+        """The loads of the following steps: ``load``, and ``added`` ramped in from ``start`` over ``duration``."""
+        self.load = load
+        self.added = np.zeros_like(load) if added is None else added
+        self.added_start, self.added_time = start, duration
 
 
 def detect(scene: Scene, controls: Controls, state: State | None, pos: np.ndarray):
@@ -133,20 +166,19 @@ def rebuild(scene: Scene, controls: Controls, state: State) -> None:
     state.rebuilds += 1
 
 
-def advance(scene: Scene, controls: Controls, state: State, load: np.ndarray, n_steps: int, rate: float,
+def advance(scene: Scene, controls: Controls, state: State, n_steps: int, rate: float,
             target: float, out: np.ndarray) -> None:
     """One call of the numba stepping kernel (see :func:`.kernels.advance`)."""
     kernels.advance(n_steps, controls.dt, state.pos, state.vel, scene.pos0, state.pos_detect, scene.radius,
                     scene.lx, scene.ly, scene.offs, state.faces, state.props, controls.kn, controls.kt,
                     controls.min_half, controls.contact_damping, scene.inv_mass, state.shear, state.bonded, state.normal,
-                    state.energy, scene.mass, scene.free, scene.driven, scene.moving, scene.direction, load,
-                    controls.load_ramp, controls.damping, rate, controls.ramp_time, state.settlement_start,
-                    target, 0.5 * controls.buffer, state.active, state.calm, controls.sleep_speed,
-                    controls.sleep_steps, state.acc, out)
+                    state.energy, scene.mass, scene.free, scene.driven, scene.moving, scene.direction, state.load,
+                    controls.load_ramp, state.added, state.added_start, state.added_time, controls.damping, rate,
+                    controls.ramp_time, state.settlement_start, target, 0.5 * controls.buffer, state.active,
+                    state.calm, controls.sleep_speed, controls.sleep_steps, state.acc, out)
 
 
-def chunk(scene: Scene, controls: Controls, state: State, load: np.ndarray, n_steps: int,
-          rate: float, target: float) -> np.ndarray:
+def chunk(scene: Scene, controls: Controls, state: State, n_steps: int, rate: float, target: float) -> np.ndarray:
     """Run up to ``n_steps`` steps (rebuilding the pair list as needed); returns the kernel's ``out``."""
     out = np.zeros(6)
     left = n_steps
@@ -155,7 +187,7 @@ def chunk(scene: Scene, controls: Controls, state: State, load: np.ndarray, n_st
         if nodal:
             state.advance_chunk(scene, controls, left, rate, target, out)
         else:
-            advance(scene, controls, state, load, left, rate, target, out)
+            advance(scene, controls, state, left, rate, target, out)
         if not out[3] < UNSTABLE_KINETIC_ENERGY:  # also catches nan
             raise mf.SolveError(
                 f"fdem: the time integration blew up (kinetic energy {out[3]:.3g} W x length after "
@@ -174,7 +206,7 @@ def chunk(scene: Scene, controls: Controls, state: State, load: np.ndarray, n_st
             return out
 
 
-def gravity_phase(scene, controls, state, load, history, progress) -> None:
+def gravity_phase(scene, controls, state, history, progress) -> None:
     """Apply the loads with the supports still until the unbalanced-force ratio drops below
     the rest tolerance (or for exactly ``gravity_time``)."""
     if controls.gravity_time > 0:
@@ -184,7 +216,7 @@ def gravity_phase(scene, controls, state, load, history, progress) -> None:
     while state.gravity_steps < total:
         n = min(controls.record_steps, total - state.gravity_steps)
         before = state.steps
-        out = chunk(scene, controls, state, load, n, 0.0, 0.0)
+        out = chunk(scene, controls, state, n, 0.0, 0.0)
         state.gravity_steps += state.steps - before
         history.add(GRAVITY_PHASE, state.acc, out)
         ramped = state.acc[kernels.TIME] >= controls.load_ramp
@@ -223,7 +255,7 @@ def plateau_reached(history: History, controls: Controls, reference: float) -> b
     return float(np.ptp(recent)) <= controls.plateau_tolerance * reference
 
 
-def settlement_phase(scene, controls, state, load, history, progress) -> None:
+def settlement_phase(scene, controls, state, history, progress) -> None:
     state.settlement_start = float(state.acc[kernels.TIME])
     reference = history.rows[-1][3] if history.rows else 0.0
     pending = sorted(controls.snapshots)
@@ -232,7 +264,7 @@ def settlement_phase(scene, controls, state, load, history, progress) -> None:
             state.stop_reason = "step limit"
             LOG.warning("fdem: settlement phase hit the step limit (%d)", controls.max_steps)
             return
-        out = chunk(scene, controls, state, load, controls.record_steps, controls.rate, controls.target)
+        out = chunk(scene, controls, state, controls.record_steps, controls.rate, controls.target)
         history.add(SETTLEMENT_PHASE, state.acc, out)
         settled = state.acc[kernels.SETTLEMENT]
         while pending and settled >= pending[0]:
@@ -246,6 +278,83 @@ def settlement_phase(scene, controls, state, load, history, progress) -> None:
     state.stop_reason = "target settlement"
 
 
+def largest_motion(scene: Scene, pos: np.ndarray, reference: np.ndarray) -> float:
+    """Largest block motion from ``reference`` (centroid displacement plus rotation times the block radius)."""
+    free = ~scene.driven
+    moved = np.hypot(*(pos[free, :2] - reference[free, :2]).T) + np.abs(pos[free, 2] - reference[free, 2]) * \
+        scene.radius[free]
+    return float(moved.max(initial=0.0))
+
+
+def hold(scene: Scene, controls: Controls, state: State, reference: np.ndarray, history: History,
+         load_factor: float) -> tuple[bool, float]:
+    """Run ``state`` until it is at rest after its load ramp (stable) or moves ``collapse_motion`` from
+    ``reference`` or has not come to rest within ``search_trial_time`` (unstable); ``(stable, motion)``."""
+    ramp_end = state.added_start + state.added_time
+    limit = ramp_end + controls.search_trial_time
+    while True:
+        out = chunk(scene, controls, state, controls.record_steps, 0.0, 0.0)
+        history.add(SEARCH_PHASE, state.acc, out, load_factor)
+        motion = largest_motion(scene, state.pos, reference)
+        if motion > controls.collapse_motion:
+            return False, motion
+        now = state.acc[kernels.TIME]
+        if now >= ramp_end and out[5] < controls.rest_tolerance:
+            return True, motion
+        if now >= limit or state.steps >= controls.max_steps:
+            return False, motion
+
+
+def search_phase(scene: Scene, controls: Controls, state: State, history: History, progress) -> None:
+    """The load-factor search of the module docstring; ``state`` ends as the last unstable trial
+    (the last stable one if none was), ``state.trials`` lists every trial."""
+    try:
+        lower, upper, unstable = _bisect(scene, controls, state, history, progress)
+    except KeyboardInterrupt:  # keep the last state at rest and the trials so far
+        _become(state, state.last_stable)
+        raise
+    final = unstable if unstable is not None else state.last_stable
+    _become(state, final)
+    state.collapse_bracket = (lower, upper)
+
+
+def _become(state: State, other: State) -> None:
+    """``state`` takes the fields of ``other`` but keeps its own trials, stop reason and bracket."""
+    keep = {name: getattr(state, name) for name in ("trials", "stop_reason", "collapse_bracket")}
+    state.__dict__.update({k: v for k, v in other.__dict__.items() if k not in keep})
+
+
+def _bisect(scene, controls, state, history, progress):
+    """The trials: ``(largest stable, smallest unstable, its state)`` (None, None if none was unstable)."""
+    base = state.load.copy()
+    lower, upper, unstable = 0.0, None, None
+    stable = state.last_stable = copy.deepcopy(state)
+    trial = controls.search_first
+    while upper is None or upper - lower > controls.search_tolerance:
+        if trial > controls.search_limit:
+            state.stop_reason = f"stable up to the search limit {controls.search_limit:g}"
+            break
+        attempt = copy.deepcopy(stable)
+        attempt.set_loads(scene, base + lower * scene.live, (trial - lower) * scene.live,
+                          float(attempt.acc[kernels.TIME]), controls.search_step_time)
+        is_stable, motion = hold(scene, controls, attempt, stable.pos, history, trial)
+        state.trials.append((trial, is_stable, motion))
+        if is_stable:
+            lower, stable = trial, attempt
+            stable.set_loads(scene, base + trial * scene.live)
+            state.last_stable = stable
+        else:
+            upper, unstable = trial, attempt
+        state.steps = attempt.steps
+        state.collapse_bracket = (lower, upper)
+        trial = 2.0 * trial if upper is None else 0.5 * (lower + upper)
+        bracket = "" if upper is None else f", unstable at {upper:.4g}"
+        progress(0.05 + 0.9 * min(1.0, len(state.trials) / 16), f"fdem: stable at load factor {lower:.4g}{bracket}")
+    else:
+        state.stop_reason = "collapse bracketed"
+    return lower, upper, unstable
+
+
 def run(scene: Scene, controls: Controls, state: State, load: np.ndarray, progress) -> History:
     """Gravity, then settlement, from ``state`` (rigid or deformable); returns the history.
 
@@ -253,16 +362,19 @@ def run(scene: Scene, controls: Controls, state: State, load: np.ndarray, progre
     reached evaluated as a last record); one before the first record propagates.
     """
     history = History()
+    state.set_loads(scene, load)
     try:
-        gravity_phase(scene, controls, state, load, history, progress)
-        if controls.target > 0 and scene.moving.any():
-            settlement_phase(scene, controls, state, load, history, progress)
+        gravity_phase(scene, controls, state, history, progress)
+        if controls.search:
+            search_phase(scene, controls, state, history, progress)
+        elif controls.target > 0 and scene.moving.any():
+            settlement_phase(scene, controls, state, history, progress)
     except KeyboardInterrupt:
         if not history.rows:
             raise
         state.interrupted = True
         state.stop_reason = "interrupted"
-        out = chunk(scene, controls, state, load, 0, 0.0, 0.0)  # evaluate the state reached
-        phase = SETTLEMENT_PHASE if state.settlement_start > 0 else GRAVITY_PHASE
-        history.add(phase, state.acc, out)
+        out = chunk(scene, controls, state, 0, 0.0, 0.0)  # evaluate the state reached
+        phase = SEARCH_PHASE if state.trials else SETTLEMENT_PHASE if state.settlement_start > 0 else GRAVITY_PHASE
+        history.add(phase, state.acc, out, state.collapse_bracket[0] if state.collapse_bracket else 0.0)
     return history

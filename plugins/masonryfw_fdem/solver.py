@@ -20,6 +20,9 @@ from .scene import Scene, build_scene
 from .simulation import Controls, History, State, initial_state, run
 
 LOG = logging.getLogger("masonryfw.fdem")
+#: Load-factor search (scaled time, sqrt(length / g)): the ramp to a trial multiplier, the longest hold.
+SEARCH_STEP_TIME = 1.0
+SEARCH_TRIAL_TIME = 20.0
 
 
 def critical_time_step(scene: Scene, kn: float) -> float:
@@ -77,7 +80,19 @@ def make_controls(scene: Scene, options: Mapping[str, Any]) -> Controls:
         plateau_tolerance=options["plateau_tolerance"],
         plateau_window=options["plateau_window"],
         snapshots=tuple(v / length for v in options["snapshots"]),
+        search=searches(scene, options),
+        search_first=options["search_first"],
+        search_limit=options["search_limit"],
+        search_tolerance=options["search_tolerance"],
+        search_step_time=SEARCH_STEP_TIME,
+        search_trial_time=SEARCH_TRIAL_TIME,
+        collapse_motion=options["collapse_motion"] * scene.unit_height,
     )
+
+
+def searches(scene: Scene, options: Mapping[str, Any]) -> bool:
+    """The load-factor search runs when load_factor is auto, no support moves and the masonry has a live load."""
+    return options["load_factor"] is None and not scene.moving.any() and bool(np.any(scene.live != 0))
 
 
 def solve(model: xr.Dataset, options: Mapping[str, Any], progress=mf.no_progress) -> xr.Dataset:
@@ -98,7 +113,7 @@ def solve(model: xr.Dataset, options: Mapping[str, Any], progress=mf.no_progress
 def _solve(model: xr.Dataset, options: Mapping[str, Any], progress) -> xr.Dataset:
     scene = build_scene(model)
     controls = make_controls(scene, options)
-    load = scene.dead + options["load_factor"] * scene.live
+    load = scene.dead + (options["load_factor"] or 0.0) * scene.live
     if options["mode"] == "deformable":
         from . import deformable, deformable_simulation
 
@@ -129,6 +144,9 @@ def _solve(model: xr.Dataset, options: Mapping[str, Any], progress) -> xr.Datase
         fdem_asleep_blocks=int((~scene.driven & (state.active == 0)).sum()),
         fdem_target_settlement=controls.target * scene.scales.length,
     )
+    if state.trials:
+        result.attrs["fdem_unstable_load_factor"] = state.collapse_bracket[1] if state.collapse_bracket[1] is not None \
+            else np.nan
     progress(1.0, f"fdem: {state.stop_reason} after {state.steps} steps")
     return result
 
@@ -148,12 +166,17 @@ def history_variables(scene: Scene, history: History) -> dict:
     def var(values, units, long_name):
         return ("step", values, {"units": units, "long_name": long_name})
 
-    return {
+    settling = {
         "step_settlement": ("step", rows["settlement"] * length, mf.variable_attrs("step_settlement")),
         "step_reaction": ("step", rows["reaction"] * f, mf.variable_attrs("step_reaction")),
+    } if scene.moving.any() else {
+        "step_load_factor": var(rows["load_factor"], "1", "multiplier of the live load (tried) at the record"),
+    }
+    return {
+        **settling,
         "step_phase": ("step", rows["phase"].astype(np.int8),
-                       {"units": "1", "long_name": "analysis phase", "flag_values": np.array([0, 1], np.int8),
-                        "flag_meanings": "gravity settlement"}),
+                       {"units": "1", "long_name": "analysis phase", "flag_values": np.array([0, 1, 2], np.int8),
+                        "flag_meanings": "gravity settlement load_factor_search"}),
         "step_time": var(rows["time"] * scene.scales.time, "s", "simulated time"),
         "step_kinetic_energy": var(kinetic, "J", "kinetic energy of the blocks"),
         "step_work_gravity": var(work_gravity, "J", "work of the applied (dead + factored live) loads"),
@@ -181,6 +204,17 @@ def result_dataset(scene: Scene, state: State, history: History) -> xr.Dataset:
         "interface_shear_force": (ie, shear, mf.variable_attrs("interface_shear_force")),
         **history_variables(scene, history),
     }
+    if state.trials:
+        factor, stable, motion = (np.array(column) for column in zip(*state.trials))
+        data.update({
+            "collapse_multiplier": ((), state.collapse_bracket[0], mf.variable_attrs("collapse_multiplier")),
+            "trial_load_factor": ("trial", factor, {"units": "1", "long_name": "multiplier of the live load tried"}),
+            "trial_stable": ("trial", stable.astype(np.int8), {
+                "units": "1", "long_name": "the wall came to rest under the trial multiplier",
+                "flag_values": np.array([0, 1], np.int8), "flag_meanings": "unstable stable"}),
+            "trial_largest_motion": ("trial", motion * scene.scales.length, {
+                "units": "m", "long_name": "largest block motion from the last state at rest"}),
+        })
     if history.snapshots:
         motion = np.stack([postprocess.block_displacement(scene, p) for _, p in history.snapshots])
         data["snapshot_settlement"] = ("snapshot", np.array([s for s, _ in history.snapshots]) * scene.scales.length,

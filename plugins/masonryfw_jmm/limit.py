@@ -51,9 +51,10 @@ from skfem import MeshTri
 
 import masonryfw as mf
 
+from .fabric import stress_rotation
 from .material import failure_mode
 from .output import mesh_variables, point_variables, variable
-from .problem import Domain, wall_domain
+from .problem import Domain, live_body_force, support_facets, wall_domain
 
 ROLE = mf.flags("block_role")
 #: a strength row is plastic when its multiplier per unit volume exceeds this fraction of the largest
@@ -165,13 +166,18 @@ class StaticField:
                                 shape=(2, half_length.size))
         return summing @ traction
 
-    def strength(self, A: np.ndarray, b: np.ndarray, corner: np.ndarray, face: np.ndarray):
-        """Rows ``A[face] s <= b[face]`` at stress nodes ``corner`` (= 3 element + local corner); one row each."""
+    def strength(self, A: np.ndarray, b: np.ndarray, corner: np.ndarray, face: np.ndarray,
+                 to_bed: np.ndarray | None = None):
+        """Rows ``A[face] T s <= b[face]`` at stress nodes ``corner`` (= 3 element + local corner); one row each.
+
+        ``to_bed``: ``(e, 3, 3)`` rotation of each triangle's stresses into its bed frame (None: horizontal beds).
+        """
+        coefficients = A[face] if to_bed is None else np.einsum("rk,rkj->rj", A[face], to_bed[corner // 3])
         rows = np.repeat(np.arange(corner.size), 3)
         cols = (3 * corner[:, None] + np.arange(3)).ravel()
-        return sp.csr_matrix((A[face].ravel(), (rows, cols)), shape=(corner.size, self.n_var)), b[face]
+        return sp.csr_matrix((coefficients.ravel(), (rows, cols)), shape=(corner.size, self.n_var)), b[face]
 
-    def implied_by_free_edges(self, A: np.ndarray, free: np.ndarray) -> np.ndarray:
+    def implied_by_free_edges(self, A: np.ndarray, free: np.ndarray, to_bed: np.ndarray | None = None) -> np.ndarray:
         """Boolean ``(3 e, faces)``: strength rows that the traction-free conditions already decide.
 
         On a free edge with normal n the stress at its end points is uniaxial along the edge,
@@ -185,7 +191,10 @@ class StaticField:
         corner = (3 * np.repeat(E.element[free], 2) + E.local[free].ravel())
         nx, ny = np.repeat(E.normal[free], 2, axis=0).T
         implied = np.zeros((3 * self.n_el, A.shape[0]), dtype=bool)
-        tangential = np.stack([ny**2, nx**2, -nx * ny], axis=1) @ A.T  # (entries, faces)
+        uniaxial = np.stack([ny**2, nx**2, -nx * ny], axis=1)  # (entries, 3)
+        if to_bed is not None:
+            uniaxial = np.einsum("nij,nj->ni", to_bed[corner // 3], uniaxial)
+        tangential = uniaxial @ A.T  # (entries, faces)
         np.logical_or.at(implied, corner, np.abs(tangential) <= 1e-12 * np.abs(A).max())
         direction = np.round(np.abs(np.stack([nx, ny], axis=1)), 9)
         distinct = np.unique(np.column_stack([corner, direction]), axis=0)[:, 0].astype(int)
@@ -240,24 +249,16 @@ def plastic_rows(duals: np.ndarray, volume: np.ndarray) -> np.ndarray:
     return rate > PLASTIC_DUAL_FRACTION * rate.max(initial=0.0)
 
 
-def support_edges(domain: Domain, field: StaticField) -> tuple[np.ndarray, np.ndarray]:
-    """Boundary edge occurrences on fixed and on moving supports.
-
-    An edge is on a support when it is horizontal, at the support block's top and within its
-    x range (the same test as the incremental solver's prescribed DOFs).
-    """
+def support_edges(domain: Domain, field: StaticField, model: xr.Dataset) -> tuple[np.ndarray, np.ndarray]:
+    """Boundary edge occurrences on fixed and on moving supports: those lying on the model's support
+    interfaces (the same test as the incremental solver's prescribed DOFs)."""
     E, H = field.edges, domain.length
-    tol = 1e-6 * domain.mesh_size / H
     occ = E.boundary
-    ends = field.triangles[E.local[occ], E.element[occ][:, None]]  # (b, 2) global nodes
-    px, py = field.points[0, ends], field.points[1, ends]
-    horizontal = np.isclose(py[:, 0], py[:, 1], atol=tol)
-    mid_x, mid_y = px.mean(axis=1), py.mean(axis=1)
-    fixed, moving = np.zeros(occ.size, bool), np.zeros(occ.size, bool)
-    for x0, x1, y, _, role in domain.mesh.supports:  # a handful of supports
-        on = horizontal & np.isclose(mid_y, y / H, atol=tol) & (mid_x > x0 / H - tol) & (mid_x < x1 / H + tol)
-        (fixed if role == ROLE["fixed_support"] else moving)[on] = True
-    moving &= ~fixed
+    ends = field.triangles[E.local[occ], E.element[occ][:, None]].T  # (2, b) global nodes
+    on = support_facets(field.points, ends, domain.mesh.supports / H, 1e-6 * domain.mesh_size / H)
+    block = np.where(on >= 0, domain.mesh.support_block[np.maximum(on, 0)], -1)
+    role = np.where(block >= 0, model.block_role.values[np.maximum(block, 0)], -1)
+    fixed, moving = role == ROLE["fixed_support"], role == ROLE["moving_support"]
     return occ[fixed], occ[moving]
 
 
@@ -275,57 +276,104 @@ def check_vertical_settlement(model: xr.Dataset) -> None:
 
 
 @dataclass
-class SettlementLP:
-    """The assembled settlement LP ``min R`` and what is needed to read its solution."""
+class LimitLP:
+    """An assembled limit LP and what is needed to read its solution.
+
+    Settlement (``dead_reaction`` set): ``min R``, the moving support's vertical reaction.
+    Load factor (``dead_reaction`` None): ``max lambda`` of the live load, the last variable.
+    """
 
     field: StaticField
-    cost: np.ndarray  # R: vertical resultant of the moving support's traction on the body
+    cost: np.ndarray
     equalities: sp.csr_matrix
     rhs: np.ndarray
     inequalities: sp.csr_matrix
     bounds: np.ndarray
     strength_corner: np.ndarray  # stress node (3 element + local corner) of every strength row
     strength_face: np.ndarray  # face (row of A) of every strength row
-    dead_reaction: float  # W L_moving / L_contact: the settlement dead load of the moving support
+    dead_reaction: float | None  # W L_moving / L_contact: the settlement dead load of the moving support
     n_faces: int
 
 
+def strength_rows(field: StaticField, A: np.ndarray, b: np.ndarray, strong: np.ndarray, free: np.ndarray,
+                  to_bed: np.ndarray | None, head: np.ndarray | None = None, headless: np.ndarray | None = None):
+    """``(inequalities, bounds, corner, face)``: ``A T s <= b`` at the corners of the ``strong`` triangles,
+    less the rows the free edges already decide and the ``head`` faces of ``headless`` triangles."""
+    corner = np.repeat((3 * np.asarray(strong)[:, None] + np.arange(3)).ravel(), A.shape[0])
+    face = np.tile(np.arange(A.shape[0]), corner.size // A.shape[0])
+    keep = ~field.implied_by_free_edges(A, free, to_bed)[corner, face]
+    if headless is not None:
+        keep &= ~(headless[corner // 3] & head[face])
+    corner, face = corner[keep], face[keep]
+    inequalities, bounds = field.strength(A, b, corner, face, to_bed)
+    return inequalities, bounds, corner, face
+
+
 def settlement_lp(field: StaticField, unit_weight: np.ndarray, strong: np.ndarray, A: np.ndarray, b: np.ndarray,
-                  fixed: np.ndarray, moving: np.ndarray) -> SettlementLP:
+                  fixed: np.ndarray, moving: np.ndarray, to_bed: np.ndarray | None = None,
+                  head: np.ndarray | None = None, headless: np.ndarray | None = None) -> LimitLP:
     """``min R`` for a body under its weight (``unit_weight`` per triangle, acting in -y) on supports.
 
     ``fixed`` and ``moving`` are boundary edge occurrences on the supports (traction free to
-    take any value); every other boundary edge is traction free; ``A s <= b`` holds at the
-    corners of the ``strong`` triangles.
+    take any value); every other boundary edge is traction free; ``A T s <= b`` holds at the
+    corners of the ``strong`` triangles (``T``: ``to_bed``, the bed frame of every triangle).
     """
     body = np.stack([np.zeros(field.n_el), -unit_weight], axis=1)
     equilibrium, load = field.equilibrium(body)
     free = np.setdiff1d(field.edges.boundary, np.concatenate([fixed, moving]))
     equalities = sp.vstack([equilibrium, field.continuity(), field.boundary_traction(free)], format="csr")
     rhs = np.concatenate([load, np.zeros(equalities.shape[0] - load.size)])
-    corner = np.repeat((3 * np.asarray(strong)[:, None] + np.arange(3)).ravel(), A.shape[0])
-    face = np.tile(np.arange(A.shape[0]), corner.size // A.shape[0])
-    keep = ~field.implied_by_free_edges(A, free)[corner, face]
-    corner, face = corner[keep], face[keep]
-    inequalities, bounds = field.strength(A, b, corner, face)
+    inequalities, bounds, corner, face = strength_rows(field, A, b, strong, free, to_bed, head, headless)
     weight = float((unit_weight * field.area * field.thickness).sum())
     lengths = field.edges.length
     share = lengths[moving].sum() / (lengths[fixed].sum() + lengths[moving].sum())
     cost = field.boundary_resultant(moving).toarray()[1]
-    return SettlementLP(field, cost, equalities, rhs, inequalities, bounds, corner, face, float(weight * share),
-                        A.shape[0])
+    return LimitLP(field, cost, equalities, rhs, inequalities, bounds, corner, face, float(weight * share),
+                   A.shape[0])
 
 
-def wall_settlement_lp(domain: Domain, model: xr.Dataset, A: np.ndarray, b: np.ndarray) -> SettlementLP:
-    """The settlement LP of the wall meshed by :func:`.problem.wall_domain` (non-dimensional, module docstring)."""
+def load_factor_lp(field: StaticField, dead_body: np.ndarray, live_body: np.ndarray, strong: np.ndarray,
+                   A: np.ndarray, b: np.ndarray, supports: np.ndarray, to_bed: np.ndarray | None = None,
+                   head: np.ndarray | None = None, headless: np.ndarray | None = None) -> LimitLP:
+    """``max lambda``: the body in equilibrium under ``dead_body + lambda live_body`` (``(e, 2)`` per unit
+    volume) on held ``supports``, every other boundary edge traction free, ``A T s <= b`` in the ``strong``
+    triangles. The variables are the stresses and then lambda."""
+    equilibrium, dead = field.equilibrium(dead_body)
+    _, live = field.equilibrium(live_body)
+    free = np.setdiff1d(field.edges.boundary, supports)
+    column = lambda values: sp.csr_matrix(np.asarray(values, dtype=float).reshape(-1, 1))  # noqa: E731
+    others = sp.vstack([field.continuity(), field.boundary_traction(free)], format="csr")
+    equalities = sp.vstack([sp.hstack([equilibrium, column(-live)]),
+                            sp.hstack([others, sp.csr_matrix((others.shape[0], 1))])], format="csr")
+    rhs = np.concatenate([dead, np.zeros(others.shape[0])])
+    inequalities, bounds, corner, face = strength_rows(field, A, b, strong, free, to_bed, head, headless)
+    inequalities = sp.hstack([inequalities, sp.csr_matrix((inequalities.shape[0], 1))], format="csr")
+    cost = np.zeros(field.n_var + 1)
+    cost[-1] = -1.0
+    return LimitLP(field, cost, equalities, rhs, inequalities, bounds, corner, face, None, A.shape[0])
+
+
+def wall_lp(domain: Domain, model: xr.Dataset, A: np.ndarray, b: np.ndarray, names: tuple[str, ...]) -> LimitLP:
+    """The limit LP of the wall meshed by :func:`.problem.wall_domain` (non-dimensional, module docstring):
+    the settlement LP with a moving support, else the load-factor LP of the live load."""
     H = domain.length
     mesh = MeshTri(domain.mesh.points / H, domain.mesh.triangles)
     blocks = domain.mesh.block
     field = StaticField(mesh.p, mesh.t, model.block_thickness.values[blocks] / H)
     unit_weight = model.block_unit_weight.values[blocks] / domain.unit_weight
-    fixed, moving = support_edges(domain, field)
+    fixed, moving = support_edges(domain, field, model)
     strong = np.nonzero(model.block_role.values[blocks] == ROLE["unit"])[0]
-    return settlement_lp(field, unit_weight, strong, A, b, fixed, moving)
+    angle = domain.angles[blocks]
+    to_bed = stress_rotation(angle) if np.any(angle) else None
+    head = np.array([name.startswith("head") for name in names])
+    headless = domain.headless[blocks]
+    if moving.size:
+        return settlement_lp(field, unit_weight, strong, A, b, fixed, moving, to_bed, head, headless)
+    if not np.any(mf.block_loads(model, "live")[blocks]):
+        raise mf.ModelError("jmm-limit: no moving support to settle and no live load to raise: nothing to analyse")
+    dead = np.stack([np.zeros(field.n_el), -unit_weight], axis=1)
+    return load_factor_lp(field, dead, live_body_force(model, blocks, domain.unit_weight), strong, A, b, fixed,
+                          to_bed, head, headless)
 
 
 def collapse_points(field: StaticField, stress: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -341,7 +389,7 @@ def collapse_points(field: StaticField, stress: np.ndarray) -> tuple[np.ndarray,
     return xy.transpose(0, 2, 1).reshape(2, -1), at_points.reshape(-1, 3)
 
 
-def limit_dataset(domain: Domain, lp: SettlementLP, sol: LPSolution, names: tuple[str, ...],
+def limit_dataset(domain: Domain, lp: LimitLP, sol: LPSolution, names: tuple[str, ...],
                   assembly: float) -> xr.Dataset:
     """The result variables (physical units) of the limit LP (docs/format.md)."""
     field, H, S = lp.field, domain.length, domain.stress
@@ -350,23 +398,30 @@ def limit_dataset(domain: Domain, lp: SettlementLP, sol: LPSolution, names: tupl
     active = np.zeros((3 * field.n_el, lp.n_faces), dtype=bool)
     active[lp.strength_corner[plastic], lp.strength_face[plastic]] = True
     failure = failure_mode(active, names)
-    (qx, qy), stress = collapse_points(field, sol.x)
+    (qx, qy), stress = collapse_points(field, sol.x[:field.n_var])
     qx, qy, stress = qx * H, qy * H, stress * S
-    reaction = sol.objective * domain.force
-    dead = lp.dead_reaction * domain.force
     variables = {
         **mesh_variables(field.points * H, field.triangles),
         **point_variables((qx, qy), failure, stress, "point (midway between a triangle corner and its centroid)",
                           "in the collapse state (failure: LP duals of the strength rows)"),
-        "collapse_multiplier": variable((), 1.0 - reaction / dead, "1",
-                                    "alpha = 1 - R_min / (W L_moving / L_contact), lower bound on the mesh"),
-        "moving_support_reaction": variable((), reaction, "N",
-                                        "smallest upward vertical reaction of the moving support (static LP)"),
     }
+    attrs = {"jmm_beta": domain.beta}
+    if lp.dead_reaction is None:
+        variables["collapse_multiplier"] = variable((), float(sol.x[-1]), "1",
+                                                    "largest multiplier of the live load (static LP), lower bound "
+                                                    "on the mesh")
+    else:
+        reaction = sol.objective * domain.force
+        dead = lp.dead_reaction * domain.force
+        variables["collapse_multiplier"] = variable((), 1.0 - reaction / dead, "1",
+                                                    "alpha = 1 - R_min / (W L_moving / L_contact), lower bound on "
+                                                    "the mesh")
+        variables["moving_support_reaction"] = variable((), reaction, "N", "smallest upward vertical reaction of "
+                                                        "the moving support (static LP)")
+        attrs["jmm_dead_reaction_n"] = dead
     attrs = {
-        "jmm_beta": domain.beta,
-        "jmm_dead_reaction_n": dead,
-        "jmm_lp_variables": int(field.n_var),
+        **attrs,
+        "jmm_lp_variables": int(lp.cost.size),
         "jmm_lp_equalities": int(lp.equalities.shape[0]),
         "jmm_lp_inequalities": int(lp.inequalities.shape[0]),
         "jmm_lp_nonzeros": int(lp.equalities.nnz + lp.inequalities.nnz),
@@ -379,13 +434,14 @@ def limit_dataset(domain: Domain, lp: SettlementLP, sol: LPSolution, names: tupl
 
 
 def solve(model: xr.Dataset, options, progress) -> xr.Dataset:
-    """Smallest moving-support reaction the JMM continuum can carry: the ``jmm-limit`` solver entry point."""
+    """Smallest moving-support reaction the JMM continuum can carry (or, without a moving support, the largest
+    multiplier of its live load): the ``jmm-limit`` solver entry point."""
     check_vertical_settlement(model)
     start = time.perf_counter()
     progress(0.0, "meshing and assembling the limit LP")
     domain = wall_domain(model, options["mesh_size"], options["beta"])
     A, b, _, names = domain.scaled_strength(options["apex_shift"]).faces()
-    lp = wall_settlement_lp(domain, model, A, b)
+    lp = wall_lp(domain, model, A, b, names)
     assembly = time.perf_counter() - start
     progress(0.2, f"solving the limit LP: {lp.field.n_var} variables, {lp.equalities.shape[0]} equalities, "
              f"{lp.inequalities.shape[0]} inequalities")

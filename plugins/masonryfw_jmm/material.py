@@ -145,8 +145,11 @@ class ReturnMap:
                 sets.append(ActiveSet(faces, M, P, np.ascontiguousarray(A @ P), tangent))
         return sets
 
-    def __call__(self, trial: np.ndarray, tol: float = 1e-10):
+    def __call__(self, trial: np.ndarray, tol: float = 1e-10, bounds: np.ndarray | None = None):
         """Return ``(stress, tangent, active, multipliers)`` for trial stresses ``(n, 3)``.
+
+        ``bounds``: ``(faces, n)`` right-hand sides per point replacing ``b`` (a face that a point
+        does not have gets a bound it never reaches); the candidate sets do not depend on them.
 
         ``active`` is a boolean ``(n, faces)`` (faces with a positive multiplier),
         ``tangent`` is ``(n, 3, 3)``; elastic points get ``D``. Every candidate set is
@@ -156,7 +159,7 @@ class ReturnMap:
         """
         trial = np.asarray(trial, dtype=float)
         n, nf = trial.shape[0], len(self.b)
-        values = self.A @ trial.T - self.b[:, None]  # (faces, n): face-major keeps the reductions fast
+        values = self.A @ trial.T - (self.b[:, None] if bounds is None else bounds)  # (faces, n): face-major
         scale = tol * (1.0 + np.abs(trial).max(axis=1))
         stress = trial.copy()
         tangent = np.broadcast_to(self.D, (n, 3, 3)).copy()

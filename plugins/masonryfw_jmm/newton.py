@@ -83,16 +83,32 @@ class NewtonSolver:
     def prescribed_values(self, settlement: float) -> np.ndarray:
         return np.concatenate([np.zeros(self.problem.fixed.size), settlement * self.problem.moving_direction])
 
-    def evaluate(self, u: np.ndarray, start: State, gravity_factor: float) -> State:
-        """Strains, returned stresses, tangents and the residual ``f_int - f_ext`` at ``u``."""
+    def external(self, gravity_factor: float, load_factor: float) -> np.ndarray:
+        """The applied loads: ``gravity_factor`` times gravity plus ``load_factor`` times the live load."""
+        p = self.problem
+        return gravity_factor * p.gravity + load_factor * p.live if load_factor else gravity_factor * p.gravity
+
+    def evaluate(self, u: np.ndarray, start: State, gravity_factor: float, load_factor: float = 0.0) -> State:
+        """Strains, returned stresses, tangents and the residual ``f_int - f_ext`` at ``u``.
+
+        Where the beds are not horizontal the return works in every point's bed frame
+        (``Problem.to_bed``): the JMM's faces read the stress normal to the bed and head planes.
+        D is isotropic, so the elastic predictor and the energy norm are the same in any frame.
+        """
         p = self.problem
         strain = p.disc.strain(u)
         trial = start.stress + np.einsum("nij,nj->ni", p.D_points, strain - start.strain)
         stress, tangent = trial, p.D_points.copy()
         active = np.zeros_like(start.active)
         m = p.masonry_points
-        stress[m], tangent[m], active[m], _ = p.return_map(trial[m])
-        residual = p.disc.internal_force(stress) - gravity_factor * p.gravity
+        if p.to_bed is None:
+            stress[m], tangent[m], active[m], _ = p.return_map(trial[m], bounds=p.face_bounds)
+        else:
+            local, local_tangent, active[m], _ = p.return_map(np.einsum("nij,nj->ni", p.to_bed, trial[m]),
+                                                              bounds=p.face_bounds)
+            stress[m] = np.einsum("nij,nj->ni", p.from_bed, local)
+            tangent[m] = p.from_bed @ local_tangent @ p.from_bed.transpose(0, 2, 1)
+        residual = p.disc.internal_force(stress) - self.external(gravity_factor, load_factor)
         return State(u, strain, stress, tangent, active, residual)
 
     def reaction(self, state: State) -> float:
@@ -130,7 +146,8 @@ class NewtonSolver:
         return x
 
     def step(self, start: State, gravity_factor: float, settlement: float,
-             max_iterations: int | None = None, guess: np.ndarray | None = None) -> tuple[State, StepReport]:
+             max_iterations: int | None = None, guess: np.ndarray | None = None,
+             load_factor: float = 0.0) -> tuple[State, StepReport]:
         """One load step from the converged ``start``; the first solve is the tangent predictor.
 
         ``guess`` (displacements, e.g. the last step's increment extrapolated) replaces the
@@ -145,15 +162,15 @@ class NewtonSolver:
         u = start.u.copy()
         jump = self.prescribed_values(settlement) - start.u[fixed_all]
         u[fixed_all] += jump
-        base = p.disc.internal_force(start.stress) - gravity_factor * p.gravity
+        base = p.disc.internal_force(start.stress) - self.external(gravity_factor, load_factor)
         rhs = -(base[free] + K[free][:, fixed_all] @ jump)
         u[free] += self._solve(K, rhs)
-        state = self.evaluate(u, start, gravity_factor)
+        state = self.evaluate(u, start, gravity_factor, load_factor)
         residuals = [self._norm(state)]
         if guess is not None and residuals[0] > self.tolerance:
             guessed = guess.copy()
             guessed[fixed_all] = u[fixed_all]
-            other = self.evaluate(guessed, start, gravity_factor)
+            other = self.evaluate(guessed, start, gravity_factor, load_factor)
             if self._norm(other) < residuals[0]:
                 state, residuals = other, [self._norm(other)]
         iterations = 1
@@ -166,7 +183,7 @@ class NewtonSolver:
             K = p.disc.stiffness(self._regularised(state, settled)).tocsr()
             du = self._solve(K, -state.residual[free])
             iterations += 1
-            state = self._line_search(state, du, start, gravity_factor, residuals[-1])
+            state = self._line_search(state, du, start, gravity_factor, residuals[-1], load_factor)
             residuals.append(self._norm(state))
         converged = bool(residuals[-1] <= self.tolerance)
         return state, StepReport(converged, iterations, residuals)
@@ -189,13 +206,13 @@ class NewtonSolver:
         return tangent
 
     def _line_search(self, state: State, du: np.ndarray, start: State, gravity_factor: float,
-                     norm0: float) -> State:
+                     norm0: float, load_factor: float = 0.0) -> State:
         """Full step if it lowers the residual, else the best of the halved steps tried."""
         best, best_norm, alpha = None, np.inf, 1.0
         for _ in range(self.line_search + 1):
             u = state.u.copy()
             u[self.free] += alpha * du
-            trial = self.evaluate(u, start, gravity_factor)
+            trial = self.evaluate(u, start, gravity_factor, load_factor)
             norm = self._norm(trial)
             if norm < best_norm:
                 best, best_norm = trial, norm

@@ -42,9 +42,13 @@ INCREMENTAL_OPTIONS = (
               above=0),
     mf.Option("max_settlement", float, None, "stop at this settlement [m]; auto: 30 elastic unloading settlements",
               above=0.0),
-    mf.Option("max_steps", int, 200, "largest number of settlement steps", above=0),
-    mf.Option("plateau_slope", float, 0.01, "plateau: |dR/ds| below this fraction of the elastic slope ...",
-              above=0.0),
+    mf.Option("max_steps", int, 200, "largest number of settlement (or load-factor) steps", above=0),
+    mf.Option("load_increment", float, 0.05,
+              "without a moving support: the first increment of the live load's factor", above=0.0),
+    mf.Option("load_tolerance", float, 1e-3,
+              "without a moving support: the run ends when a halved load increment falls below this", above=0.0),
+    mf.Option("plateau_slope", float, 0.01, "plateau: |dR/ds| (or, without a moving support, the load factor's "
+              "rate per unit displacement) below this fraction of the elastic (first step's) one ...", above=0.0),
     mf.Option("plateau_steps", int, 3, "... over this many consecutive steps", above=0),
 )
 

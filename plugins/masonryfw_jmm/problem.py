@@ -15,9 +15,10 @@ from skfem import MeshTri
 
 import masonryfw as mf
 
+from .fabric import bed_angles, extents_along, head_joints, stress_rotation
 from .fem import Discretisation
 from .material import JointStrength, ReturnMap, elastic_matrix
-from .mesh import WallMesh, block_rectangles, wall_mesh
+from .mesh import WallMesh, block_boxes, masonry, wall_mesh
 
 ROLE = mf.flags("block_role")
 KIND = mf.flags("interface_kind")
@@ -46,6 +47,11 @@ class Problem:
     young: float
     poisson: float
     strength: JointStrength
+    live: np.ndarray | None = None  # (ndof,) body force of the live load at load factor 1
+    to_bed: np.ndarray | None = None  # (masonry points, 3, 3) stresses into each point's bed frame; None: horizontal
+    from_bed: np.ndarray | None = None  # the inverse rotations
+    face_bounds: np.ndarray | None = None  # (faces, masonry points) b per point (no head faces without head joints)
+    searches_load: bool = False  # no moving support: the live load's factor grows instead of a settlement
 
     @property
     def free(self) -> np.ndarray:
@@ -62,30 +68,51 @@ def _modal(values: np.ndarray, tol: float) -> float:
     return float(values[groups == keys[counts.argmax()]].mean())
 
 
-def interlocking_beta(model: xr.Dataset, friction_bed: float) -> float:
+def unit_size(model: xr.Dataset, angles: np.ndarray) -> tuple[float, float]:
+    """``(b, a)``: length and height of the commonest unit, measured along and across its bed direction."""
+    units = model.block_role.values == ROLE["unit"]
+    if not units.any():
+        raise mf.ModelError("jmm: no unit blocks to take the unit size b x a from; give options beta and mesh_size")
+    length, height = extents_along(model, angles)
+    tol = 1e-6 * mf.model_scale(model.node_x.values, model.node_y.values)
+    return _modal(length[units], tol), _modal(height[units], tol)
+
+
+def median_unit_height(model: xr.Dataset, angles: np.ndarray) -> float:
+    """The median extent of the units across their beds: half of it is the automatic mesh size (the
+    commonest unit's height in a wall of courses; the voussoirs' widths in an arch on piers of fewer units)."""
+    units = model.block_role.values == ROLE["unit"]
+    return float(np.median(extents_along(model, angles)[1][units]))
+
+
+def interlocking_beta(model: xr.Dataset, friction_bed: float, angles: np.ndarray) -> float:
     """beta = tan(phi_bed) b / (2 a) (eq. 13), b and a the length and height of the commonest unit.
 
     With mu = 0.4: 200 x 50 mm units give 0.4 * 200 / 100 = 0.8 (Tests 8C, 12C), 100 x 50 mm
     units give 0.4 (the others), the paper's values.
     """
-    box = block_rectangles(model)
-    units = model.block_role.values == ROLE["unit"]
-    if not units.any():
-        raise mf.ModelError("jmm: no unit blocks to take the unit size b x a for beta from; give option beta")
-    tol = 1e-6 * mf.model_scale(model.node_x.values, model.node_y.values)
-    b = _modal(box[units, 2] - box[units, 0], tol)
-    a = _modal(box[units, 3] - box[units, 1], tol)
+    b, a = unit_size(model, angles)
     return friction_bed * b / (2.0 * a)
 
 
-def _joint_mean(model: xr.Dataset, name: str, kind: str, fallback: str | None = None) -> float:
-    """Mean of interface variable ``name`` over joints of ``kind`` (else ``fallback`` kind)."""
-    chosen = model.interface_kind.values == KIND[kind]
-    if not chosen.any() and fallback is not None:
-        return _joint_mean(model, name, fallback)
-    if not chosen.any():
-        raise mf.ModelError(f"jmm: the model has no {kind} interfaces to take {name} from")
-    return float(model[name].values[chosen].mean())
+def joint_planes(model: xr.Dataset, angles: np.ndarray) -> np.ndarray:
+    """``(interface,)`` ``"bed"``, ``"head"`` or ``""``: a joint between masonry blocks is a bed joint when it
+    runs within 45 deg of its side-0 block's bed direction (the interface kind in a wall of courses);
+    a joint on a support is neither."""
+    sides = model.interface_blocks.values.astype(np.int64)
+    on_support = mf.support_blocks(model.block_role.values)[sides].any(axis=1)
+    direction = np.arctan2(np.diff(model.interface_y.values, axis=1)[:, 0], np.diff(model.interface_x.values, axis=1)[:, 0])
+    off = np.abs(np.sin(direction - angles[sides[:, 0]]))
+    return np.where(on_support, "", np.where(off < np.sqrt(0.5), "bed", "head"))
+
+
+def _joint_mean(model: xr.Dataset, name: str, planes: np.ndarray, plane: str, fallback: str) -> float:
+    """Mean of interface variable ``name`` over the joints of ``plane``, else of ``fallback``, else (masonry
+    that stands on its supports alone) over every joint."""
+    for chosen in (planes == plane, planes == fallback, np.ones(planes.size, dtype=bool)):
+        if chosen.any():
+            return float(model[name].values[chosen].mean())
+    raise mf.ModelError(f"jmm: the model has no interfaces to take {name} from")
 
 
 def _block_constant(model: xr.Dataset, name: str, blocks: np.ndarray, option: float | None,
@@ -98,21 +125,22 @@ def _block_constant(model: xr.Dataset, name: str, blocks: np.ndarray, option: fl
     return np.full(blocks.size, default)
 
 
-def strength_from_model(model: xr.Dataset, beta: float | None, dilatancy: float | None) -> tuple[JointStrength, float]:
-    """The JMM strength (physical units) from the bed/head interfaces; and beta (auto: eq. 13).
-
-    ``dilatancy``: the dilatancy angle psi [deg] of both planes, None for associated flow.
+def strength_from_model(model: xr.Dataset, beta: float | None, dilatancy: float | None,
+                        angles: np.ndarray) -> tuple[JointStrength, float]:
+    """The JMM strength (physical units) from the bed and head joints (:func:`joint_planes`); and beta
+    (auto: eq. 13). ``dilatancy``: the dilatancy angle psi [deg] of both planes, None for associated flow.
     """
-    mu_bed = _joint_mean(model, "interface_friction", "bed")
-    mu_head = _joint_mean(model, "interface_friction", "head", "bed")
-    beta = beta if beta is not None else interlocking_beta(model, mu_bed)
+    planes = joint_planes(model, angles)
+    mu_bed = _joint_mean(model, "interface_friction", planes, "bed", "head")
+    mu_head = _joint_mean(model, "interface_friction", planes, "head", "bed")
+    beta = beta if beta is not None else interlocking_beta(model, mu_bed, angles)
     tan_psi = None if dilatancy is None else float(np.tan(np.radians(dilatancy)))
     strength = JointStrength(
         friction_bed=mu_bed, friction_head=mu_head,
-        cohesion_bed=_joint_mean(model, "interface_cohesion", "bed"),
-        cohesion_head=_joint_mean(model, "interface_cohesion", "head", "bed"),
-        tensile_bed=_joint_mean(model, "interface_tensile_strength", "bed"),
-        tensile_head=_joint_mean(model, "interface_tensile_strength", "head", "bed"),
+        cohesion_bed=_joint_mean(model, "interface_cohesion", planes, "bed", "head"),
+        cohesion_head=_joint_mean(model, "interface_cohesion", planes, "head", "bed"),
+        tensile_bed=_joint_mean(model, "interface_tensile_strength", planes, "bed", "head"),
+        tensile_head=_joint_mean(model, "interface_tensile_strength", planes, "head", "bed"),
         beta=beta, dilatancy_bed=tan_psi, dilatancy_head=tan_psi,
     )
     return strength, beta
@@ -139,37 +167,50 @@ def regularised(strength: JointStrength, shift: float) -> JointStrength:
     )
 
 
+def support_facets(points: np.ndarray, ends: np.ndarray, segments: np.ndarray, tol: float) -> np.ndarray:
+    """``(facets,)`` index of the support segment each facet lies on (both ends within ``tol``), -1 if none.
+
+    ``ends``: ``(2, facets)`` node indices; ``segments``: ``(k, end, xy)``, in the units of ``points``.
+    """
+    px, py = points[0, ends], points[1, ends]  # (2 ends, facets)
+    ax, ay = segments[:, 0, 0], segments[:, 0, 1]
+    bx, by = segments[:, 1, 0], segments[:, 1, 1]
+    near = np.ones((ends.shape[1], segments.shape[0]), dtype=bool)
+    for end in (0, 1):
+        near &= mf.point_segment_distance(px[end][:, None], py[end][:, None], ax, ay, bx, by) <= tol
+    return np.where(near.any(axis=1), near.argmax(axis=1), -1)
+
+
 def _support_dofs(mesh: WallMesh, disc: Discretisation, model: xr.Dataset, length: float, tol: float):
-    """Fixed DOFs, moving DOFs and their motion per unit settlement, from the support blocks' top edges."""
+    """Fixed DOFs, moving DOFs and their motion per unit settlement, from the support segments (the masonry
+    on its supports); the moving arrays are empty when no support moves."""
     m = disc.mesh
     boundary = m.boundary_facets()
-    mid = m.p[:, m.facets[:, boundary]].mean(axis=1)
-    horizontal = np.isclose(m.p[1, m.facets[0, boundary]], m.p[1, m.facets[1, boundary]], atol=tol)
+    on = support_facets(m.p, m.facets[:, boundary], mesh.supports / length, tol)
     locs = disc.basis.doflocs
+    block = np.where(on >= 0, mesh.support_block[np.maximum(on, 0)], -1)
     fixed, moving, direction = [], [], []
-    for x0, x1, y, block, role in mesh.supports:  # a handful of supports
-        x0, x1, y = x0 / length, x1 / length, y / length
-        on = horizontal & np.isclose(mid[1], y, atol=tol) & (mid[0] > x0 - tol) & (mid[0] < x1 + tol)
-        dofs = disc.facet_dofs(boundary[on])
-        if role == ROLE["fixed_support"]:
+    for support in np.unique(block[block >= 0]):  # a handful of supports
+        dofs = disc.facet_dofs(boundary[block == support])
+        if model.block_role.values[support] == ROLE["fixed_support"]:
             fixed.append(np.concatenate([2 * dofs, 2 * dofs + 1]))
             continue
-        d = model.settlement_direction.values[block]
-        cx, cy = (model[f"block_centroid_{c}"].values[block] / length for c in "xy")
+        d = model.settlement_direction.values[support]
+        cx, cy = (model[f"block_centroid_{c}"].values[support] / length for c in "xy")
         ux = d[0] - d[2] * length * (locs[1, dofs] - cy)
         uy = d[1] + d[2] * length * (locs[0, dofs] - cx)
         moving.append(np.concatenate([2 * dofs, 2 * dofs + 1]))
         direction.append(np.concatenate([ux, uy]))
+    if not fixed and not moving:
+        raise mf.ModelError("jmm: no mesh edge lies on a support interface: the wall stands on nothing")
     fixed = np.unique(np.concatenate(fixed)) if fixed else np.zeros(0, int)
     if not moving:
-        raise mf.ModelError("jmm: the model has no moving_support block under the wall to settle")
+        return fixed, np.zeros(0, int), np.zeros(0)
     moving = np.concatenate(moving)
     direction = np.concatenate(direction)
     keep = ~np.isin(moving, fixed)  # a node shared with a fixed support stays fixed
     moving, direction = moving[keep], direction[keep]
     moving, first = np.unique(moving, return_index=True)
-    if moving.size == 0:
-        raise mf.ModelError("jmm: no mesh node lies on the moving support's top edge")
     return fixed, moving, direction[first]
 
 
@@ -191,6 +232,8 @@ class Domain:
     unit_weight: float  # gamma [N m-3]: the largest masonry unit weight
     strength: JointStrength
     beta: float
+    angles: np.ndarray  # (block,) bed direction [rad] (fabric.py)
+    headless: np.ndarray  # (block,) no head joints: the bed faces only (fabric.py)
 
     def scaled_strength(self, apex_shift: float) -> JointStrength:
         """The non-dimensional strength (stresses over S) with the apex regularisation."""
@@ -200,21 +243,52 @@ class Domain:
 def wall_domain(model: xr.Dataset, mesh_size: float | None, beta: float | None,
                 dilatancy: float | None = None) -> Domain:
     """Mesh the wall (cells no larger than ``mesh_size``, auto: half the unit height), scale it, read its strength."""
-    role = model.block_role.values
-    masonry_blocks = np.isin(role, [ROLE["unit"], ROLE["lintel"]])
-    box = block_rectangles(model)
-    ys = box[masonry_blocks][:, [1, 3]]
-    H = float(ys.max() - ys.min())
-    unit_height = _modal(box[role == ROLE["unit"], 3] - box[role == ROLE["unit"], 1], 1e-6 * H) if (
-        role == ROLE["unit"]).any() else H / 10
-    size = mesh_size if mesh_size is not None else unit_height / 2
+    blocks = masonry(model)
+    box = block_boxes(model)[blocks]
+    H = float(box[:, 3].max() - box[:, 1].min())
+    angles = bed_angles(model)
+    has_units = (model.block_role.values == ROLE["unit"]).any()
+    size = mesh_size if mesh_size is not None else (median_unit_height(model, angles) if has_units else H / 10) / 2
     mesh = wall_mesh(model, size)
     gamma_ref = float(model.block_unit_weight.values[mesh.block].max())
     if not gamma_ref > 0:
         raise mf.ModelError("jmm: the masonry has no weight (block_unit_weight is 0 everywhere)")
-    strength, beta = strength_from_model(model, beta, dilatancy)
+    strength, beta = strength_from_model(model, beta, dilatancy, angles)
     S = gamma_ref * H
-    return Domain(mesh, H, size, S, S * H * H, gamma_ref, strength, beta)
+    return Domain(mesh, H, size, S, S * H * H, gamma_ref, strength, beta, angles, ~head_joints(model, angles))
+
+
+def live_body_force(model: xr.Dataset, blocks: np.ndarray, unit_weight: float) -> np.ndarray:
+    """``(triangles, 2)`` the live load of every masonry block spread uniformly over its volume, over
+    ``unit_weight`` (the non-dimensional body force); a live moment has no such meaning and is refused."""
+    live = mf.block_loads(model, "live")
+    moment = np.flatnonzero(live[blocks, 2] != 0)
+    if moment.size:
+        raise mf.ModelError(f"block(s) {mf.listed(np.unique(blocks[moment]))}: live_load has a moment; jmm "
+                            "spreads a block's live load over its volume, which carries forces only")
+    volume = model.block_area.values * model.block_thickness.values
+    return live[blocks, :2] / volume[blocks, None] / unit_weight
+
+
+#: The bound of a face a point does not have: never reached by non-dimensional stresses (of order 1).
+ABSENT_FACE = 1e6
+
+
+def headless_bounds(rmap: ReturnMap, headless: np.ndarray) -> np.ndarray | None:
+    """``(faces, points)`` bounds with the head faces lifted out of reach at ``headless`` points (None if none)."""
+    if not headless.any():
+        return None
+    bounds = np.repeat(rmap.b[:, None], headless.size, axis=1)
+    head = np.array([name.startswith("head") for name in rmap.names])
+    bounds[np.ix_(head, headless)] = ABSENT_FACE
+    return bounds
+
+
+def bed_rotations(angle: np.ndarray) -> tuple[np.ndarray | None, np.ndarray | None]:
+    """``(to bed, from bed)`` Voigt rotations of the points, or ``(None, None)`` when every bed is horizontal."""
+    if not np.any(angle):
+        return None, None
+    return stress_rotation(angle), stress_rotation(-angle)
 
 
 def build_problem(model: xr.Dataset, options) -> Problem:
@@ -244,9 +318,16 @@ def build_problem(model: xr.Dataset, options) -> Problem:
     body = np.stack([np.zeros(blocks.size), -gamma / domain.unit_weight], axis=1)
     gravity = disc.body_force(body)
     fixed, moving, direction = _support_dofs(mesh, disc, model, H, 1e-6 * size / H)
+    searches_load = moving.size == 0
+    if searches_load and not np.any(mf.block_loads(model, "live")[masonry(model)]):
+        raise mf.ModelError("jmm: no moving support to settle and no live load to raise: nothing to analyse")
+    live = disc.body_force(live_body_force(model, blocks, domain.unit_weight))
+    to_bed, from_bed = bed_rotations(np.repeat(domain.angles[blocks], disc.nqp)[masonry_points])
+    face_bounds = headless_bounds(rmap, np.repeat(domain.headless[blocks], disc.nqp)[masonry_points])
     return Problem(
         mesh=mesh, disc=disc, return_map=rmap, masonry_points=masonry_points, D_points=D_points,
         gravity=gravity, fixed=fixed, moving=moving, moving_direction=direction,
         moving_vertical=moving % 2 == 1, length=H, mesh_size=size, stress=S, displacement=U, force=domain.force,
-        beta=domain.beta, young=young, poisson=poisson, strength=domain.strength,
+        beta=domain.beta, young=young, poisson=poisson, strength=domain.strength, live=live, to_bed=to_bed,
+        from_bed=from_bed, face_bounds=face_bounds, searches_load=searches_load,
     )

@@ -1,4 +1,11 @@
-"""The ``jmm`` solve: gravity, then incremental settlement of the moving support to the reaction plateau."""
+"""The ``jmm`` solve: gravity, then incremental settlement of the moving support to the reaction plateau.
+
+Without a moving support (a tilting table: the weight acting sideways as the live load),
+the live load's factor grows instead, step by step under load control, until no step
+converges (a step is cut in half when Newton fails, and the run ends when the increment
+falls below ``load_tolerance``) or the factor has reached its plateau (it grows by less
+than ``plateau_slope`` times the first step's rate per unit of the largest displacement
+over ``plateau_steps`` steps): the last converged factor is the collapse multiplier."""
 from __future__ import annotations
 
 from dataclasses import dataclass, field
@@ -19,9 +26,24 @@ MIN_INCREMENT = 1e-4  # of the elastic unloading settlement: below it a failing 
 class History:
     settlement: list = field(default_factory=list)
     reaction: list = field(default_factory=list)
+    load_factor: list = field(default_factory=list)
+    displacement: list = field(default_factory=list)  # largest node displacement (non-dimensional)
     iterations: list = field(default_factory=list)
     plastic_points: list = field(default_factory=list)
     residuals: list = field(default_factory=list)
+
+    def add(self, newton: NewtonSolver, state: State, settlement: float, load_factor: float, iterations: int) -> None:
+        self.settlement.append(settlement)
+        self.reaction.append(newton.reaction(state))
+        self.load_factor.append(load_factor)
+        self.displacement.append(float(np.hypot(state.u[0::2], state.u[1::2]).max(initial=0.0)))
+        self.iterations.append(iterations)
+        self.plastic_points.append(int(state.active.any(axis=1).sum()))
+
+    @property
+    def steps(self) -> int:
+        """Steps after the gravity stage."""
+        return len(self.iterations) - 1
 
 
 GRAVITY_ITERATIONS = 4  # times max_iterations: with c = sigma_t = 0 the domain is a cone, so smaller
@@ -41,10 +63,7 @@ def _gravity_stage(newton: NewtonSolver, state: State, history: History) -> tupl
         increment /= 2
         if increment < 1e-3:
             return state, f"gravity stage did not converge at gravity factor {factor:.4f}"
-    history.settlement.append(0.0)
-    history.reaction.append(newton.reaction(state))
-    history.iterations.append(iterations)
-    history.plastic_points.append(int(state.active.any(axis=1).sum()))
+    history.add(newton, state, 0.0, 0.0, iterations)
     return state, ""
 
 
@@ -94,7 +113,7 @@ def run(problem: Problem, options, progress) -> tuple[State, History, dict]:
         largest = options["max_increment"] * unloading
         last_increment = None  # (du, ds) of the last converged step, extrapolated as a second predictor
         while True:
-            if len(history.settlement) - 1 >= options["max_steps"]:
+            if history.steps >= options["max_steps"]:
                 info["stop_reason"] = f"max_steps ({options['max_steps']}) reached"
                 break
             target = min(settlement + increment, limit)
@@ -111,12 +130,9 @@ def run(problem: Problem, options, progress) -> tuple[State, History, dict]:
                 continue
             last_increment = (trial.u - state.u, target - settlement)
             state, settlement = trial, target
-            history.settlement.append(settlement)
-            history.reaction.append(newton.reaction(state))
-            history.iterations.append(report.iterations)
-            history.plastic_points.append(int(state.active.any(axis=1).sum()))
+            history.add(newton, state, settlement, 0.0, report.iterations)
             history.residuals.append(report.residuals)
-            progress(min(0.99, settlement / limit), f"step {len(history.settlement) - 1}: settlement "
+            progress(min(0.99, settlement / limit), f"step {history.steps}: settlement "
                      f"{settlement * problem.displacement:.3g} m, reaction {history.reaction[-1] * problem.force:.4g} N, "
                      f"{report.iterations} Newton iterations")
             if _plateau(history, slope, options):
@@ -135,6 +151,75 @@ def run(problem: Problem, options, progress) -> tuple[State, History, dict]:
     return state, history, info
 
 
+def _load_plateau(history: History, options) -> bool:
+    """The load factor has grown by less than ``plateau_slope`` times its first-step rate per unit of the
+    largest displacement over the last ``plateau_steps`` steps: the structure yields without more load."""
+    n = options["plateau_steps"]
+    if history.steps < n + 1:
+        return False
+    factor, moved = np.asarray(history.load_factor), np.asarray(history.displacement)
+    first = (factor[1] - factor[0]) / max(moved[1] - moved[0], 1e-300)
+    rate = np.diff(factor[-n - 1:]) / np.maximum(np.diff(moved[-n - 1:]), 1e-300)
+    return bool(np.all(rate < options["plateau_slope"] * first))
+
+
+def run_load_factor(problem: Problem, options, progress) -> tuple[State, History, dict]:
+    """Gravity, then load steps of the live load until no step converges (module docstring)."""
+    kappa = options["vertex_stiffness"], options["settled_stiffness"]
+    newton = NewtonSolver(problem, options["tolerance"], options["max_iterations"], regularisation=kappa)
+    history = History()
+    info = {"interrupted": 0, "stop_reason": ""}
+    state = State.initial(problem)
+    try:
+        progress(0.0, "gravity")
+        state, failure = _gravity_stage(newton, state, history)
+        if failure:
+            info["stop_reason"] = failure
+            return state, history, info
+        factor, increment, last = 0.0, options["load_increment"], None
+        while True:
+            if history.steps >= options["max_steps"]:
+                info["stop_reason"] = f"max_steps ({options['max_steps']}) reached"
+                break
+            target = factor + increment
+            guess = None if last is None else state.u + (target - factor) / last[1] * last[0]
+            trial, report = newton.step(state, 1.0, 0.0, guess=guess, load_factor=target)
+            if not report.converged:
+                increment /= 2
+                if increment < options["load_tolerance"]:
+                    info["stop_reason"] = f"no convergence above load factor {factor:.6g}: the limit load"
+                    break
+                continue
+            last = (trial.u - state.u, target - factor)
+            state, factor = trial, target
+            history.add(newton, state, 0.0, factor, report.iterations)
+            history.residuals.append(report.residuals)
+            progress(min(0.99, history.steps / options["max_steps"]),
+                     f"step {history.steps}: load factor {factor:.4g}, {report.iterations} Newton iterations")
+            if _load_plateau(history, options):
+                info["stop_reason"] = "load plateau"
+                break
+            if report.iterations <= options["target_iterations"]:
+                increment *= 1.5
+            elif report.iterations > 2 * options["target_iterations"]:
+                increment *= 0.5
+    except KeyboardInterrupt:
+        info["interrupted"] = 1
+        info["stop_reason"] = "interrupted"
+    return state, history, info
+
+
+def load_factor_variables(history: History, displacement: float) -> dict:
+    """The load-factor run's history and its collapse multiplier (the last converged factor)."""
+    return {
+        "collapse_multiplier": variable((), history.load_factor[-1], "1",
+                                        "multiplier of the live load at the last converged step (the limit load)"),
+        "step_load_factor": variable("step", np.asarray(history.load_factor), "1", "multiplier of the live load"),
+        "step_largest_displacement": variable("step", np.asarray(history.displacement) * displacement, "m",
+                                              "largest displacement of a mesh node"),
+    }
+
+
 def result_dataset(problem: Problem, state: State, history: History, info: dict) -> xr.Dataset:
     """docs/format.md result variables (physical units) from the final converged state and the history."""
     p, disc = problem, problem.disc
@@ -149,9 +234,11 @@ def result_dataset(problem: Problem, state: State, history: History, info: dict)
         "mesh_node_ux": variable("mesh_node", state.u[2 * vertex] * U, "m", "final horizontal displacement of the mesh node"),
         "mesh_node_uy": variable("mesh_node", state.u[2 * vertex + 1] * U, "m", "final vertical displacement of the mesh node"),
         **point_variables((qx, qy), failure, stress, "quadrature point", "in the last step"),
-        "step_settlement": variable("step", np.asarray(history.settlement) * U, "m", "imposed settlement"),
-        "step_reaction": variable("step", np.asarray(history.reaction) * p.force, "N",
-                              "vertical reaction on the moving support"),
+        **(load_factor_variables(history, U) if p.searches_load else {
+            "step_settlement": variable("step", np.asarray(history.settlement) * U, "m", "imposed settlement"),
+            "step_reaction": variable("step", np.asarray(history.reaction) * p.force, "N",
+                                      "vertical reaction on the moving support"),
+        }),
         "step_newton_iterations": variable("step", np.asarray(history.iterations, dtype=np.int32), "1",
                                        "Newton iterations of the step (step 0: the whole gravity stage)"),
         "step_plastic_points": variable("step", np.asarray(history.plastic_points, dtype=np.int32), "1",
@@ -171,10 +258,11 @@ def result_dataset(problem: Problem, state: State, history: History, info: dict)
 
 
 def solve(model: xr.Dataset, options, progress) -> xr.Dataset:
-    """Solve ``model`` with the Jointed Masonry Model, settlement step by step: the ``jmm`` solver entry point."""
+    """Solve ``model`` with the Jointed Masonry Model, settlement (or load factor) step by step: the ``jmm``
+    solver entry point."""
     problem = build_problem(model, options)
-    state, history, info = run(problem, options, progress)
-    if info["interrupted"] and len(history.settlement) == 0:
+    state, history, info = (run_load_factor if problem.searches_load else run)(problem, options, progress)
+    if info["interrupted"] and len(history.iterations) == 0:
         raise KeyboardInterrupt  # interrupted before the gravity stage converged: nothing to keep
     progress(1.0, info["stop_reason"])
     return result_dataset(problem, state, history, info)

@@ -92,7 +92,7 @@ def test_a_polyline_going_on_past_its_start_and_points_around_it(tmp_path):
     assert drawing.block_node_count[4] == 4
     assert drawing.ignored == {"POINT": sum(len(p) for p in polygons)}
     assert drawing.block_node_count[-1] == 12  # the base with the springers: non-convex
-    assert not mf.geometry.convex_blocks(drawing.node_x, drawing.node_y, drawing.block_node_count)[-1]
+    assert not mf.convex_blocks(drawing.node_x, drawing.node_y, drawing.block_node_count)[-1]
 
 
 def test_arcs_become_chords_within_the_tolerance(tmp_path):

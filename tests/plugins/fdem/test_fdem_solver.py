@@ -82,18 +82,6 @@ def test_bad_options_name_the_option(small_wall, options, named):
         mf.solve(small_wall, "fdem", options)
 
 
-def test_non_convex_block_is_named(small_wall):
-    model = small_wall.copy()
-    x = model.node_x.values.copy()
-    y = model.node_y.values.copy()
-    # block 0 is the rectangle of nodes 0..3; pull its top-right corner inside: a dart (concave)
-    x[2], y[2] = 0.05, 0.01
-    model["node_x"], model["node_y"] = ("node", x, model.node_x.attrs), ("node", y, model.node_y.attrs)
-    model = mf.derive_geometry(model.drop_vars(list(mf.DERIVED_GEOMETRY_VARIABLES), errors="ignore"))
-    with pytest.raises(mf.ModelError, match=r"block\(s\) 0: not convex"):
-        build_scene(model)
-
-
 def test_weightless_masonry_block_is_named(small_wall):
     weight = small_wall.block_unit_weight.values.copy()
     weight[3] = 0.0
