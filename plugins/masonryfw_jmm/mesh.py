@@ -158,7 +158,8 @@ def gmsh_mesh(model: xr.Dataset, size: float) -> tuple[np.ndarray, np.ndarray, n
     clockwise = (px[:, 1] - px[:, 0]) * (py[:, 2] - py[:, 0]) - (px[:, 2] - px[:, 0]) * (py[:, 1] - py[:, 0]) < 0
     triangles[clockwise] = triangles[clockwise][:, ::-1]
     used, triangles = np.unique(triangles, return_inverse=True)
-    return points[:, used], triangles.reshape(-1, 3).T, np.concatenate(owner)
+    # C order: scikit-fem copies (and says so) anything else
+    return np.ascontiguousarray(points[:, used]), np.ascontiguousarray(triangles.reshape(-1, 3).T), np.concatenate(owner)
 
 
 def wall_mesh(model: xr.Dataset, size: float) -> WallMesh:

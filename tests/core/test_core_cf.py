@@ -38,6 +38,10 @@ def written(tmp_path_factory):
         results[solver] = mf.solve(model, solver, options.get(solver, {}))
         files[solver] = mf.save(results[solver], folder / f"{solver}.nc")
     files["comparison"] = mf.save(mf.compare(results["la"], results["fdem"], "crack"), folder / "comparison.nc")
+    drawn = mf.open_model("lact3-arch")  # a model of a drawing, and the tilt results (load factors, trials)
+    files["drawn model"] = mf.save(drawn, folder / "drawn.nc")
+    for solver in ("fdem", "jmm", "jmm-limit"):
+        files[f"{solver} tilt"] = mf.save(mf.solve(drawn, solver), folder / f"{solver}-tilt.nc")
     from masonryfw_sweep import combine, plan_sweep
     from masonryfw_sweep.tasks import run_point
 
@@ -49,6 +53,7 @@ def written(tmp_path_factory):
     return files
 
 
-@pytest.mark.parametrize("kind", ["model", "la", "fdem", "jmm", "jmm-limit", "statics", "comparison", "sweep"])
+@pytest.mark.parametrize("kind", ["model", "la", "fdem", "jmm", "jmm-limit", "statics", "comparison", "sweep",
+                                  "drawn model", "fdem tilt", "jmm tilt", "jmm-limit tilt"])
 def test_cf_checker_finds_no_error(written, tmp_path, kind):
     assert cf_errors(written[kind], tmp_path) == []
