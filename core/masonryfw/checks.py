@@ -36,6 +36,7 @@ from .geometry import (
     node_block,
     point_segment_distance,
     polygon_area_centroid,
+    vertex_turns,
 )
 from .schema import FORMAT_VERSION, KINDS, READABLE_VERSIONS, load_schema
 
@@ -390,7 +391,7 @@ def _polygon_problems(model) -> list[Problem]:
     passing all of them are kept in ``model.good_polygon`` for the overlap test.
     """
     x, y, owner, tol = model.x, model.y, model.owner, model.tol
-    edge_len, offset, forward = _vertex_turns(model)
+    edge_len, offset, forward = vertex_turns(model.x, model.y, model.counts)
     readable_node = model.readable[owner]
     repeated = readable_node & (edge_len <= tol)
     problems = [
@@ -429,20 +430,6 @@ def _polygon_problems(model) -> list[Problem]:
     simple &= ~zero_area
     model.good_polygon = simple & ~clockwise
     return problems
-
-
-def _vertex_turns(model):
-    """Per vertex: length of the outgoing edge, signed distance from the chord of its two
-    neighbours (> 0 for a left turn) and whether the path goes on forward (no reversal)."""
-    x, y, nxt = model.x, model.y, model.next
-    prev = np.empty_like(nxt)
-    prev[nxt] = np.arange(nxt.size)
-    ax, ay = x - x[prev], y - y[prev]
-    bx, by = x[nxt] - x, y[nxt] - y
-    chord = np.hypot(x[nxt] - x[prev], y[nxt] - y[prev])
-    with np.errstate(invalid="ignore", divide="ignore"):
-        offset = (ax * by - ay * bx) / chord
-    return np.hypot(bx, by), offset, ax * bx + ay * by > 0
 
 
 def _segment_distance(p0x, p0y, p1x, p1y, q0x, q0y, q1x, q1y):

@@ -81,6 +81,22 @@ def block_bounds(node_x, node_y, block_node_count):
     return tuple(out)
 
 
+def vertex_turns(node_x, node_y, block_node_count):
+    """Per vertex: length of the outgoing edge, signed distance from the chord of its two neighbours
+    (> 0 for a left turn) and whether the path goes on forward (no reversal)."""
+    x = np.asarray(node_x, dtype=float)
+    y = np.asarray(node_y, dtype=float)
+    nxt = next_node(block_node_count)
+    prev = np.empty_like(nxt)
+    prev[nxt] = np.arange(nxt.size)
+    ax, ay = x - x[prev], y - y[prev]
+    bx, by = x[nxt] - x, y[nxt] - y
+    chord = np.hypot(x[nxt] - x[prev], y[nxt] - y[prev])
+    with np.errstate(invalid="ignore", divide="ignore"):
+        offset = (ax * by - ay * bx) / chord
+    return np.hypot(bx, by), offset, ax * bx + ay * by > 0
+
+
 def convex_blocks(node_x, node_y, block_node_count, tol: float = 0.0) -> np.ndarray:
     """Whether every polygon is convex: no vertex turns against the polygon's orientation by more than ``tol``.
 
@@ -89,14 +105,7 @@ def convex_blocks(node_x, node_y, block_node_count, tol: float = 0.0) -> np.ndar
     x = np.asarray(node_x, dtype=float)
     y = np.asarray(node_y, dtype=float)
     counts = np.asarray(block_node_count, dtype=np.int64)
-    nxt = next_node(counts)
-    prev = np.empty_like(nxt)
-    prev[nxt] = np.arange(nxt.size)
-    ax, ay = x - x[prev], y - y[prev]
-    bx, by = x[nxt] - x, y[nxt] - y
-    chord = np.hypot(x[nxt] - x[prev], y[nxt] - y[prev])
-    with np.errstate(invalid="ignore", divide="ignore"):
-        offset = (ax * by - ay * bx) / chord
+    offset = vertex_turns(x, y, counts)[1]
     owner = node_block(counts)
     sign = np.sign(polygon_area_centroid(x, y, counts)[0])[owner]
     reflex = np.nan_to_num(sign * offset, nan=0.0) < -tol

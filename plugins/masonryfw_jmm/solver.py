@@ -92,18 +92,27 @@ def _plateau(history: History, slope: float, options) -> bool:
     return bool(np.all(np.abs(np.diff(r) / np.diff(s)) < options["plateau_slope"] * abs(slope)))
 
 
-def run(problem: Problem, options, progress) -> tuple[State, History, dict]:
-    """Gravity, then settlement steps until the plateau; every converged step kept."""
+def _start(problem: Problem, options) -> tuple[NewtonSolver, History, dict, State]:
+    """The Newton solver of a run, an empty history, the run's info and the initial state."""
     kappa = options["vertex_stiffness"], options["settled_stiffness"]
     newton = NewtonSolver(problem, options["tolerance"], options["max_iterations"], regularisation=kappa)
-    history = History()
-    info = {"interrupted": 0, "stop_reason": ""}
-    state = State.initial(problem)
+    return newton, History(), {"interrupted": 0, "stop_reason": ""}, State.initial(problem)
+
+
+def _gravity(newton: NewtonSolver, state: State, history: History, info: dict, progress) -> tuple[State, bool]:
+    """The gravity stage; ``(state, failed)``, the failure written into ``info``."""
+    progress(0.0, "gravity")
+    state, failure = _gravity_stage(newton, state, history)
+    info["stop_reason"] = failure
+    return state, bool(failure)
+
+
+def run(problem: Problem, options, progress) -> tuple[State, History, dict]:
+    """Gravity, then settlement steps until the plateau; every converged step kept."""
+    newton, history, info, state = _start(problem, options)
     try:
-        progress(0.0, "gravity")
-        state, failure = _gravity_stage(newton, state, history)
-        if failure:
-            info["stop_reason"] = failure
+        state, failed = _gravity(newton, state, history, info, progress)
+        if failed:
             return state, history, info
         unloading, slope = elastic_unloading_settlement(newton, state)
         info["jmm_elastic_unloading_settlement_m"] = unloading * problem.displacement
@@ -165,16 +174,10 @@ def _load_plateau(history: History, options) -> bool:
 
 def run_load_factor(problem: Problem, options, progress) -> tuple[State, History, dict]:
     """Gravity, then load steps of the live load until no step converges (module docstring)."""
-    kappa = options["vertex_stiffness"], options["settled_stiffness"]
-    newton = NewtonSolver(problem, options["tolerance"], options["max_iterations"], regularisation=kappa)
-    history = History()
-    info = {"interrupted": 0, "stop_reason": ""}
-    state = State.initial(problem)
+    newton, history, info, state = _start(problem, options)
     try:
-        progress(0.0, "gravity")
-        state, failure = _gravity_stage(newton, state, history)
-        if failure:
-            info["stop_reason"] = failure
+        state, failed = _gravity(newton, state, history, info, progress)
+        if failed:
             return state, history, info
         factor, increment, last = 0.0, options["load_increment"], None
         while True:

@@ -305,3 +305,50 @@ def test_numba_compilation_is_recorded_apart_from_the_wall_time(spec, tmp_path):
     assert attrs["compile_time_s"] > 1.0
     assert attrs["wall_time_s"] < attrs["compile_time_s"]
     assert json.loads(attrs["solver_options"])["mode"] == "rigid"
+
+
+# ---------------------------------------------------------------- drawings
+
+DRAWN_SPEC = """title = "drawn"
+[geometry]
+dxf = "wall.dxf"
+[wall]
+thickness = 0.1
+[material]
+unit_weight = 12000.0
+friction_angle = 30.0
+[supports.base]
+kind = "fixed"
+select = "lowest"
+[loading]
+type = "tilt"
+direction = 1
+"""
+
+
+def test_a_broken_drawing_is_named_and_an_overlapping_one_can_still_be_drawn(tmp_path):
+    """An open polyline: exit 1, the entity and its ends, no traceback, nothing written. Overlapping
+    blocks: build refuses naming both entities; plot --kind model draws the model all the same."""
+    import ezdxf
+
+    (tmp_path / "wall.toml").write_text(DRAWN_SPEC)
+    doc = ezdxf.new()
+    doc.header["$INSUNITS"] = 4
+    doc.modelspace().add_lwpolyline([(0, 0), (200, 0), (200, 100)], close=False)
+    doc.saveas(tmp_path / "wall.dxf")
+    done = run(["build", "wall.toml", "-o", "wall.nc"], tmp_path)
+    assert done.returncode == 1 and "Traceback" not in done.stderr
+    assert re.search(r"LWPOLYLINE #\w+ on layer 0: open \(it starts at \(0, 0\) and ends at \(200, 100\)", done.stderr)
+    assert not (tmp_path / "wall.nc").exists()
+    doc = ezdxf.new()
+    doc.header["$INSUNITS"] = 4
+    for corners in ([(0, 0), (200, 0), (200, 100), (0, 100)], [(150, 0), (350, 0), (350, 100), (150, 100)],
+                    [(-50, -50), (400, -50), (400, 0), (-50, 0)]):
+        doc.modelspace().add_lwpolyline(corners, close=True)
+    doc.saveas(tmp_path / "wall.dxf")
+    done = run(["build", "wall.toml", "-o", "wall.nc"], tmp_path)
+    assert done.returncode == 1 and "Traceback" not in done.stderr
+    assert re.search(r"block 0 \(LWPOLYLINE #\w+ on layer 0\): overlaps block 1 \(LWPOLYLINE", done.stderr)
+    drawn = run(["plot", "wall.toml", "--kind", "model", "-o", "model.png"], tmp_path)
+    assert drawn.returncode == 0, drawn.stderr
+    assert (tmp_path / "model.png").stat().st_size > 10_000
