@@ -65,6 +65,7 @@ from .plugins import (
     solve,
     solver_version,
 )
+from .damage import DAMAGE_LIMITS, damage_category, distortion, support_profile, widest_opening
 from .progress import ProgressCallback, no_progress
 from .schema import FORMAT_VERSION, flags, load_schema, variable_attrs
 from .semantics import (

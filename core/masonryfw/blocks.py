@@ -17,8 +17,11 @@ and loads are made; the parametric builder, the import of drawings and
   loading: the weight acts horizontally as live load on every unit and lintel,
   and every support is held;
 - a moving support translates vertically (``block_fixed`` 1 0 1, direction
-  0 -1 0) or rotates about a pivot (free, direction of the small rotation that
-  moves its centroid down, as a unit vector).
+  0 -1 0), translates along a given direction (a greenfield trough's
+  segments: ``block_fixed`` 0 0 1) or rotates about a pivot (free, direction
+  of the small rotation that moves its centroid down, as a unit vector); its
+  direction is then scaled by its ``rate``: all moving supports move as
+  ``u_s = t * settlement_direction_s`` with one settlement parameter ``t``.
 """
 from __future__ import annotations
 
@@ -54,12 +57,19 @@ class Material:
 
 @dataclass(frozen=True)
 class Support:
-    """How one support block moves: ``kind`` fixed or moving; ``motion`` translation or rotation (about ``pivot``)."""
+    """How one support block moves: ``kind`` fixed or moving; ``motion`` translation or rotation (about ``pivot``).
+
+    A moving support moves ``rate`` times as fast as the settlement parameter;
+    ``translation`` (x, y) replaces the vertical unit translation (0, -1) before
+    the rate scales it (a greenfield trough's horizontal component).
+    """
 
     name: str
     kind: str = "fixed"
     motion: str = "none"
     pivot: tuple[float, float] | None = None
+    rate: float = 1.0
+    translation: tuple[float, float] | None = None
 
 
 def rotation_direction(centre, pivot) -> np.ndarray:
@@ -85,10 +95,13 @@ def support_kinematics(supports, centres, loading: str):
         roles[i] = role["moving_support"]
         if support.motion == "rotation":
             fixed[i] = 0
-            direction[i] = rotation_direction(centres[i], support.pivot)
+            direction[i] = support.rate * rotation_direction(centres[i], support.pivot)
+        elif support.translation is not None:
+            fixed[i] = (0, 0, 1)
+            direction[i] = (support.rate * support.translation[0], support.rate * support.translation[1], 0.0)
         else:
             fixed[i] = (1, 0, 1)
-            direction[i] = (0.0, -1.0, 0.0)
+            direction[i] = (0.0, -support.rate, 0.0)
     return fixed, direction, roles
 
 

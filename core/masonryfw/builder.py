@@ -24,7 +24,8 @@ Generation rules (the model is always in SI; ``length_unit`` only scales input):
   head joint on either side (e.g. a narrow pier between an opening and the
   wall end) stays as it is. Every block is a rectangle.
 * **Supports** are rectangular blocks one unit high under the wall, one per
-  support range.
+  support range, or one per segment of a ``[settlement]`` profile
+  (:mod:`masonryfw.profiles`: a greenfield trough, a tilt or measured rates).
 * **Interfaces, kinds and loads** as every model gets them (:mod:`masonryfw.blocks`):
   self-weight of units and lintels; settlement loading puts ``+R`` dead and
   ``-R`` live (vertical) on every moving support, ``R = W L_m / L_total`` from
@@ -43,6 +44,7 @@ from . import blocks
 from .errors import SpecError
 from .imported import build_drawn, is_drawn, parse_drawn_spec, resolved_drawing
 from .model import checked_model
+from .profiles import profile_segments, read_profile
 from .schema import flags
 from .spec import (
     LENGTH_UNITS,
@@ -104,6 +106,8 @@ class Support:
     end: float
     motion: str
     pivot: tuple[float, float] | None
+    rate: float = 1.0
+    translation: tuple[float, float] | None = None
 
 
 @dataclass(frozen=True)
@@ -135,9 +139,9 @@ class Wall:
 
 
 _TOP_KEYS = ("title", "description", "length_unit", "wall", "unit", "bond", "material",
-             "openings", "supports", "loading")
+             "openings", "supports", "settlement", "loading")
 _OPENING_KEYS = ("x", "y", "width", "height", "lintel_bearing")
-_SUPPORT_KEYS = ("kind", "start", "end", "motion", "pivot")
+_SUPPORT_KEYS = ("kind", "start", "end", "motion", "pivot", "rate")
 
 
 def parse_spec(spec: dict) -> Wall:
@@ -157,8 +161,10 @@ def parse_spec(spec: dict) -> Wall:
     bond = top.sub("bond", ("pattern", "first_course"), {})
 
     material = read_material(top)
-    supports = _supports(top, width)
-    kind, direction = read_loading(top, any(s.kind == "moving" for s in supports))
+    if top.has("settlement") and top.has("supports"):
+        raise SpecError("spec tables 'settlement' and 'supports': give one of them (the profile makes the supports)")
+    supports = () if top.has("settlement") else _supports(top, width)
+    kind, direction = read_loading(top, top.has("settlement") or any(s.kind == "moving" for s in supports))
 
     result = Wall(
         title=top.text("title"),
@@ -176,8 +182,24 @@ def parse_spec(spec: dict) -> Wall:
         loading=kind,
         tilt_direction=direction,
     )
-    openings = _openings(top, result)
-    return replace(result, openings=openings)
+    result = replace(result, openings=_openings(top, result))
+    if top.has("settlement"):
+        result = replace(result, supports=_profile_supports(top, result))
+    return result
+
+
+def _profile_supports(top: SpecTable, wall: Wall) -> tuple[Support, ...]:
+    """The support segments of the ``[settlement]`` profile under the wall's bottom course."""
+    profile = read_profile(top, wall.width)
+    x0, x1, y0, _, _ = masonry_blocks(wall)
+    bottom = y0 <= wall.tol
+    segments = profile_segments(profile, wall.width, np.c_[x0[bottom], x1[bottom]])
+    return tuple(
+        Support(f"segment {k} [{s.start:.6g}, {s.end:.6g}] m", "moving" if s.moving else "fixed", s.start, s.end,
+                "translation" if s.moving else "none", None, s.rate,
+                (s.horizontal / s.rate, -1.0) if s.moving and s.horizontal else None)
+        for k, s in enumerate(segments)
+    )
 
 
 def _whole_courses(value: float, unit_height: float, key: str, shown) -> int:
@@ -205,9 +227,9 @@ def _supports(top: SpecTable, width: float) -> tuple[Support, ...]:
             raise SpecError(f"spec key {entry.key('end')!r} = {entry.raw('end')!r}: beyond the wall's right end")
         if end <= start + tol:
             raise SpecError(f"spec key {entry.key('end')!r} = {entry.raw('end')!r}: must exceed start")
-        motion, pivot = read_motion(entry, kind)
+        motion, pivot, rate = read_motion(entry, kind)
         check_pivot(entry, pivot, 0.5 * (start + end), tol)
-        supports.append(Support(name, kind, min(start, width), min(end, width), motion, pivot))
+        supports.append(Support(name, kind, min(start, width), min(end, width), motion, pivot, rate))
     ordered = sorted(supports, key=lambda s: s.start)
     for left, right in zip(ordered, ordered[1:]):
         if right.start < left.end - tol:
@@ -375,6 +397,11 @@ def masonry_blocks(wall: Wall):
 # --------------------------------------------------------------------------- the dataset
 
 
+def _support_label(name: str) -> str:
+    """How errors name a support: its spec key, or the profile segment."""
+    return f"settlement {name}" if name.startswith("segment ") else f"spec key 'supports.{name}'"
+
+
 def build(spec, *, validate: bool = True) -> xr.Dataset:
     """Build the model dataset of a wall spec (a dict, a path, a Traversable or TOML text).
 
@@ -398,7 +425,8 @@ def build(spec, *, validate: bool = True) -> xr.Dataset:
     y0 = np.concatenate((my0, np.full(s_x0.size, -wall.unit_height)))
     y1 = np.concatenate((my1, np.zeros(s_x0.size)))
     role = np.concatenate((m_role, np.full(s_x0.size, flags("block_role")["fixed_support"], dtype=np.int8)))
-    supports = [blocks.Support(f"spec key 'supports.{s.name}'", s.kind, s.motion, s.pivot) for s in wall.supports]
+    supports = [blocks.Support(_support_label(s.name), s.kind, s.motion, s.pivot, s.rate, s.translation)
+                for s in wall.supports]
     material = wall.material
     attrs = {"title": wall.title, "source_spec": text}
     if wall.description:

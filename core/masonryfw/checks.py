@@ -41,7 +41,6 @@ from .geometry import (
 from .schema import FORMAT_VERSION, KINDS, READABLE_VERSIONS, load_schema
 
 RELATIVE_TOLERANCE = 1e-6  # lengths below this fraction of the model scale count as zero
-UNIT_VECTOR_TOLERANCE = 1e-6  # |settlement_direction| must be 1 within this
 
 
 @dataclass(frozen=True)
@@ -700,7 +699,7 @@ def _flag_meanings(variable: str) -> dict[int, str]:
 
 
 def _support_problems(ds, usable, model) -> list[Problem]:
-    """Settlement directions: non-zero unit vectors on moving supports, zero elsewhere."""
+    """Settlement directions: non-zero on moving supports (their length is the rate), zero elsewhere."""
     if not {"block_role", "settlement_direction"} <= usable:
         return []
     meaning = _flag_meanings("block_role")
@@ -727,11 +726,6 @@ def _support_problems(ds, usable, model) -> list[Problem]:
             f"block {b}",
             "moving support with settlement_direction 0 0 0: it cannot settle; "
             "set e.g. 0 -1 0 for a vertical settlement",
-            *where(b),
-        ))
-    for b in np.flatnonzero(moving & finite & (norm > 0) & (np.abs(norm - 1) > UNIT_VECTOR_TOLERANCE)):
-        problems.append(Problem(
-            f"block {b}", f"settlement_direction has length {norm[b]:.6g}, must be a unit vector; normalise it",
             *where(b),
         ))
     if "block_fixed" in usable:

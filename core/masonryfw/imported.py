@@ -50,7 +50,7 @@ _BLOCK = re.compile(r"\bblock (\d+)\b")
 SELECTIONS = ("lowest", "leftmost", "rightmost")
 _TOP_KEYS = ("title", "description", "length_unit", "geometry", "wall", "material", "supports", "loading")
 _GEOMETRY_KEYS = ("dxf", "polygons", "drawing_unit", "chord_tolerance", "snap_tolerance", "layers")
-_SUPPORT_KEYS = ("kind", "select", "layer", "at", "motion", "pivot")
+_SUPPORT_KEYS = ("kind", "select", "layer", "at", "motion", "pivot", "rate")
 _PARAMETRIC = {
     "unit": "the drawing gives the blocks",
     "bond": "the drawing gives the blocks",
@@ -68,6 +68,7 @@ class DrawnSupport:
     what: object  # the selection keyword, the layer name or the point (m)
     motion: str
     pivot: tuple[float, float] | None
+    rate: float
     table: SpecTable
 
 
@@ -174,8 +175,8 @@ def _drawn_supports(top: SpecTable, layers: dict[str, str]) -> tuple[DrawnSuppor
                                 f"{what!r} cannot be both a support and {layers[what]!r}")
         else:
             what = entry.point("at")
-        motion, pivot = read_motion(entry, kind)
-        supports.append(DrawnSupport(name, kind, how, what, motion, pivot, entry))
+        motion, pivot, rate = read_motion(entry, kind)
+        supports.append(DrawnSupport(name, kind, how, what, motion, pivot, rate, entry))
     return tuple(supports)
 
 
@@ -205,7 +206,7 @@ def build_drawn(spec_dict: dict, text: str, base_dir: Path | None, validate: boo
     order = np.concatenate((masonry, support_order))
     roles = np.array([role_flag["lintel"] if spec.layers.get(drawing.layers[b]) == "lintel" else role_flag["unit"]
                       for b in masonry] + [role_flag["fixed_support"]] * support_order.size, dtype=np.int8)
-    described = [blocks.Support(f"spec key 'supports.{s.name}'", s.kind, s.motion, s.pivot)
+    described = [blocks.Support(f"spec key 'supports.{s.name}'", s.kind, s.motion, s.pivot, s.rate)
                  for s, members in zip(spec.supports, chosen) for _ in members]
     node_x, node_y, counts = _reordered(drawing, order)
     _check_pivots(spec, chosen, drawing)

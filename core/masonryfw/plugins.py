@@ -34,6 +34,7 @@ from .io import CONVENTIONS, add_history, content_sha256
 from .model import checked_model
 from .progress import ProgressCallback, no_progress
 from .schema import FORMAT_VERSION, variable_attrs
+from .damage import DERIVED_STEP_VARIABLES, damage_variables
 from .semantics import DERIVED_RESULT_VARIABLES, FLOW_RULES, ROTATIONS, derived_variables, plastic_crack_indicator
 
 #: record kind -> (hook name, record type)
@@ -335,7 +336,13 @@ def solver_version(name: str) -> str:
 
 
 def _derive_comparable_fields(name: str, model: xr.Dataset, produced: xr.Dataset) -> xr.Dataset:
-    """``produced`` with the fields :mod:`.semantics` derives from its ``block_displacement`` or ``qp_failure``."""
+    """``produced`` with the fields :mod:`.semantics` derives from its ``block_displacement`` or ``qp_failure``
+    and those :mod:`.damage` derives from its history."""
+    derived_too = sorted(map(str, set(produced.data_vars) & set(DERIVED_STEP_VARIABLES)))
+    if derived_too:
+        raise SolveError(f"solver {name} returned {', '.join(derived_too)}; the core derives them from "
+                         "step_crack_width_max and step_settlement (docs/format.md): return only those")
+    produced = produced.assign(damage_variables(model, produced))
     primary = "block_displacement" if "block_displacement" in produced else "qp_failure"
     if primary not in produced:
         return produced

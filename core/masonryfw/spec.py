@@ -169,19 +169,24 @@ def read_loading(top: SpecTable, any_moving: bool) -> tuple[str, int]:
     return kind, 0
 
 
-def read_motion(entry: SpecTable, kind: str) -> tuple[str, tuple[float, float] | None]:
-    """``(motion, pivot)`` of a support table: ``none`` for a fixed support."""
+def read_motion(entry: SpecTable, kind: str) -> tuple[str, tuple[float, float] | None, float]:
+    """``(motion, pivot, rate)`` of a support table: ``none`` for a fixed support.
+
+    ``rate`` (default 1) scales the support's motion per unit of the settlement
+    parameter: a support at rate 0.5 settles half as fast as one at rate 1.
+    """
     if kind != "moving":
-        if entry.has("motion") or entry.has("pivot"):
-            bad = "motion" if entry.has("motion") else "pivot"
-            raise SpecError(f"spec key {entry.key(bad)!r} only applies to kind = 'moving'")
-        return "none", None
+        for bad in ("motion", "pivot", "rate"):
+            if entry.has(bad):
+                raise SpecError(f"spec key {entry.key(bad)!r} only applies to kind = 'moving'")
+        return "none", None, 0.0
     motion = entry.choice("motion", ("translation", "rotation"), "translation")
+    rate = entry.number("rate", 1.0, positive=True)
     if motion == "rotation":
-        return motion, entry.point("pivot")
+        return motion, entry.point("pivot"), rate
     if entry.has("pivot"):
         raise SpecError(f"spec key {entry.key('pivot')!r} only applies to motion = 'rotation'")
-    return motion, None
+    return motion, None, rate
 
 
 def check_pivot(entry: SpecTable, pivot: tuple[float, float] | None, centre_x: float, tol: float) -> None:

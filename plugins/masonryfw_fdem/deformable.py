@@ -459,7 +459,10 @@ def advance(n_steps, dt, x, y, vel, x0, y0, x_detect, y_detect, offs, node_block
     reaction = 0.0
     kinetic = 0.0
     unbalanced = 0.0
+    out[6:] = 0.0
     for k in range(n_node):
+        if driven[k]:
+            out[6 + node_block[k]] -= force[k, 1]
         if moving[node_block[k]]:
             reaction -= force[k, 1]
         if not driven[k]:

@@ -391,7 +391,8 @@ def advance(n_steps, dt, pos, vel, pos0, pos_detect, radius, lx, ly, offs, faces
 
     ``out`` receives: steps done, rebuild needed (0/1), reaction on the moving
     supports (upward force on the wall), kinetic energy, stored energy,
-    unbalanced-force ratio. Returns nothing; ``acc`` carries the accumulators.
+    unbalanced-force ratio, then per block the upward force of a support block
+    on the wall (0 for the others). Returns nothing; ``acc`` carries the accumulators.
     """
     n_block = pos.shape[0]
     force = np.zeros((n_block, 3))
@@ -481,6 +482,7 @@ def advance(n_steps, dt, pos, vel, pos0, pos_detect, radius, lx, ly, offs, faces
     kinetic = 0.0
     unbalanced = 0.0
     for i in range(n_block):
+        out[6 + i] = -force[i, 1] if driven[i] else 0.0
         if moving[i]:
             reaction -= force[i, 1]
         if not driven[i]:

@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import copy
 import logging
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -34,6 +35,7 @@ GRAVITY_PHASE, SETTLEMENT_PHASE, SEARCH_PHASE = 0, 1, 2
 # the whole wall falling a thousand times its own size. Beyond it the integration has blown up.
 UNSTABLE_KINETIC_ENERGY = 1e3
 GRAVITY_TIME_LIMIT = 20.0  # scaled time units (sqrt(length / g)) for the gravity phase to come to rest
+OUT_SCALARS = 6  # the kernels' ``out``: six scalars, then one support force per block
 
 
 @dataclass(frozen=True)
@@ -74,21 +76,32 @@ class Controls:
 
 @dataclass
 class History:
-    """One row per recorded chunk."""
+    """One row per recorded chunk: the scalars, the support forces and the widest joint opening.
+
+    ``opening`` measures the widest masonry-joint opening [m] of block positions
+    (set by the solver; None: not measured).
+    """
 
     rows: list = field(default_factory=list)
+    supports: list = field(default_factory=list)  # (block,) upward force of each support on the wall
+    widest: list = field(default_factory=list)  # widest masonry-joint opening [m]
     snapshots: list = field(default_factory=list)  # (settlement, positions)
+    opening: Callable[[np.ndarray], float] | None = None
 
     COLUMNS = ("phase", "time", "settlement", "reaction", "kinetic", "stored", "work_gravity",
                "work_support", "dissipated_damping", "dissipated_friction", "released", "unbalanced", "load_factor")
 
-    def add(self, phase: int, acc: np.ndarray, out: np.ndarray, load_factor: float = 0.0) -> None:
+    def add(self, phase: int, state: State, out: np.ndarray, load_factor: float = 0.0) -> None:
+        acc = state.acc
         self.rows.append((
             phase, acc[kernels.TIME], acc[kernels.SETTLEMENT], out[2], out[3], out[4],
             acc[kernels.WORK_GRAVITY], acc[kernels.WORK_SUPPORT],
             acc[kernels.DISSIPATED_DAMPING], acc[kernels.DISSIPATED_FRICTION], acc[kernels.RELEASED], out[5],
             load_factor,
         ))
+        self.supports.append(out[OUT_SCALARS:].copy())
+        if self.opening is not None:
+            self.widest.append(self.opening(state.pos))
 
     def table(self) -> dict[str, np.ndarray]:
         data = np.asarray(self.rows, dtype=float).reshape(-1, len(self.COLUMNS))
@@ -180,7 +193,7 @@ def advance(scene: Scene, controls: Controls, state: State, n_steps: int, rate: 
 
 def chunk(scene: Scene, controls: Controls, state: State, n_steps: int, rate: float, target: float) -> np.ndarray:
     """Run up to ``n_steps`` steps (rebuilding the pair list as needed); returns the kernel's ``out``."""
-    out = np.zeros(6)
+    out = np.zeros(OUT_SCALARS + scene.driven.size)
     left = n_steps
     while True:
         nodal = hasattr(state, "advance_chunk")  # deformable mode: the state steps its own nodes
@@ -218,7 +231,7 @@ def gravity_phase(scene, controls, state, history, progress) -> None:
         before = state.steps
         out = chunk(scene, controls, state, n, 0.0, 0.0)
         state.gravity_steps += state.steps - before
-        history.add(GRAVITY_PHASE, state.acc, out)
+        history.add(GRAVITY_PHASE, state, out)
         ramped = state.acc[kernels.TIME] >= controls.load_ramp
         if controls.gravity_time <= 0 and ramped and out[5] < controls.rest_tolerance:
             state.stop_reason = "at rest"
@@ -229,7 +242,7 @@ def gravity_phase(scene, controls, state, history, progress) -> None:
         if controls.gravity_time <= 0:
             raise mf.SolveError(
                 f"fdem: the wall did not come to rest under its loads within {state.gravity_steps} steps "
-                f"(unbalanced force ratio {history.rows[-1][-1]:.2e} > rest_tolerance "
+                f"(unbalanced force ratio {history.table()['unbalanced'][-1]:.2e} > rest_tolerance "
                 f"{controls.rest_tolerance:g}): it is not stable as built, or the integration is "
                 "(lower dt_safety); set gravity_time to run a fixed time instead"
             )
@@ -265,7 +278,7 @@ def settlement_phase(scene, controls, state, history, progress) -> None:
             LOG.warning("fdem: settlement phase hit the step limit (%d)", controls.max_steps)
             return
         out = chunk(scene, controls, state, controls.record_steps, controls.rate, controls.target)
-        history.add(SETTLEMENT_PHASE, state.acc, out)
+        history.add(SETTLEMENT_PHASE, state, out)
         settled = state.acc[kernels.SETTLEMENT]
         while pending and settled >= pending[0]:
             pending.pop(0)
@@ -294,7 +307,7 @@ def hold(scene: Scene, controls: Controls, state: State, reference: np.ndarray, 
     limit = ramp_end + controls.search_trial_time
     while True:
         out = chunk(scene, controls, state, controls.record_steps, 0.0, 0.0)
-        history.add(SEARCH_PHASE, state.acc, out, load_factor)
+        history.add(SEARCH_PHASE, state, out, load_factor)
         motion = largest_motion(scene, state.pos, reference)
         if motion > controls.collapse_motion:
             return False, motion
@@ -355,13 +368,15 @@ def _bisect(scene, controls, state, history, progress):
     return lower, upper, unstable
 
 
-def run(scene: Scene, controls: Controls, state: State, load: np.ndarray, progress) -> History:
-    """Gravity, then settlement, from ``state`` (rigid or deformable); returns the history.
+def run(scene: Scene, controls: Controls, state: State, load: np.ndarray, progress,
+        opening: Callable[[np.ndarray], float] | None = None) -> History:
+    """Gravity, then settlement, from ``state`` (rigid or deformable); returns the history
+    (``opening``: :attr:`History.opening`).
 
     A KeyboardInterrupt keeps what was computed (``state.interrupted``, the state
     reached evaluated as a last record); one before the first record propagates.
     """
-    history = History()
+    history = History(opening=opening)
     state.set_loads(scene, load)
     try:
         gravity_phase(scene, controls, state, history, progress)
@@ -376,5 +391,5 @@ def run(scene: Scene, controls: Controls, state: State, load: np.ndarray, progre
         state.stop_reason = "interrupted"
         out = chunk(scene, controls, state, 0, 0.0, 0.0)  # evaluate the state reached
         phase = SEARCH_PHASE if state.trials else SETTLEMENT_PHASE if state.settlement_start > 0 else GRAVITY_PHASE
-        history.add(phase, state.acc, out, state.collapse_bracket[0] if state.collapse_bracket else 0.0)
+        history.add(phase, state, out, state.collapse_bracket[0] if state.collapse_bracket else 0.0)
     return history

@@ -128,7 +128,7 @@ def _solve(model: xr.Dataset, options: Mapping[str, Any], progress) -> xr.Datase
              options["dt_safety"], controls.kn * scene.scales.force / scene.scales.length**2)
     progress(0.0, f"fdem: dt = {controls.dt * scene.scales.time:.3g} s "
                   f"(dt_crit = {controls.dt_critical * scene.scales.time:.3g} s)")
-    history = run(scene, controls, state, load, progress)
+    history = run(scene, controls, state, load, progress, opening_meter(scene))
     result = result_dataset(scene, state, history)
     result.attrs.update(
         stop_reason=state.stop_reason,
@@ -151,6 +151,13 @@ def _solve(model: xr.Dataset, options: Mapping[str, Any], progress) -> xr.Datase
     return result
 
 
+def opening_meter(scene: Scene):
+    """The widest masonry-joint opening [m] of block positions (``mf.widest_opening``, finite rotations)."""
+    def widest(pos: np.ndarray) -> float:
+        return mf.widest_opening(scene.model, postprocess.block_displacement(scene, pos), "finite")
+    return widest
+
+
 def history_variables(scene: Scene, history: History) -> dict:
     rows = history.table()
     f, length = scene.scales.force, scene.scales.length
@@ -169,6 +176,10 @@ def history_variables(scene: Scene, history: History) -> dict:
     settling = {
         "step_settlement": ("step", rows["settlement"] * length, mf.variable_attrs("step_settlement")),
         "step_reaction": ("step", rows["reaction"] * f, mf.variable_attrs("step_reaction")),
+        "step_support_reaction": (("step", "block"), np.array(history.supports).reshape(len(history.rows), -1) * f,
+                                  mf.variable_attrs("step_support_reaction")),
+        "step_crack_width_max": ("step", np.asarray(history.widest, dtype=float),
+                                 mf.variable_attrs("step_crack_width_max")),
     } if scene.moving.any() else {
         "step_load_factor": var(rows["load_factor"], "1", "multiplier of the live load (tried) at the record"),
     }

@@ -263,7 +263,8 @@ def support_edges(domain: Domain, field: StaticField, model: xr.Dataset) -> tupl
 
 
 def check_vertical_settlement(model: xr.Dataset) -> None:
-    """The LP's objective is the vertical reaction: every moving support must translate straight down."""
+    """The LP's objective is the vertical reaction: every moving support must translate straight down, all
+    at one rate (a trough's segments at their own rates need the incremental solver)."""
     moving = np.nonzero(model.block_role.values == ROLE["moving_support"])[0]
     direction = model.settlement_direction.values[moving]
     bad = moving[~(np.isclose(direction[:, 0], 0) & np.isclose(direction[:, 2], 0) & (direction[:, 1] < 0))]
@@ -271,7 +272,15 @@ def check_vertical_settlement(model: xr.Dataset) -> None:
         raise mf.ModelError(
             f"jmm-limit: moving support block {int(bad[0])} has settlement_direction "
             f"{model.settlement_direction.values[bad[0]].tolist()}; the limit LP needs a downward vertical "
-            "translation (0, -1, 0) (use the solver jmm for rotations)"
+            "translation (0, -1, 0) (use the solver jmm for rotations and horizontal ground motion)"
+        )
+    rates = -direction[:, 1]
+    if moving.size and not np.allclose(rates, rates[0], rtol=1e-9):
+        other = moving[int(np.argmax(~np.isclose(rates, rates[0], rtol=1e-9)))]
+        raise mf.ModelError(
+            f"jmm-limit: moving support blocks {int(moving[0])} and {int(other)} settle at different rates "
+            f"({rates[0]:.6g} and {-model.settlement_direction.values[other, 1]:.6g}); the limit LP minimises one "
+            "vertical reaction, so every moving support must settle at one rate (use the solver jmm for a profile)"
         )
 
 

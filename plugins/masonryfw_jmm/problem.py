@@ -38,6 +38,8 @@ class Problem:
     moving: np.ndarray  # prescribed DOFs that move with the support
     moving_direction: np.ndarray  # (moving,) displacement of each moving DOF per unit settlement
     moving_vertical: np.ndarray  # bool (moving,): uy DOFs (their reactions sum to the vertical reaction)
+    support_uy: np.ndarray  # vertical DOFs of every support (fixed and moving)
+    support_of: np.ndarray  # (support_uy,) the support block each belongs to
     length: float  # H [m]
     mesh_size: float  # [m]
     stress: float  # S [Pa]
@@ -52,6 +54,7 @@ class Problem:
     from_bed: np.ndarray | None = None  # the inverse rotations
     face_bounds: np.ndarray | None = None  # (faces, masonry points) b per point (no head faces without head joints)
     searches_load: bool = False  # no moving support: the live load's factor grows instead of a settlement
+    n_block: int = 0  # blocks of the model (the per-support reactions are per block)
 
     @property
     def free(self) -> np.ndarray:
@@ -183,16 +186,19 @@ def support_facets(points: np.ndarray, ends: np.ndarray, segments: np.ndarray, t
 
 def _support_dofs(mesh: WallMesh, disc: Discretisation, model: xr.Dataset, length: float, tol: float):
     """Fixed DOFs, moving DOFs and their motion per unit settlement, from the support segments (the masonry
-    on its supports); the moving arrays are empty when no support moves."""
+    on its supports); the moving arrays are empty when no support moves. Last, the vertical prescribed DOFs
+    and the support block each belongs to (a node two supports share goes to the fixed one)."""
     m = disc.mesh
     boundary = m.boundary_facets()
     on = support_facets(m.p, m.facets[:, boundary], mesh.supports / length, tol)
     locs = disc.basis.doflocs
     block = np.where(on >= 0, mesh.support_block[np.maximum(on, 0)], -1)
-    fixed, moving, direction = [], [], []
+    fixed, moving, direction, vertical = [], [], [], []
     for support in np.unique(block[block >= 0]):  # a handful of supports
         dofs = disc.facet_dofs(boundary[block == support])
-        if model.block_role.values[support] == ROLE["fixed_support"]:
+        is_fixed = model.block_role.values[support] == ROLE["fixed_support"]
+        vertical.append((not is_fixed, 2 * dofs + 1, np.full(dofs.size, support)))
+        if is_fixed:
             fixed.append(np.concatenate([2 * dofs, 2 * dofs + 1]))
             continue
         d = model.settlement_direction.values[support]
@@ -204,14 +210,17 @@ def _support_dofs(mesh: WallMesh, disc: Discretisation, model: xr.Dataset, lengt
     if not fixed and not moving:
         raise mf.ModelError("jmm: no mesh edge lies on a support interface: the wall stands on nothing")
     fixed = np.unique(np.concatenate(fixed)) if fixed else np.zeros(0, int)
+    vertical.sort(key=lambda entry: entry[0])  # fixed supports first: they keep shared nodes
+    uy, first = np.unique(np.concatenate([dofs for _, dofs, _ in vertical]), return_index=True)
+    owner = np.concatenate([owners for _, _, owners in vertical])[first]
     if not moving:
-        return fixed, np.zeros(0, int), np.zeros(0)
+        return fixed, np.zeros(0, int), np.zeros(0), uy, owner
     moving = np.concatenate(moving)
     direction = np.concatenate(direction)
     keep = ~np.isin(moving, fixed)  # a node shared with a fixed support stays fixed
     moving, direction = moving[keep], direction[keep]
     moving, first = np.unique(moving, return_index=True)
-    return fixed, moving, direction[first]
+    return fixed, moving, direction[first], uy, owner
 
 
 def _elastic_matrices(young: np.ndarray, poisson: np.ndarray, hypothesis: str) -> np.ndarray:
@@ -317,7 +326,7 @@ def build_problem(model: xr.Dataset, options) -> Problem:
                      elastic_matrix(young / G, poisson, options["hypothesis"]))
     body = np.stack([np.zeros(blocks.size), -gamma / domain.unit_weight], axis=1)
     gravity = disc.body_force(body)
-    fixed, moving, direction = _support_dofs(mesh, disc, model, H, 1e-6 * size / H)
+    fixed, moving, direction, support_uy, support_of = _support_dofs(mesh, disc, model, H, 1e-6 * size / H)
     searches_load = moving.size == 0
     if searches_load and not np.any(mf.block_loads(model, "live")[masonry(model)]):
         raise mf.ModelError("jmm: no moving support to settle and no live load to raise: nothing to analyse")
@@ -327,7 +336,8 @@ def build_problem(model: xr.Dataset, options) -> Problem:
     return Problem(
         mesh=mesh, disc=disc, return_map=rmap, masonry_points=masonry_points, D_points=D_points,
         gravity=gravity, fixed=fixed, moving=moving, moving_direction=direction,
-        moving_vertical=moving % 2 == 1, length=H, mesh_size=size, stress=S, displacement=U, force=domain.force,
+        moving_vertical=moving % 2 == 1, support_uy=support_uy, support_of=support_of, length=H, mesh_size=size, stress=S, displacement=U, force=domain.force,
         beta=domain.beta, young=young, poisson=poisson, strength=domain.strength, live=live, to_bed=to_bed,
         from_bed=from_bed, face_bounds=face_bounds, searches_load=searches_load,
+        n_block=model.sizes["block"],
     )

@@ -31,10 +31,16 @@ class History:
     iterations: list = field(default_factory=list)
     plastic_points: list = field(default_factory=list)
     residuals: list = field(default_factory=list)
+    supports: list = field(default_factory=list)  # (block,) upward force of each support on the wall
+    crack_width: list = field(default_factory=list)  # crack band estimate (non-dimensional, as u)
 
     def add(self, newton: NewtonSolver, state: State, settlement: float, load_factor: float, iterations: int) -> None:
+        p = newton.problem
         self.settlement.append(settlement)
         self.reaction.append(newton.reaction(state))
+        self.supports.append(np.bincount(p.support_of, weights=state.residual[p.support_uy],
+                                         minlength=p.n_block))
+        self.crack_width.append(crack_band_width(p, state))
         self.load_factor.append(load_factor)
         self.displacement.append(float(np.hypot(state.u[0::2], state.u[1::2]).max(initial=0.0)))
         self.iterations.append(iterations)
@@ -44,6 +50,24 @@ class History:
     def steps(self) -> int:
         """Steps after the gravity stage."""
         return len(self.iterations) - 1
+
+
+def crack_band_width(problem: Problem, state: State) -> float:
+    """Widest crack estimated from the plastic strain (non-dimensional, in the units of ``u``).
+
+    The smeared crack band (Bazant & Oh 1983): a crack that localises in one row of
+    cells of size h opens by the plastic strain across it times h. At every masonry
+    point the plastic strain ``strain - D^-1 stress`` is turned into the bed frame
+    and its normal components, across the bed (yy) and across the head joints (xx),
+    times the mesh size give the opening there; the widest over the points is returned.
+    """
+    p = problem
+    plastic = state.strain - np.linalg.solve(p.D_points, state.stress[..., None])[..., 0]
+    plastic = plastic[p.masonry_points]
+    if p.from_bed is not None:  # engineering strains turn with the inverse transpose of the stress rotation
+        plastic = np.einsum("pji,pj->pi", p.from_bed, plastic)
+    opening = np.maximum(plastic[:, :2], 0.0).max(initial=0.0)
+    return float(opening * p.mesh_size / p.length)
 
 
 GRAVITY_ITERATIONS = 4  # times max_iterations: with c = sigma_t = 0 the domain is a cone, so smaller
@@ -240,7 +264,13 @@ def result_dataset(problem: Problem, state: State, history: History, info: dict)
         **(load_factor_variables(history, U) if p.searches_load else {
             "step_settlement": variable("step", np.asarray(history.settlement) * U, "m", "imposed settlement"),
             "step_reaction": variable("step", np.asarray(history.reaction) * p.force, "N",
-                                      "vertical reaction on the moving support"),
+                                      "vertical reaction on the moving supports (their sum)"),
+            "step_support_reaction": variable(("step", "block"), np.array(history.supports) * p.force, "N",
+                                              mf.variable_attrs("step_support_reaction")["long_name"]),
+            "step_crack_width_max": variable(
+                "step", np.asarray(history.crack_width) * U, "m",
+                "widest crack estimated as the plastic opening strain across the joints times the mesh size "
+                "(a smeared crack band, Bazant & Oh 1983)"),
         }),
         "step_newton_iterations": variable("step", np.asarray(history.iterations, dtype=np.int32), "1",
                                        "Newton iterations of the step (step 0: the whole gravity stage)"),

@@ -1,0 +1,100 @@
+"""What a settlement does to a wall, one definition for every solver: crack widths, damage
+categories and the distortion of the imposed settlement profile.
+
+- **crack width** of a state: the widest opening of a masonry joint (an interface
+  with a masonry side: the joints between blocks and the wall's bed on its
+  supports, as for ``crack_indicator``), from the block motions
+  (:func:`masonryfw.relative_motion`). Solvers report it per recorded step as
+  ``step_crack_width_max``;
+- **damage category** (``step_damage_category``, derived by the core): Burland et
+  al. (1977) and Boscardin & Cording (1989), by the crack width, upper limits
+  inclusive: 0 negligible (<= 0.1 mm), 1 very slight (<= 1 mm), 2 slight
+  (<= 5 mm), 3 moderate (<= 15 mm), 4 severe (<= 25 mm), 5 very severe;
+- **imposed profile**: the vertical motion of every support at the midpoint of
+  the masonry resting on it (0 for fixed supports), per unit of the settlement
+  parameter; with the supports sorted by that midpoint, the **deflection ratio**
+  is the largest distance of the profile from the chord joining its first and
+  last points over the chord's length, positive where the profile sags below the
+  chord, negative where it hogs above it (Burland & Wroth 1974, over the whole
+  wall rather than per sagging or hogging zone); the **angular distortion** is
+  the largest slope between neighbouring points once the chord's tilt is
+  removed. Both grow linearly with the settlement parameter
+  (``step_deflection_ratio``, ``step_angular_distortion``).
+"""
+from __future__ import annotations
+
+import numpy as np
+import xarray as xr
+
+from .schema import flags, variable_attrs
+from .semantics import masonry_joints, relative_motion, support_blocks
+
+#: Upper crack widths [m] of damage categories 0 to 4 (category 5 beyond the last).
+DAMAGE_LIMITS = (1.0e-4, 1.0e-3, 5.0e-3, 15.0e-3, 25.0e-3)
+#: Variables the core derives from a result's history (a solver must not return them).
+DERIVED_STEP_VARIABLES = ("step_damage_category", "step_deflection_ratio", "step_angular_distortion")
+
+
+def damage_category(width) -> np.ndarray:
+    """int8 damage category 0..5 of crack widths [m] (module docstring)."""
+    return np.searchsorted(np.array(DAMAGE_LIMITS), np.asarray(width, dtype=float), side="left").astype(np.int8)
+
+
+def widest_opening(model: xr.Dataset, u: np.ndarray, rotations: str = "finite") -> float:
+    """Widest masonry-joint opening [m] under block motions ``u`` (block, 3)."""
+    opening, _ = relative_motion(model, u, rotations)
+    masonry = masonry_joints(model.block_role.values, model.interface_blocks.values)
+    return float(np.maximum(opening[masonry], 0.0).max(initial=0.0))
+
+
+def support_profile(model: xr.Dataset) -> tuple[np.ndarray, np.ndarray]:
+    """``(x, v)``: every support's contact midpoint with the masonry [m] and its vertical motion there
+    per unit settlement parameter (the small-rotation motion of a rotating support), sorted by x."""
+    sides = model.interface_blocks.values.astype(np.int64)
+    ground = support_blocks(model.block_role.values)
+    touching = ground[sides].any(axis=1) & ~ground[sides].all(axis=1)
+    support = np.where(ground[sides[:, 0]], sides[:, 0], sides[:, 1])[touching]
+    length = model.interface_length.values[touching]
+    mid = model.interface_x.values[touching].mean(axis=1)
+    n = model.sizes["block"]
+    contact = np.bincount(support, weights=length, minlength=n)
+    which = np.flatnonzero(contact > 0)
+    x = np.bincount(support, weights=length * mid, minlength=n)[which] / contact[which]
+    d = model.settlement_direction.values[which]
+    v = d[:, 1] + d[:, 2] * (x - model.block_centroid_x.values[which])
+    order = np.argsort(x, kind="stable")
+    return x[order], v[order]
+
+
+def distortion(x: np.ndarray, v: np.ndarray) -> tuple[float, float]:
+    """``(deflection ratio, angular distortion)`` of a profile ``v(x)`` (module docstring)."""
+    if x.size < 2 or not x[-1] > x[0]:
+        return 0.0, 0.0
+    span = x[-1] - x[0]
+    tilt = (v[-1] - v[0]) / span
+    offset = v[0] + tilt * (x - x[0]) - v  # > 0 where the profile sags below the chord
+    largest = int(np.argmax(np.abs(offset)))
+    step = np.diff(x)
+    moving = step > 0
+    slopes = np.diff(v)[moving] / step[moving]
+    return float(offset[largest] / span), float(np.abs(slopes - tilt).max(initial=0.0))
+
+
+def damage_variables(model: xr.Dataset, produced: xr.Dataset) -> dict[str, tuple]:
+    """The damage variables the core derives from a solver's history: the category of every
+    ``step_crack_width_max`` and the distortion of the imposed profile at every ``step_settlement``."""
+    derived: dict[str, tuple] = {}
+    if "step_crack_width_max" in produced:
+        derived["step_damage_category"] = ("step", damage_category(produced.step_crack_width_max.values),
+                                           variable_attrs("step_damage_category"))
+    if "step_settlement" in produced:
+        ratio, angle = distortion(*support_profile(model))
+        settlement = np.asarray(produced.step_settlement.values, dtype=float)
+        derived["step_deflection_ratio"] = ("step", ratio * settlement, variable_attrs("step_deflection_ratio"))
+        derived["step_angular_distortion"] = ("step", angle * settlement, variable_attrs("step_angular_distortion"))
+    return derived
+
+
+def category_names() -> dict[int, str]:
+    """``{0: "negligible", ...}``: the flag meanings of ``step_damage_category``."""
+    return {value: name for name, value in flags("step_damage_category").items()}
