@@ -55,6 +55,8 @@ _PARAMETRIC = {
     "unit": "the drawing gives the blocks",
     "bond": "the drawing gives the blocks",
     "openings": "openings are drawn (left empty) in the drawing",
+    "settlement": "its supports are drawn: give each moving support its rate, or cut the drawn base into "
+                  "segments with the rates of the profile",
 }
 
 

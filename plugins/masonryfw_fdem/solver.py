@@ -112,6 +112,13 @@ def solve(model: xr.Dataset, options: Mapping[str, Any], progress=mf.no_progress
 
 def _solve(model: xr.Dataset, options: Mapping[str, Any], progress) -> xr.Dataset:
     scene = build_scene(model)
+    if scene.moving.any() and scene.moving.sum() == scene.driven.sum() and options["plateau_tolerance"] > 0:
+        raise mf.ModelError(
+            "fdem: every support of the wall settles, so together they carry its whole weight at any "
+            "settlement and the reaction plateau that stops the run is there from the start; set the option "
+            "plateau_tolerance=0 to run to the target settlement, or keep part of the base fixed "
+            "(a [settlement] profile: raise settlement.cutoff)"
+        )
     controls = make_controls(scene, options)
     load = scene.dead + (options["load_factor"] or 0.0) * scene.live
     if options["mode"] == "deformable":

@@ -328,6 +328,12 @@ def build_problem(model: xr.Dataset, options) -> Problem:
     gravity = disc.body_force(body)
     fixed, moving, direction, support_uy, support_of = _support_dofs(mesh, disc, model, H, 1e-6 * size / H)
     searches_load = moving.size == 0
+    if not searches_load and fixed.size == 0:
+        raise mf.ModelError(
+            "jmm: every support of the wall settles, so together they carry its whole weight at any "
+            "settlement and the reaction that sizes the steps and stops the run never drops; keep part of "
+            "the base fixed (a [settlement] profile: raise settlement.cutoff)"
+        )
     if searches_load and not np.any(mf.block_loads(model, "live")[masonry(model)]):
         raise mf.ModelError("jmm: no moving support to settle and no live load to raise: nothing to analyse")
     live = disc.body_force(live_body_force(model, blocks, domain.unit_weight))

@@ -1,0 +1,148 @@
+"""Settlement profiles and damage (issue 14): the spec keys, the supports they make, the damage scale."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import masonryfw as mf
+
+ROLE = mf.flags("block_role")
+BASE = {
+    "title": "long wall", "length_unit": "m",
+    "wall": {"width": 4.0, "height": 1.2, "thickness": 0.1},
+    "unit": {"length": 0.4, "height": 0.1},
+    "material": {"unit_weight": 12000.0, "friction_angle": 30.0},
+    "loading": {"type": "settlement"},
+}
+TROUGH = {"profile": "gaussian", "center": 1.0, "width": 0.3, "segment": 0.1, "cutoff": 0.05, "depth": 10.0}
+
+
+def moving_supports(model):
+    moving = np.flatnonzero(model.block_role.values == ROLE["moving_support"])
+    x0 = np.array([model.node_x.values[4 * b] for b in moving])
+    return moving, x0
+
+
+def test_gaussian_trough_segments_follow_peck_and_oreilly_new():
+    """The issue's example: every moving segment's direction is (h, -S(x_mid), 0) with
+    S = exp(-(x_mid - x0)^2 / (2 i^2)) and h = (x_mid - x0) / z0 times the vertical one; the segments
+    whose rate is below the cutoff are fixed and merge into one block on each side."""
+    model = mf.build({**BASE, "settlement": TROUGH})
+    role = model.block_role.values
+    supports = np.flatnonzero(np.isin(role, [ROLE["fixed_support"], ROLE["moving_support"]]))
+    cx = model.block_centroid_x.values[supports]
+    direction = model.settlement_direction.values[supports]
+    moving = role[supports] == ROLE["moving_support"]
+    rate = np.exp(-0.5 * ((cx - 1.0) / 0.3) ** 2)
+    assert np.all(rate[moving] > 0.05) and np.all(rate[~moving] <= 0.05 + 1e-12)
+    np.testing.assert_allclose(direction[moving, 1], -rate[moving], rtol=1e-12)
+    np.testing.assert_allclose(direction[moving, 0], (cx[moving] - 1.0) / 10.0 * -rate[moving], rtol=1e-12)
+    assert moving.sum() == 14  # x_mid 0.35 .. 1.65: |x_mid - 1| <= 0.3 sqrt(2 ln 20) = 0.735
+    assert (~moving).sum() == 2  # [0, 0.3] and [1.7, 4] each merged
+    np.testing.assert_array_equal(model.block_fixed.values[supports[moving]], [[0, 0, 1]] * 14)
+    # the paper's loading per support: the uniform share of the weight, up (dead) and down (live)
+    weight = -mf.block_loads(model, "dead")[mf.masonry_blocks(role), 1].sum()
+    np.testing.assert_allclose(mf.block_loads(model, "dead")[supports[moving], 1], weight * 0.1 / 4.0)
+    np.testing.assert_allclose(mf.block_loads(model, "live")[supports[moving], 1], -weight * 0.1 / 4.0)
+
+
+def test_profile_lengths_in_millimetres_give_the_metre_model():
+    in_mm = {**BASE, "length_unit": "mm", "wall": {"width": 4000.0, "height": 1200.0, "thickness": 100.0},
+             "unit": {"length": 400.0, "height": 100.0},
+             "settlement": {**TROUGH, "center": 1000.0, "width": 300.0, "segment": 100.0, "depth": 10000.0}}
+    a, b = mf.build({**BASE, "settlement": TROUGH}), mf.build(in_mm)
+    np.testing.assert_allclose(b.settlement_direction.values, a.settlement_direction.values, atol=1e-12)
+    np.testing.assert_allclose(b.node_x.values, a.node_x.values, atol=1e-12)
+
+
+def test_linear_and_table_profiles():
+    tilt = mf.build({**BASE, "settlement": {"profile": "linear", "segment": 1.0}})
+    moving = tilt.block_role.values == ROLE["moving_support"]
+    np.testing.assert_allclose(-tilt.settlement_direction.values[moving, 1], [0.125, 0.375, 0.625, 0.875])
+    table = mf.build({**BASE, "settlement": {"profile": "table", "segment": 1.0, "points": [[1.0, 0.0], [3.0, 1.0]]}})
+    moving = table.block_role.values == ROLE["moving_support"]
+    np.testing.assert_allclose(-table.settlement_direction.values[moving, 1], [0.25, 0.75, 1.0])
+
+
+def test_rate_of_a_support_range_scales_its_direction():
+    spec = {**BASE, "supports": {"fixed": {"kind": "fixed", "start": 0.0, "end": 2.0},
+                                 "slow": {"kind": "moving", "start": 2.0, "end": 4.0, "rate": 0.5}}}
+    model = mf.build(spec)
+    moving = model.block_role.values == ROLE["moving_support"]
+    np.testing.assert_array_equal(model.settlement_direction.values[moving], [[0.0, -0.5, 0.0]])
+
+
+def test_a_door_at_the_base_leaves_no_support_segment_under_it():
+    spec = {**BASE, "openings": [{"x": 1.6, "y": 0.0, "width": 0.8, "height": 0.6, "lintel_bearing": 0.4}],
+            "settlement": {**TROUGH, "center": 2.0, "width": 1.0, "segment": 0.4}}
+    model = mf.build(spec)
+    supports = np.isin(model.block_role.values, [ROLE["fixed_support"], ROLE["moving_support"]])
+    x0 = model.node_x.values.reshape(-1, 4)[supports, 0]  # rectangles: 4 nodes each
+    assert not np.any((x0 >= 1.6 - 1e-9) & (x0 < 2.4 - 1e-9))
+
+
+@pytest.mark.parametrize(("change", "message"), [
+    ({"settlement": TROUGH, "supports": {"a": {"kind": "fixed", "start": 0.0, "end": 4.0}}}, "give one of them"),
+    ({"settlement": {**TROUGH, "profile": "cosine"}}, "'settlement.profile' = 'cosine': must be one of"),
+    ({"settlement": {**TROUGH, "width": 0.0}}, "'settlement.width' = 0.0: must be positive"),
+    ({"settlement": {**TROUGH, "points": [[0, 1], [1, 1]]}}, "'settlement.points' only applies to profile = 'table'"),
+    ({"settlement": {"profile": "table", "segment": 0.5, "points": [[1.0, 0.1], [0.5, 0.2]]}},
+     "point 1 ([0.5, 0.2]) must lie right of the one before"),
+    ({"settlement": {"profile": "table", "segment": 0.5, "points": [[1.0, -0.1], [2.0, 0.2]]}}, "negative rate"),
+    ({"settlement": {**TROUGH, "center": 40.0}}, "nothing settles under the wall"),
+    ({"settlement": {**TROUGH, "segmnt": 0.1}}, "did you mean 'settlement.segment'"),
+])
+def test_bad_profiles_are_named(change, message):
+    with pytest.raises(mf.SpecError, match=message.replace("(", r"\(").replace(")", r"\)").replace("[", r"\[")
+                       .replace("]", r"\]")):
+        mf.build({**BASE, **change})
+
+
+def test_rate_keys_are_checked():
+    spec = {**BASE, "supports": {"fixed": {"kind": "fixed", "start": 0.0, "end": 2.0, "rate": 2.0},
+                                 "m": {"kind": "moving", "start": 2.0, "end": 4.0}}}
+    with pytest.raises(mf.SpecError, match="'supports.fixed.rate' only applies to kind = 'moving'"):
+        mf.build(spec)
+    spec["supports"] = {"m": {"kind": "moving", "start": 0.0, "end": 4.0, "rate": -1.0}}
+    with pytest.raises(mf.SpecError, match="'supports.m.rate' = -1.0: must be positive"):
+        mf.build(spec)
+
+
+def test_a_drawn_wall_refuses_a_settlement_table_and_says_why():
+    spec = mf.load_spec(mf.bundled_spec_path("arch-settlement"))
+    spec["settlement"] = TROUGH
+    with pytest.raises(mf.SpecError, match="'settlement' does not apply to a wall drawn in \\[geometry\\]"):
+        mf.build(spec)
+
+
+@pytest.mark.parametrize(("width_mm", "category"), [
+    (0.0, 0), (0.05, 0), (0.1, 0), (0.11, 1), (1.0, 1), (1.2, 2), (5.0, 2), (7.0, 3), (15.0, 3), (20.0, 4),
+    (25.0, 4), (30.0, 5),
+])
+def test_damage_categories_follow_burlands_table(width_mm, category):
+    assert int(mf.damage_category(width_mm * 1e-3)) == category
+
+
+def test_profile_distortion_closed_forms():
+    """Three points: the middle one 1 below the chord of the ends 2 apart: deflection ratio 1/2 (sagging,
+    positive), angular distortion 1; raised instead: -1/2. A tilt (a straight profile) distorts nothing."""
+    x = np.array([0.0, 1.0, 2.0])
+    assert mf.distortion(x, np.array([0.0, -1.0, 0.0])) == pytest.approx((0.5, 1.0))
+    assert mf.distortion(x, np.array([-1.0, 0.0, -1.0])) == pytest.approx((-0.5, 1.0))
+    assert mf.distortion(x, np.array([0.0, -0.5, -1.0])) == pytest.approx((0.0, 0.0))
+    # a trough: Peck's profile sampled finely, its steepest slope at the inflection point (x0 +- i)
+    i = 0.3
+    xs = np.linspace(-2, 2, 4001)
+    ratio, beta = mf.distortion(xs, -np.exp(-0.5 * (xs / i) ** 2))
+    assert ratio == pytest.approx(1.0 / 4.0, rel=1e-3)  # the axis 1 below the chord, over the 4 m span
+    assert beta == pytest.approx(math.exp(-0.5) / i, rel=1e-4)
+
+
+def test_support_profile_of_a_trough_model():
+    model = mf.build({**BASE, "settlement": TROUGH})
+    x, v = mf.support_profile(model)
+    assert np.all(np.diff(x) > 0)
+    moving = v < 0
+    np.testing.assert_allclose(v[moving], -np.exp(-0.5 * ((x[moving] - 1.0) / 0.3) ** 2), rtol=1e-12)
