@@ -22,13 +22,15 @@ CASE_NAMES = (
 
 #: Drawn example walls (``datasets/drawings``, see its ``generate.py``): a spec with ``[geometry]`` each.
 DRAWN_NAMES = ("lact3-wall", "lact3-portal", "lact3-arch", "arch-settlement", "stepped-units")
+#: Walls over a settlement profile (``[settlement]``, docs/settlements.md).
+PROFILE_NAMES = ("facade-1-trough",)
 #: Every name :func:`bundled_spec_path` knows.
-BUNDLED_NAMES = CASE_NAMES + DRAWN_NAMES
+BUNDLED_NAMES = CASE_NAMES + DRAWN_NAMES + PROFILE_NAMES
 
 
 def bundled_spec_path(name: str):
     """The spec file of a bundled case or drawn example (an ``importlib.resources`` Traversable)."""
-    if name in CASE_NAMES:
+    if name in CASE_NAMES or name in PROFILE_NAMES:
         return resources.files(__name__).joinpath(f"{name}.toml")
     if name in DRAWN_NAMES:
         return resources.files(__name__).joinpath("drawings", f"{name}.toml")

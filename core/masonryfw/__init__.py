@@ -18,7 +18,8 @@ except PackageNotFoundError:  # running from a source tree that is not installed
 
 from .builder import build, load_spec
 from .checks import Problem, check
-from .datasets import BUNDLED_NAMES, CASE_NAMES, DRAWN_NAMES, bundled_cases, bundled_spec_path
+from .damage import DAMAGE_LIMITS, damage_category, distortion, support_profile, widest_opening
+from .datasets import BUNDLED_NAMES, CASE_NAMES, DRAWN_NAMES, PROFILE_NAMES, bundled_cases, bundled_spec_path
 from .dofs import block_loads, block_motion, load_variables, motion_variables, upgrade
 from .errors import MasonryError, ModelError, PluginError, SolveError, SpecError, listed
 from .geometry import (
@@ -65,7 +66,6 @@ from .plugins import (
     solve,
     solver_version,
 )
-from .damage import DAMAGE_LIMITS, damage_category, distortion, support_profile, widest_opening
 from .progress import ProgressCallback, no_progress
 from .schema import FORMAT_VERSION, flags, load_schema, variable_attrs
 from .semantics import (

@@ -26,6 +26,7 @@ import pluggy
 import xarray as xr
 
 from .checks import check
+from .damage import DERIVED_STEP_VARIABLES, damage_variables
 from .dofs import block_motion
 from .errors import MasonryError, ModelError, PluginError, SolveError
 from .hookspecs import PROJECT, Comparator, MasonryfwSpec, Plotter, Solver, resolve_options, unknown_name_message
@@ -34,7 +35,6 @@ from .io import CONVENTIONS, add_history, content_sha256
 from .model import checked_model
 from .progress import ProgressCallback, no_progress
 from .schema import FORMAT_VERSION, variable_attrs
-from .damage import DERIVED_STEP_VARIABLES, damage_variables
 from .semantics import DERIVED_RESULT_VARIABLES, FLOW_RULES, ROTATIONS, derived_variables, plastic_crack_indicator
 
 #: record kind -> (hook name, record type)

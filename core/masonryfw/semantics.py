@@ -351,7 +351,8 @@ def key_numbers(result: xr.Dataset) -> list[KeyNumber]:
 
     Limit analysis: alpha and the reaction on the moving supports at collapse
     (the solver's ``moving_support_reaction``, else ``(1 - alpha) R0``). Incremental solvers: the dead reaction, the smallest
-    reaction and the plateau reaction with their settlements. Both: the number of
+    reaction and the plateau reaction with their settlements, the widest crack and the damage
+    category at the last record (:mod:`masonryfw.damage`). Both: the number of
     masonry macro-blocks when the result has them.
     """
     numbers: list[KeyNumber] = []
@@ -367,6 +368,12 @@ def key_numbers(result: xr.Dataset) -> list[KeyNumber]:
                                      "reaction on the moving supports at collapse, (1 - alpha) R0"))
     if "step_reaction" in result and "step_settlement" in result:
         numbers += _history_numbers(result)
+    if "step_crack_width_max" in result and result.step_crack_width_max.size:
+        numbers.append(KeyNumber("crack_width", float(result.step_crack_width_max.values[-1]), "m",
+                                 "widest crack at the last record"))
+    if "step_damage_category" in result and result.step_damage_category.size:
+        numbers.append(KeyNumber("damage_category", float(result.step_damage_category.values[-1]), "1",
+                                 "damage category at the last record (0 negligible .. 5 very severe)"))
     if "macro_block" in result:
         masonry = masonry_blocks(result.block_role.values)
         count = np.unique(result.macro_block.values[masonry]).size

@@ -141,12 +141,16 @@ def draw_model(datasets: Sequence[xr.Dataset], ax, options: Mapping[str, Any]) -
             ax.add_collection(LineCollection(segments, colors=colour, linewidths=1.2, zorder=2))
             handles.append(Line2D([], [], color=colour, lw=1.5, label=f"{name} ({int(chosen.sum())})"))
     size = mf.model_scale(geo.node_x.values, geo.node_y.values)
-    for block in np.flatnonzero(roles == "moving_support"):
+    moving = np.flatnonzero(roles == "moving_support")
+    fastest = float(np.linalg.norm(geo.settlement_direction.values[moving, :2], axis=1).max(initial=0.0))
+    for block in moving:  # arrows as long as the rates: a settlement profile shows its shape
         direction = geo.settlement_direction.values[block, :2]
         if np.linalg.norm(direction) > 0:
             start = np.array([geo.block_centroid_x.values[block], geo.block_centroid_y.values[block]])
-            ax.annotate("", xy=start + 0.06 * size * direction / np.linalg.norm(direction), xytext=start,
-                        arrowprops={"arrowstyle": "-|>", "color": "#b00000", "lw": 1.6}, zorder=3)
+            tip = start + 0.08 * size * direction / fastest
+            ax.annotate("", xy=tip, xytext=start,
+                        arrowprops={"arrowstyle": "-|>", "color": "#b00000", "lw": 1.2}, zorder=3)
+            ax.update_datalim([tip])
     if options["numbers"]:
         for block in range(geo.sizes["block"]):
             ax.text(geo.block_centroid_x.values[block], geo.block_centroid_y.values[block], str(block),
@@ -279,14 +283,29 @@ def draw_plastic(datasets: Sequence[xr.Dataset], ax, options: Mapping[str, Any])
 
 
 def draw_history(datasets: Sequence[xr.Dataset], ax, options: Mapping[str, Any]) -> None:
-    """Vertical reaction on the moving support against the imposed settlement."""
+    """The reaction on the moving supports, or the damage (category and widest crack), against the settlement."""
     ds = _single(datasets, "history")
     _require(ds, ["step_settlement", "step_reaction"], "history", "an incremental (fdem or jmm) result")
-    ax.plot(1e3 * ds.step_settlement.values, ds.step_reaction.values, marker=".", ms=3)
-    ax.set_xlabel("settlement [mm]")
-    ax.set_ylabel("reaction on the moving support [N]")
-    ax.grid(True, lw=0.3)
     ax.set_title(title_of(ds), fontsize="medium")
+    ax.grid(True, lw=0.3)
+    ax.set_xlabel("settlement [mm]")
+    settlement = 1e3 * ds.step_settlement.values
+    if options.get("quantity", "reaction") == "reaction":
+        ax.plot(settlement, ds.step_reaction.values, marker=".", ms=3)
+        ax.set_ylabel("reaction on the moving supports [N]")
+        return
+    _require(ds, ["step_damage_category", "step_crack_width_max"], "history --option quantity=damage",
+             "a result with crack widths (fdem or jmm, issue 14 or later)")
+    names = mf.flags("step_damage_category")
+    ax.step(settlement, ds.step_damage_category.values, where="post", color="C3", label="damage category")
+    ax.set_yticks(list(names.values()), [f"{v} {k.replace('_', ' ')}" for k, v in names.items()], fontsize="small")
+    ax.set_ylim(-0.3, 5.3)
+    ax.set_ylabel("damage category (Burland et al. 1977)")
+    width = ax.twinx()
+    width.plot(settlement, 1e3 * ds.step_crack_width_max.values, color="0.3", lw=1.0, label="widest crack")
+    width.set_ylabel("widest crack [mm]")
+    lines = ax.get_lines() + width.get_lines()
+    ax.legend(lines, [line.get_label() for line in lines], loc="upper left", fontsize="small", framealpha=0.8)
 
 
 def panel_kind(ds: xr.Dataset) -> str:

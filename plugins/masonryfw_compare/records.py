@@ -48,7 +48,10 @@ PLOTTERS = {
                  (mf.Option("scale", float, 1.0, "largest segment, in median interface lengths", above=0.0),)),
         _plotter("plastic", "plastic quadrature points over the mesh (continuum results)",
                  (mf.Option("marker_size", float, 4.0, "marker area [pt^2]", above=0.0),)),
-        _plotter("history", "reaction on the moving support against settlement"),
+        _plotter("history", "reaction on the moving supports (or the damage) against settlement",
+                 (mf.Option("quantity", str, "reaction",
+                            "reaction: on the moving supports; damage: the damage category and the widest crack",
+                            ("reaction", "damage")),)),
         _plotter("compare", "two or more results side by side with their scores",
                  (AMPLIFICATION_OPTION, THRESHOLD_OPTION)),
     )

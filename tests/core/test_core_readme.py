@@ -86,3 +86,13 @@ def test_the_conformance_kit_of_the_tour_passes_for_the_tour_plugin(tmp_path):
                           timeout=300, cwd=tmp_path)
     assert done.returncode == 0, done.stdout + done.stderr
     assert re.search(r"\b8 passed", done.stdout), done.stdout
+
+
+def test_the_trough_of_the_tour_builds_under_the_tour_wall(tmp_path):
+    spec = tomllib.loads(_block("toml", "# my-wall.toml"))
+    del spec["supports"]
+    spec.update(tomllib.loads(_block("toml", "# over-a-trough.toml: my-wall.toml with [settlement] in place of "
+                                             "its [supports.*] tables")))
+    model = mf.build(spec)
+    assert mf.check(model) == []
+    assert (model.block_role.values == mf.flags("block_role")["moving_support"]).sum() >= 5

@@ -1,0 +1,154 @@
+"""The worked study of docs/settlements.md: Facade 1 over a greenfield trough, la, fdem and jmm.
+
+Facade 1 (bundled case ``facade-1``) loses its two support ranges for a Gaussian
+trough (i = 0.25 m, 0.05 m segments, cutoff 0.05). Three dask sweeps, each point
+one solve, results in a store (a re-run only redraws):
+
+- fdem over the trough axis x0 (0.75 m: under the middle pier, sagging; 1.5 m:
+  under the right end, hogging; and between) and S_max (2, 5, 10, 20 mm), run to
+  S_max (``plateau_tolerance=0``): the widest crack and its damage category;
+- la over x0 (0.30 .. 1.50 m every 0.05 m): alpha and the collapse reaction;
+- jmm over the same x0 as fdem, to its reaction plateau.
+
+Then the two fdem runs at 20 mm for the sagging and the hogging axis are drawn.
+
+    python docs/scripts/settlements_study.py [--workers N] [--store DIR]
+
+Writes docs/img/settlements/*.png and prints the tables of the doc.
+"""
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from matplotlib.figure import Figure
+
+import masonryfw as mf
+from masonryfw_sweep import dask_client, failed_points, plan_sweep, run_sweep
+
+ROOT = Path(__file__).resolve().parents[2]
+IMAGES = ROOT / "docs" / "img" / "settlements"
+TROUGH = {"profile": "gaussian", "center": 0.75, "width": 0.25, "segment": 0.05, "cutoff": 0.05}
+AXES = (0.75, 1.0, 1.25, 1.5)
+S_MAX = (0.002, 0.005, 0.01, 0.02)
+
+
+def trough_spec() -> dict:
+    spec = mf.load_spec(mf.bundled_spec_path("facade-1"))
+    del spec["supports"]
+    return {**spec, "title": "Facade 1 over a trough", "settlement": dict(TROUGH)}
+
+
+def sweep(client, store: Path, solver: str, params: list[str], options: dict):
+    plan = plan_sweep(trough_spec(), solver, params, options)
+    path = store / f"{solver}.store"
+    path.mkdir(parents=True, exist_ok=True)
+    result = run_sweep(plan, client, path, store)
+    for where, message in failed_points(result):
+        print(f"{solver} failed: {where}: {message}")
+    print(f"{solver}: {result.status.size} points, wall time of the solves {float(result.wall_time_s.sum()):.1f} s")
+    return result
+
+
+def values(items) -> str:
+    return ",".join(f"{v:g}" for v in items)
+
+
+def draw_damage(fdem, path: Path) -> None:
+    """Damage category and widest crack against S_max, one line per trough axis."""
+    figure = Figure(figsize=(7.5, 5.0), layout="constrained")
+    top, bottom = figure.subplots(2, 1, sharex=True, height_ratios=(1.2, 1))
+    names = mf.flags("step_damage_category")
+    for k, x0 in enumerate(AXES):
+        row = fdem.sel(settlement_center=x0)
+        s = 1e3 * row.option_settlement.values
+        top.plot(s, row.damage_category.values + 0.06 * (k - 1.5), "o-", ms=4, label=f"x0 = {x0:g} m")
+        bottom.plot(s, 1e3 * row.crack_width.values, "o-", ms=4)
+    top.set_yticks(list(names.values()), [f"{v} {n.replace('_', ' ')}" for n, v in names.items()], fontsize=8)
+    top.set_ylim(-0.4, 5.4)
+    top.set_title("Facade 1 over a trough (i = 0.25 m): fdem, damage after Burland et al. (1977)", fontsize=10)
+    top.legend(title="trough axis", fontsize=8, ncol=2)
+    top.grid(alpha=0.3)
+    bottom.set_yscale("log")
+    for limit in mf.DAMAGE_LIMITS:
+        bottom.axhline(1e3 * limit, color="0.75", lw=0.8, zorder=0)
+    bottom.set_ylabel("widest crack [mm]")
+    bottom.set_xlabel("S_max, the settlement over the trough axis [mm]")
+    bottom.grid(alpha=0.3, which="both")
+    figure.savefig(path, dpi=130)
+
+
+def draw_reactions(la, fdem, jmm, path: Path) -> None:
+    """la's collapse reaction, fdem's minimum and jmm's plateau reaction against the trough axis."""
+    figure = Figure(figsize=(7.5, 4.2), layout="constrained")
+    ax = figure.subplots()
+    x = la.settlement_center.values
+    ax.plot(x, la.collapse_reaction.values, "o-", ms=3, label="la: (1 - alpha) R0 at collapse")
+    ax.plot(x, la.collapse_reaction.values / (1 - la.alpha.values), "k:", lw=1, label="R0: dead reaction (la)")
+    last = fdem.sel(option_settlement=S_MAX[-1])
+    ax.plot(last.settlement_center.values, last.minimum_reaction.values, "s", ms=6, label="fdem: minimum reaction")
+    ax.plot(jmm.settlement_center.values, jmm.plateau_reaction.values, "^", ms=6, label="jmm: plateau reaction")
+    ax.set_xlabel("trough axis x0 [m]")
+    ax.set_ylabel("reaction on the settling segments [N]")
+    ax.set_title("Facade 1 over a trough (i = 0.25 m): the reaction the settling ground keeps", fontsize=10)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    figure.savefig(path, dpi=130)
+
+
+def draw_cases(store: Path) -> None:
+    """The fdem runs at S_max = 20 mm under the middle (sagging) and at the end (hogging), as mechanisms."""
+    for name, x0 in (("sagging", 0.75), ("hogging", 1.5)):
+        spec = trough_spec()
+        spec["settlement"]["center"] = x0
+        result = mf.solve(mf.build(spec), "fdem", {"settlement": 0.02, "plateau_tolerance": 0.0})
+        result.attrs["title"] = f"Facade 1, trough axis x0 = {x0:g} m ({name}), S_max = 20 mm"
+        mf.save(result, store / f"fdem-{name}.nc", command="docs/scripts/settlements_study.py")
+        mf.save_figure(mf.render([result], "mechanism"), IMAGES / f"facade-1-{name}.png", dpi=130)
+        mf.save_figure(mf.render([result], "history", {"quantity": "damage"}),
+                       IMAGES / f"facade-1-{name}-damage.png", dpi=130)
+        print(f"{name}: " + ", ".join(map(str, mf.key_numbers(result))))
+
+
+def table(fdem, la, jmm) -> str:
+    lines = ["| x0 [m] | la alpha | la (1 - alpha) R0 [N] | fdem min. reaction [N] | jmm plateau reaction [N] | "
+             + " | ".join(f"fdem {1e3 * s:g} mm: crack [mm] / cat." for s in S_MAX) + " |",
+             "|---:|---:|---:|---:|---:|" + "---:|" * len(S_MAX)]
+    for x0 in AXES:
+        row = fdem.sel(settlement_center=x0)
+        l_row = la.sel(settlement_center=x0, method="nearest")
+        cells = [f"{1e3 * w:.2f} / {int(c)}" for w, c in zip(row.crack_width.values, row.damage_category.values)]
+        lines.append(f"| {x0:g} | {float(l_row.alpha):.4f} | {float(l_row.collapse_reaction):.1f} | "
+                     f"{float(row.minimum_reaction.values[-1]):.1f} | "
+                     f"{float(jmm.sel(settlement_center=x0).plateau_reaction):.1f} | " + " | ".join(cells) + " |")
+    return "\n".join(lines)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--workers", type=int, default=None)
+    parser.add_argument("--store", type=Path, default=ROOT / "build" / "sweeps" / "settlements")
+    args = parser.parse_args()
+    args.store.mkdir(parents=True, exist_ok=True)
+    IMAGES.mkdir(parents=True, exist_ok=True)
+    with dask_client(workers=args.workers) as client:
+        fdem = sweep(client, args.store, "fdem", [f"settlement.center={values(AXES)}",
+                                                  f"option.settlement={values(S_MAX)}"],
+                     {"plateau_tolerance": 0.0})
+        la = sweep(client, args.store, "la", ["settlement.center=0.3:1.5:0.05"], {})
+        jmm = sweep(client, args.store, "jmm", [f"settlement.center={values(AXES)}"], {})
+    mf.save_figure(mf.render([mf.build(mf.bundled_spec_path("facade-1-trough"))], "model"),
+                   IMAGES / "facade-1-trough-model.png", dpi=130)
+    draw_damage(fdem, IMAGES / "facade-1-damage-vs-smax.png")
+    draw_reactions(la, fdem, jmm, IMAGES / "facade-1-reactions-vs-axis.png")
+    draw_cases(args.store)
+    print(table(fdem, la, jmm))
+    jmm_widths = ", ".join(f"{x0:g} m: {1e3 * float(w):.4f} mm at {1e3 * float(s):.3f} mm"
+                           for x0, w, s in zip(jmm.settlement_center.values, jmm.crack_width.values,
+                                               jmm.final_settlement.values))
+    print(f"jmm widest crack at its plateau stop: {jmm_widths}")
+    print(f"wrote {IMAGES.relative_to(ROOT)}")
+
+
+if __name__ == "__main__":
+    main()
