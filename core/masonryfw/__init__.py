@@ -86,6 +86,7 @@ from .semantics import (
     plastic_crack_indicator,
     point_motion,
     polar_moment,
+    reaction_weights,
     relative_motion,
     states_at,
     support_blocks,

@@ -310,10 +310,28 @@ class KeyNumber:
         return f"{self.name} = {self.value:.6g}{unit}"
 
 
+def reaction_weights(role: np.ndarray, direction: np.ndarray) -> np.ndarray:
+    """Per block, the weight of its vertical reaction in the settlement reaction: a moving support's
+    downward rate over the fastest one's (1 for all when they settle at one rate), 0 for other blocks.
+
+    With one settlement parameter t, equilibrium fixes only the reactions' work on t, the sum of
+    the supports' reactions weighted by their rates: that is what drops by alpha in la (its plain
+    sum is not unique when the rates differ). Vertical components only: exact for supports that
+    translate vertically, and the plain sum for a single support of any motion.
+    """
+    moving = np.asarray(role) == _ROLE["moving_support"]
+    down = np.where(moving, -np.asarray(direction, dtype=float)[:, 1], 0.0)
+    fastest = float(down.max(initial=0.0))
+    if moving.sum() <= 1 or not fastest > 0:
+        return moving.astype(float)
+    return down / fastest
+
+
 def dead_reaction(model: xr.Dataset) -> float:
-    """Upward dead load on the moving supports [N]: the paper's settlement reaction R0 (0 without one)."""
-    moving = model.block_role.values == _ROLE["moving_support"]
-    return float(block_loads(model, "dead")[moving, 1].sum())
+    """Upward dead load on the moving supports [N], weighted by their rates (:func:`reaction_weights`):
+    the paper's settlement reaction R0 (0 without one)."""
+    weights = reaction_weights(model.block_role.values, model.settlement_direction.values)
+    return float((weights * block_loads(model, "dead")[:, 1]).sum())
 
 
 def plateau_start(settlement: np.ndarray, reaction: np.ndarray, band: float) -> int:

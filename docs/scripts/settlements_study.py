@@ -54,6 +54,28 @@ def values(items) -> str:
     return ",".join(f"{v:g}" for v in items)
 
 
+def weighted_reactions(path: Path):
+    """A result's settlement reaction at every step: the segments' reactions weighted by their rates over
+    the fastest one's (``mf.reaction_weights``), the quantity la's ``(1 - alpha) R0`` is (the plain sum is
+    not fixed by la's equilibrium when the rates differ)."""
+    result = mf.open_dataset(path)
+    weights = mf.reaction_weights(result.block_role.values, result.settlement_direction.values)
+    return result, result.step_support_reaction.values @ weights
+
+
+def weighted_minimum(store: Path, fdem, x0: float) -> float:
+    """fdem's smallest weighted reaction in its settlement phase, at S_max = 20 mm."""
+    row = fdem.sel(settlement_center=x0, option_settlement=S_MAX[-1])
+    result, reaction = weighted_reactions(store / str(row.result_path.values))
+    return float(reaction[result.step_phase.values == 1].min())
+
+
+def weighted_last(store: Path, jmm, x0: float) -> float:
+    """jmm's weighted reaction at its last step (its reaction plateau)."""
+    _, reaction = weighted_reactions(store / str(jmm.sel(settlement_center=x0).result_path.values))
+    return float(reaction[-1])
+
+
 def draw_damage(fdem, path: Path) -> None:
     """Damage category and widest crack against S_max, one line per trough axis."""
     figure = Figure(figsize=(7.5, 5.0), layout="constrained")
@@ -78,18 +100,18 @@ def draw_damage(fdem, path: Path) -> None:
     figure.savefig(path, dpi=130)
 
 
-def draw_reactions(la, fdem, jmm, path: Path) -> None:
-    """la's collapse reaction, fdem's minimum and jmm's plateau reaction against the trough axis."""
+def draw_reactions(la, fdem_minimum: dict, jmm_last: dict, path: Path) -> None:
+    """la's collapse reaction, fdem's smallest and jmm's plateau reaction against the trough axis (all
+    the segments' reactions weighted by their rates over the fastest, :func:`weighted_minimum`)."""
     figure = Figure(figsize=(7.5, 4.2), layout="constrained")
     ax = figure.subplots()
     x = la.settlement_center.values
     ax.plot(x, la.collapse_reaction.values, "o-", ms=3, label="la: (1 - alpha) R0 at collapse")
     ax.plot(x, la.collapse_reaction.values / (1 - la.alpha.values), "k:", lw=1, label="R0: dead reaction (la)")
-    last = fdem.sel(option_settlement=S_MAX[-1])
-    ax.plot(last.settlement_center.values, last.minimum_reaction.values, "s", ms=6, label="fdem: minimum reaction")
-    ax.plot(jmm.settlement_center.values, jmm.plateau_reaction.values, "^", ms=6, label="jmm: plateau reaction")
+    ax.plot(list(fdem_minimum), list(fdem_minimum.values()), "s", ms=6, label="fdem: smallest reaction to 20 mm")
+    ax.plot(list(jmm_last), list(jmm_last.values()), "^", ms=6, label="jmm: reaction at its plateau stop")
     ax.set_xlabel("trough axis x0 [m]")
-    ax.set_ylabel("reaction on the settling segments [N]")
+    ax.set_ylabel("settling segments' reaction, weighted by rate [N]")
     ax.set_title("Facade 1 over a trough (i = 0.25 m): the reaction the settling ground keeps", fontsize=10)
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
@@ -110,17 +132,18 @@ def draw_cases(store: Path) -> None:
         print(f"{name}: " + ", ".join(map(str, mf.key_numbers(result))))
 
 
-def table(fdem, la, jmm) -> str:
-    lines = ["| x0 [m] | la alpha | la (1 - alpha) R0 [N] | fdem min. reaction [N] | jmm plateau reaction [N] | "
+def table(fdem, fdem_minimum: dict, jmm_last: dict, la) -> str:
+    lines = ["| x0 [m] | la alpha | la (1 - alpha) R0 [N] | fdem smallest reaction [N] | fdem min. plain sum [N] | "
+             "jmm reaction at its stop [N] | "
              + " | ".join(f"fdem {1e3 * s:g} mm: crack [mm] / cat." for s in S_MAX) + " |",
-             "|---:|---:|---:|---:|---:|" + "---:|" * len(S_MAX)]
+             "|---:|---:|---:|---:|---:|---:|" + "---:|" * len(S_MAX)]
     for x0 in AXES:
         row = fdem.sel(settlement_center=x0)
         l_row = la.sel(settlement_center=x0, method="nearest")
         cells = [f"{1e3 * w:.2f} / {int(c)}" for w, c in zip(row.crack_width.values, row.damage_category.values)]
         lines.append(f"| {x0:g} | {float(l_row.alpha):.4f} | {float(l_row.collapse_reaction):.1f} | "
-                     f"{float(row.minimum_reaction.values[-1]):.1f} | "
-                     f"{float(jmm.sel(settlement_center=x0).plateau_reaction):.1f} | " + " | ".join(cells) + " |")
+                     f"{fdem_minimum[x0]:.1f} | {float(row.minimum_reaction.values[-1]):.1f} | "
+                     f"{jmm_last[x0]:.1f} | " + " | ".join(cells) + " |")
     return "\n".join(lines)
 
 
@@ -140,9 +163,11 @@ def main() -> None:
     mf.save_figure(mf.render([mf.build(mf.bundled_spec_path("facade-1-trough"))], "model"),
                    IMAGES / "facade-1-trough-model.png", dpi=130)
     draw_damage(fdem, IMAGES / "facade-1-damage-vs-smax.png")
-    draw_reactions(la, fdem, jmm, IMAGES / "facade-1-reactions-vs-axis.png")
+    fdem_minimum = {x0: weighted_minimum(args.store, fdem, x0) for x0 in AXES}
+    jmm_last = {x0: weighted_last(args.store, jmm, x0) for x0 in AXES}
+    draw_reactions(la, fdem_minimum, jmm_last, IMAGES / "facade-1-reactions-vs-axis.png")
     draw_cases(args.store)
-    print(table(fdem, la, jmm))
+    print(table(fdem, fdem_minimum, jmm_last, la))
     jmm_widths = ", ".join(f"{x0:g} m: {1e3 * float(w):.4f} mm at {1e3 * float(s):.3f} mm"
                            for x0, w, s in zip(jmm.settlement_center.values, jmm.crack_width.values,
                                                jmm.final_settlement.values))

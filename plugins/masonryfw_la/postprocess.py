@@ -10,6 +10,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+import masonryfw as mf
+
 from .assembly import KinematicLP, Scales, Wall
 
 
@@ -58,11 +60,12 @@ def contact_forces(lp: KinematicLP, y: np.ndarray, n_interface: int, scales: Sca
 
 
 def moving_support_reaction(wall: Wall, forces: ContactForces) -> float:
-    """Upward vertical force the ground must give the moving supports at collapse [N].
+    """Upward vertical force the ground must give the moving supports at collapse [N], each weighted
+    by its rate relative to the fastest (``mf.reaction_weights``; the plain sum at one rate).
 
     Minus the vertical component of the contact forces the wall exerts on them
     (on side 1 the force is ``N n + T t``, on side 0 its opposite).
     """
-    moving = wall.moving[wall.sides].astype(float)  # (interface, side)
+    moving = mf.reaction_weights(wall.role, wall.direction)[wall.sides]  # (interface, side)
     on_side1_y = forces.normal.sum(axis=1) * wall.normal[:, 1] + forces.shear.sum(axis=1) * wall.tangent[:, 1]
     return float(-(on_side1_y * (moving[:, 1] - moving[:, 0])).sum())

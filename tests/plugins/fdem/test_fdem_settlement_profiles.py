@@ -138,3 +138,13 @@ def test_fdem_damage_grows_with_the_settlement(sagging):
     category = sagging.step_damage_category.values
     np.testing.assert_array_equal(category, mf.damage_category(width))
     assert category[-1] >= 1
+
+
+def test_fdem_deformable_support_reactions_carry_the_weight():
+    """The deformable mode sums its support nodes' forces per support block: the same shares."""
+    spec = block_on_two_supports()
+    spec["material"] = {**spec["material"], "young_modulus": 1e9, "poisson_ratio": 0.2}
+    result = mf.solve(mf.build(spec), "fdem", {"mode": "deformable", "settlement": 0.0005})
+    weight = 20000.0 * 0.4 * 0.1 * 0.1
+    np.testing.assert_allclose(result.step_support_reaction.values[after_gravity(result)],
+                               [0.0, weight / 4, 3 * weight / 4], rtol=1e-3)

@@ -109,3 +109,20 @@ def test_la_trough_under_a_bundled_facade():
     spec["settlement"] = {"profile": "gaussian", "center": 1.2, "width": 0.25, "segment": 0.1, "cutoff": 0.05}
     result = mf.solve(mf.build(spec), "la")
     assert 0 < float(result.collapse_multiplier) < 1
+
+
+def test_la_collapse_reaction_of_a_trough_is_one_minus_alpha_of_the_dead_reactions(walls):
+    """The dual forces on the settling segments, each weighted by its rate over the fastest one's (the
+    reactions' work on the one settlement parameter, which the LP fixes): (1 - alpha) R0, R0 their dead
+    loads weighted alike. (The plain sum is not unique when the rates differ.)"""
+    model = mf.build(trough(2.0))
+    result = walls.solve(model, solver="highs")
+    alpha = float(result.collapse_multiplier)
+    assert float(result.moving_support_reaction) == pytest.approx((1 - alpha) * mf.dead_reaction(model), rel=1e-6)
+
+
+def test_jmm_limit_refuses_supports_at_different_rates():
+    """Its LP minimises one vertical reaction: a profile needs the incremental jmm (a clear refusal)."""
+    model = mf.build(trough(2.0))
+    with pytest.raises(mf.ModelError, match="settle at different rates"):
+        mf.solve(model, "jmm-limit")
