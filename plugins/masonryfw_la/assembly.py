@@ -259,8 +259,14 @@ def with_columns(matrix: sp.csr_matrix, n_col: int) -> sp.csr_matrix:
     return sp.csr_matrix((matrix.data, matrix.indices, matrix.indptr), shape=(matrix.shape[0], n_col))
 
 
-def assemble(wall: Wall, scales: Scales, kin: Kinematics) -> KinematicLP:
-    """The kinematic programme of ``wall`` (see the module docstring)."""
+def assemble(wall: Wall, scales: Scales, kin: Kinematics, normal_force: np.ndarray | None = None) -> KinematicLP:
+    """The kinematic programme of ``wall`` (see the module docstring).
+
+    ``normal_force`` (one per end ``2 * interface + end``, non-dimensional) makes the joints
+    non-associative (:mod:`.nonassociative`): every active end slides without opening
+    (rows ``s - dt``, ``s + dt``, ``dn``) against a fixed shear capacity ``a_c + mu N``,
+    and opens against its tensile strength as before.
+    """
     cmap, settlement_column = column_map(wall, scales)
     normal = kin.normal @ cmap
     tangent = kin.tangent @ cmap
@@ -269,7 +275,7 @@ def assemble(wall: Wall, scales: Scales, kin: Kinematics) -> KinematicLP:
     active = active_interfaces(wall, normal, tangent)
     mu, a_c, a_t = end_strengths(wall, scales)
     active_end = np.repeat(active, 2)
-    cohesive_end = (a_c > 0) | (a_t > 0)
+    cohesive_end = (a_c > 0) | (a_t > 0) | (normal_force is not None)
     dry = np.flatnonzero(active_end & ~cohesive_end)
     coh = np.flatnonzero(active_end & cohesive_end)
 
@@ -285,13 +291,17 @@ def assemble(wall: Wall, scales: Scales, kin: Kinematics) -> KinematicLP:
     rows = [normal_dry - mu_tangent_dry, normal_dry + mu_tangent_dry]
     if coh.size:
         eye = sp.identity(coh.size, format="csr")
+        dilatancy = mu[coh] if normal_force is None else np.zeros(coh.size)
         rows += [
             sp.hstack([-tangent[coh], eye]),
             sp.hstack([tangent[coh], eye]),
-            sp.hstack([normal[coh], -sp.diags(mu[coh])]),
+            sp.hstack([normal[coh], -sp.diags(dilatancy)]),
         ]
         cost[:n_col] += normal[coh].T @ a_t[coh]
-        cost[n_col:] += a_c[coh] - mu[coh] * a_t[coh]
+        if normal_force is None:
+            cost[n_col:] += a_c[coh] - mu[coh] * a_t[coh]
+        else:  # the shear capacity of the normal force given (never below zero: N >= -a_t, a_t <= a_c / mu)
+            cost[n_col:] += np.maximum(a_c[coh] + mu[coh] * normal_force[coh], 0.0)
     constraints = sp.vstack([with_columns(r.tocsr(), n_total) for r in rows], format="csr")
     return KinematicLP(
         cost=cost,

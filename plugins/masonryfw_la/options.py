@@ -20,6 +20,18 @@ OPTIONS = (
         BACKENDS,
     ),
     mf.Option("tolerance", float, 1e-9, "feasibility / optimality tolerance of the backend", above=0.0, below=1.0),
+    mf.Option("flow", str, "associative",
+              "associative: a sliding joint opens by mu |slip| (dilatant, the paper's and ALMA's; an upper bound); "
+              "nonassociative: joints slide without opening, by a sequence of LPs with the shear capacity of the "
+              "previous normal forces (Gilbert, Casapulla & Ahmed 2006; docs/la.md)",
+              ("associative", "nonassociative")),
+    mf.Option("flow_tolerance", float, 1e-6,
+              "nonassociative: stop when alpha (relative) and every end's normal force (over the dead load) "
+              "change by less than this between two LPs", above=0.0, below=1.0),
+    mf.Option("flow_iterations", int, 100, "nonassociative: the largest number of LPs", above=0),
+    mf.Option("flow_relaxation", float, 1.0,
+              "nonassociative: share of the change of the normal forces taken from one LP to the next",
+              above=0.0, at_most=1.0),
 )
 
 #: Every backend, run side by side by the gallery (their mechanisms may differ where the optimum is degenerate).

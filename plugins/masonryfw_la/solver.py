@@ -2,7 +2,8 @@
 
 The core derives the comparable fields (relative motion, joint states, crack
 indicator, macro-blocks) from the mechanism: ``rotations = "small"`` (a
-velocity field) and ``flow_rule = "associative"`` (dilatant joints).
+velocity field) and ``flow_rule`` ``associative`` (dilatant joints) or
+``nonassociative`` (option ``flow``: :mod:`.nonassociative`).
 """
 from __future__ import annotations
 
@@ -15,7 +16,7 @@ import xarray as xr
 
 import masonryfw as mf
 
-from . import assembly, backends, postprocess, topology
+from . import assembly, backends, nonassociative, postprocess, topology
 
 
 def check_live_load(lp: assembly.KinematicLP) -> None:
@@ -42,12 +43,29 @@ def solve(model: xr.Dataset, options: Mapping[str, Any], progress=mf.no_progress
     rows, cols = lp.constraints.shape
     progress(0.2, f"la: solving the LP with {options['solver']} ({rows} rows, {cols} columns)")
     clock = time.perf_counter()
-    sol = backends.solve_lp(options["solver"], lp.cost, lp.constraints, lp.live, options["tolerance"])
+    flow = None
+    if options["flow"] == "nonassociative":
+        flow = nonassociative.solve(wall, scales, kin, options, progress)
+        lp, sol = flow.lp, flow.solution
+    else:
+        sol = backends.solve_lp(options["solver"], lp.cost, lp.constraints, lp.live, options["tolerance"])
     t_lp = time.perf_counter() - clock
 
     progress(0.9, "la: post-processing")
     clock = time.perf_counter()
-    result = result_dataset(wall, lp, sol, scales)
+    result = result_dataset(wall, lp, sol, scales, "associative" if flow is None else "nonassociative")
+    if flow is not None:
+        result.attrs.update(
+            la_flow_iterations=len(flow.alphas),
+            la_flow_converged=int(flow.converged),
+            la_flow_last_change=flow.change,
+            la_alpha_associative=flow.alpha_associative,
+            la_flow_selection="the fixed point of the sequence of LPs started from the associative solution's "
+                              f"normal forces, {options['solver']} backend (docs/la.md)",
+        )
+        if not flow.converged:
+            result.attrs["stop_reason"] = (f"the non-associative iteration did not converge in {len(flow.alphas)} "
+                                           "LPs: the last iterate is reported")
     result.attrs.update(
         la_backend=options["solver"],
         la_time_assembly_s=t_assembly,
@@ -57,7 +75,8 @@ def solve(model: xr.Dataset, options: Mapping[str, Any], progress=mf.no_progress
         la_lp_columns=int(cols),
         la_interfaces_outside_lp=int((~lp.active_interfaces).sum()),
     )
-    progress(1.0, f"la: alpha = {sol.alpha_primal:.6g}")
+    unconverged = "" if flow is None or flow.converged else " (NOT CONVERGED: the last iterate)"
+    progress(1.0, f"la: alpha = {sol.alpha_primal:.6g}{unconverged}")
     return result
 
 
@@ -66,6 +85,7 @@ def result_dataset(
     lp: assembly.KinematicLP,
     sol: backends.LPSolution,
     scales: assembly.Scales,
+    flow_rule: str = "associative",
 ) -> xr.Dataset:
     """The primary result variables of one solved programme (docs/format.md)."""
     forces = postprocess.contact_forces(lp, sol.y, wall.n_interface, scales)
@@ -85,4 +105,4 @@ def result_dataset(
             mf.variable_attrs("moving_support_reaction"),
         )
     return xr.Dataset(data, attrs={"la_alpha_dual": float(sol.alpha_dual), "rotations": "small",
-                                   "flow_rule": "associative"})
+                                   "flow_rule": flow_rule})

@@ -1,0 +1,98 @@
+"""la with non-associative friction (issue 15): joints that slide without opening.
+
+References: closed forms (a unit between a base and a cap; rocking; a unit over a
+settling support; cohesion), the associative alpha as an upper bound, the same
+wall in another block order and in millimetres, and the other backends.
+"""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import masonryfw as mf
+import masonryfw.testing as mt
+
+from .test_la_closed_forms import single_unit, unit_on_two_supports
+
+NONASSOCIATIVE = {"flow": "nonassociative"}
+STATE = mf.flags("interface_state")
+
+
+def capped_unit(walls, b=0.4, h=0.3, mu=0.5):
+    """A b x h unit on a fixed base under a fixed cap that only touches it, pushed sideways by its weight."""
+    role = walls.ROLE
+    return walls.rect_model([(-1.0, -0.2, 2.0, 0.0), (0.0, 0.0, b, h), (-1.0, h, 2.0, h + 0.2)],
+                            [role["fixed_support"], role["unit"], role["fixed_support"]], friction=mu)
+
+
+@pytest.mark.parametrize("backend", ["highs", "ipm", "clarabel"])
+@pytest.mark.parametrize("mu", [0.3, 0.5, 0.8])
+def test_a_capped_unit_slides_at_mu_without_dilatancy(walls, backend, mu):
+    """The cap carries nothing (zero initial contact force), so only the base resists: alpha = mu exactly.
+    Associative joints would have to open as they slide, which the cap forbids: no mechanism at all."""
+    model = capped_unit(walls, mu=mu)
+    with pytest.raises(mf.SolveError, match="can carry any multiple"):
+        walls.solve(model, solver=backend)
+    result = walls.solve(model, solver=backend, **NONASSOCIATIVE)
+    assert float(result.collapse_multiplier) == pytest.approx(mu, rel=1e-7)
+    assert result.attrs["flow_rule"] == "nonassociative"
+    assert np.isnan(result.attrs["la_alpha_associative"])
+    u = mf.block_motion(result)[1]
+    assert u[1] == pytest.approx(0.0, abs=1e-7) and u[2] == pytest.approx(0.0, abs=1e-7)  # slides flat
+    assert set(result.interface_state.values.tolist()) == {STATE["slide"]}  # slip without opening
+
+
+@pytest.mark.parametrize("b, h, mu", [(0.4, 1.0, 0.65), (0.3, 0.6, 0.6), (1.0, 0.5, 0.4), (0.6, 0.8, 0.3)])
+def test_a_free_unit_rocks_or_slides_as_in_the_associative_closed_form(walls, b, h, mu):
+    """alpha = min(b/h, mu): rocking needs no slip; a free unit sliding on its base does no dilatancy work."""
+    result = walls.solve(single_unit(walls, b, h, friction=mu), **NONASSOCIATIVE)
+    assert float(result.collapse_multiplier) == pytest.approx(min(b / h, mu), rel=1e-6)
+
+
+@pytest.mark.parametrize("a", [0.1, 0.35, 0.7])
+def test_a_unit_over_a_settling_support_pivots_as_in_the_closed_form(walls, a):
+    expected = 1.0 if a >= 0.5 else 1.0 - (0.5 - a) / (1.0 - a) ** 2
+    result = walls.solve(unit_on_two_supports(walls, a), **NONASSOCIATIVE)
+    assert float(result.collapse_multiplier) == pytest.approx(expected, abs=1e-6)
+
+
+@pytest.mark.parametrize("mu, cohesion, tension", [(0.4, 200.0, 0.0), (0.8, 1000.0, 500.0)])
+def test_cohesion_and_tension_as_in_the_associative_closed_form(walls, mu, cohesion, tension):
+    """Sliding: alpha W = mu W + c b s (the capacity of the normal force W); rocking with the tension."""
+    b, h, s, gamma = 0.5, 1.0, 0.1, 12e3
+    weight = gamma * b * h * s
+    model = single_unit(walls, b, h, friction=mu, cohesion=cohesion, tensile_strength=tension, thickness=s)
+    ft = min(tension, cohesion / mu)
+    expected = min(b / h + ft * s * b**2 / (weight * h), mu + cohesion * b * s / weight)
+    assert float(walls.solve(model, **NONASSOCIATIVE).collapse_multiplier) == pytest.approx(expected, rel=1e-6)
+
+
+@pytest.mark.parametrize("case", mf.CASE_NAMES)
+def test_the_associative_alpha_bounds_the_nonassociative_one_on_every_bundled_wall(walls, case):
+    model = mf.open_model(case)
+    associative = walls.solve(model)
+    result = walls.solve(model, **NONASSOCIATIVE)
+    alpha, bound = float(result.collapse_multiplier), float(associative.collapse_multiplier)
+    assert result.attrs["la_flow_converged"] == 1
+    assert result.attrs["la_alpha_associative"] == pytest.approx(bound, abs=1e-9)
+    assert alpha <= bound + 1e-6
+    if not np.isin(associative.interface_state.values, [STATE["slide"], STATE["open_slide"]]).any():
+        assert alpha == pytest.approx(bound, abs=1e-5)  # no slip in the associative mechanism: no difference
+
+
+def test_the_chosen_solution_does_not_depend_on_block_order_or_units(walls):
+    model = mf.open_model("test-12c")
+    reference = float(walls.solve(model, **NONASSOCIATIVE).collapse_multiplier)
+    rng = np.random.default_rng(3)
+    shuffled = mt.permuted(model, rng.permutation(model.sizes["block"]), rng.permutation(model.sizes["interface"]))
+    assert float(walls.solve(shuffled, **NONASSOCIATIVE).collapse_multiplier) == pytest.approx(reference, abs=1e-5)
+    in_mm = mt.scaled(model, 1000.0)
+    assert float(walls.solve(in_mm, **NONASSOCIATIVE).collapse_multiplier) == pytest.approx(reference, abs=1e-5)
+
+
+def test_an_iteration_that_does_not_converge_says_so(walls, caplog):
+    model = mf.open_model("test-12c")
+    result = walls.solve(model, flow="nonassociative", flow_iterations=2)
+    assert result.attrs["la_flow_converged"] == 0
+    assert "did not converge" in result.attrs["stop_reason"]
+    assert "did not converge" in caplog.text
