@@ -9,6 +9,12 @@ class TestLa(SolverConformance):
     invariance_tolerance = 1e-7
 
 
+class TestLaNonassociative(SolverConformance):
+    solver = "la"
+    options = {"flow": "nonassociative"}
+    invariance_tolerance = 1e-5  # the fixed point to its flow_tolerance (docs/la.md)
+
+
 class TestFdem(SolverConformance):
     solver = "fdem"
     # explicit frictional dynamics: another order of summation (blocks renumbered) or the
