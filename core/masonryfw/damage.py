@@ -26,7 +26,7 @@ from __future__ import annotations
 import numpy as np
 import xarray as xr
 
-from .schema import flags, variable_attrs
+from .schema import variable_attrs
 from .semantics import masonry_joints, relative_motion, support_blocks
 
 #: Upper crack widths [m] of damage categories 0 to 4 (category 5 beyond the last).
@@ -94,7 +94,3 @@ def damage_variables(model: xr.Dataset, produced: xr.Dataset) -> dict[str, tuple
         derived["step_angular_distortion"] = ("step", angle * settlement, variable_attrs("step_angular_distortion"))
     return derived
 
-
-def category_names() -> dict[int, str]:
-    """``{0: "negligible", ...}``: the flag meanings of ``step_damage_category``."""
-    return {value: name for name, value in flags("step_damage_category").items()}

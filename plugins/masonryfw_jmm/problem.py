@@ -8,6 +8,7 @@ displacements of the gravity stage are of order 1.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 import xarray as xr
@@ -55,6 +56,11 @@ class Problem:
     face_bounds: np.ndarray | None = None  # (faces, masonry points) b per point (no head faces without head joints)
     searches_load: bool = False  # no moving support: the live load's factor grows instead of a settlement
     n_block: int = 0  # blocks of the model (the per-support reactions are per block)
+
+    @cached_property
+    def compliance(self) -> np.ndarray:
+        """``(points, 3, 3)`` inverses of ``D_points`` (the elastic strain of a stress), computed once."""
+        return np.linalg.inv(self.D_points)
 
     @property
     def free(self) -> np.ndarray:

@@ -62,7 +62,7 @@ def crack_band_width(problem: Problem, state: State) -> float:
     times the mesh size give the opening there; the widest over the points is returned.
     """
     p = problem
-    plastic = state.strain - np.linalg.solve(p.D_points, state.stress[..., None])[..., 0]
+    plastic = state.strain - np.einsum("pij,pj->pi", p.compliance, state.stress)
     plastic = plastic[p.masonry_points]
     if p.from_bed is not None:  # engineering strains turn with the inverse transpose of the stress rotation
         plastic = np.einsum("pji,pj->pi", p.from_bed, plastic)
