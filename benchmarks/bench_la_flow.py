@@ -1,15 +1,19 @@
 """Benchmark of la's non-associative flow rule against the associative solve it starts from.
 
-The ten bundled walls (median of 3 alternating pairs in this process, after a warm-up) and
-the running-bond settlement wall of 1,000 units (bench_la.py's, one pair; at 10,000 units the
-sequence would take well over 20 minutes, so it is not run):
-time, LPs of the sequence, alpha both ways; and, on Facade 3, run time against error: the
-flow tolerance loosened, alpha against the converged one.
-Run from the benchmarks folder: ``python bench_la_flow.py``. Writes the ``la-flow`` section of
-docs/benchmarks.md.
+- The ten bundled walls (median of 3 alternating pairs in this process, after a warm-up) and the
+  running-bond settlement walls of 1,000 units (bench_la.py's, one pair) and, with ``--big``,
+  10,000 units (one pair, about 20 minutes): time, LPs of the sequence, alpha both ways.
+- The selection side by side, in this process: each LP's forces by one regularised ipm solve
+  (the default) against the ipm LP followed by the selection QP (Clarabel), alternating pairs.
+- Facade 3, run time against error: the flow tolerance loosened, alpha against the sequence run
+  to flow_tolerance 1e-10.
+
+Run from the benchmarks folder: ``python bench_la_flow.py [--big]``. Writes the ``la-flow``
+section of docs/benchmarks.md.
 """
 from __future__ import annotations
 
+import argparse
 import os
 import statistics
 import sys
@@ -18,6 +22,7 @@ import time
 from _report import write_section
 
 import masonryfw as mf
+from masonryfw_la import nonassociative
 
 sys.path.insert(0, os.path.dirname(__file__))
 from bench_la import SIZES, running_bond_spec  # noqa: E402
@@ -35,7 +40,8 @@ def timed(model, options):
 def pair_rows(models, pairs):
     rows = []
     for name, model in models:
-        timed(model, {})
+        if pairs > 1:
+            timed(model, {})
         a_times, n_times = [], []
         for _ in range(pairs):
             a, assoc = timed(model, {})
@@ -44,17 +50,44 @@ def pair_rows(models, pairs):
             n_times.append(n)
         ta, tn = statistics.median(a_times), statistics.median(n_times)
         rows.append(f"| {name} | {model.sizes['block']} | {float(assoc.collapse_multiplier):.5f} | "
-                    f"{float(non.collapse_multiplier):.5f} | {non.attrs['la_flow_iterations']} | {ta:.3f} | {tn:.3f} | "
+                    f"{float(non.collapse_multiplier):.6f} | {non.attrs['la_flow_iterations']} | {ta:.3f} | {tn:.3f} | "
                     f"{tn / ta:.1f} |")
         print(rows[-1], flush=True)
     return rows
 
 
+def with_qp_selection(model):
+    """The sequence with each LP's forces from the selection QP instead of the regularised LP."""
+    regularised = nonassociative.Selection.regularised
+    nonassociative.Selection.regularised = property(lambda self: False)  # type: ignore[method-assign]
+    try:
+        return timed(model, NON)
+    finally:
+        nonassociative.Selection.regularised = regularised  # type: ignore[method-assign]
+
+
+def selection_rows(models, pairs):
+    rows = []
+    for name, model in models:
+        reg_times, qp_times = [], []
+        for _ in range(pairs):
+            t, reg = timed(model, NON)
+            reg_times.append(t)
+            t, qp = with_qp_selection(model)
+            qp_times.append(t)
+        tr, tq = statistics.median(reg_times), statistics.median(qp_times)
+        rows.append(f"| {name} | {reg.attrs['la_flow_iterations']} | {tr:.2f} | {tr / reg.attrs['la_flow_iterations']:.3f} | "
+                    f"{float(reg.collapse_multiplier):.6f} | {qp.attrs['la_flow_iterations']} | {tq:.2f} | "
+                    f"{tq / qp.attrs['la_flow_iterations']:.3f} | {float(qp.collapse_multiplier):.6f} | {tq / tr:.1f} |")
+        print(rows[-1], flush=True)
+    return rows
+
+
 def tolerance_rows(model):
-    _, reference = timed(model, {**NON, "flow_tolerance": 1e-9, "flow_iterations": 300})
+    _, reference = timed(model, {**NON, "flow_tolerance": 1e-10, "flow_iterations": 400})
     exact = float(reference.collapse_multiplier)
     rows = []
-    for tolerance in (1e-3, 1e-4, 1e-5, 1e-6):
+    for tolerance in (1e-3, 1e-4, 1e-5, 1e-6, 1e-7):
         seconds, result = timed(model, {**NON, "flow_tolerance": tolerance})
         rows.append(f"| {tolerance:g} | {result.attrs['la_flow_iterations']} | {seconds:.2f} | "
                     f"{float(result.collapse_multiplier):.7f} | {abs(float(result.collapse_multiplier) - exact):.1e} |")
@@ -62,25 +95,39 @@ def tolerance_rows(model):
     return exact, reference.attrs["la_flow_iterations"], rows
 
 
-def main() -> None:
+def main(argv=None) -> None:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--big", action="store_true", help="also the 10,000-unit wall (about 20 minutes)")
+    args = parser.parse_args(argv)
     load = os.getloadavg()
     walls = [(case, mf.open_model(case)) for case in mf.CASE_NAMES]
     ten = pair_rows(walls, PAIRS)
-    big = pair_rows([(f"running bond, {size:,} units", mf.build(running_bond_spec(*SIZES[size])))
-                     for size in (1_000,)], 1)
+    sizes = (1_000, 10_000) if args.big else (1_000,)
+    running = {size: mf.derive_geometry(mf.build(running_bond_spec(*SIZES[size]))) for size in sizes}
+    big = pair_rows([(f"running bond, {size:,} units", running[size]) for size in sizes], 1)
+    selection = selection_rows([(case, mf.open_model(case)) for case in ("test-12c", "panel-5", "facade-3")], PAIRS)
+    selection += selection_rows([("running bond, 1,000 units", running[1_000])], 1)
     exact, lps, tolerance = tolerance_rows(mf.open_model("facade-3"))
     header = ("| wall | blocks | alpha assoc. | alpha non-assoc. | LPs | assoc. [s] | non-assoc. [s] | ratio |\n"
               "|---|---:|---:|---:|---:|---:|---:|---:|")
+    not_big = "" if args.big else " (10,000 units: `--big`, not run this time)"
     body = f"""
 `masonryfw.solve(model, "la", {{"flow": "nonassociative"}})` (ipm backend, flow_tolerance 1e-6) against the
 associative solve; load average before: {load[0]:.2f}, {load[1]:.2f}, {load[2]:.2f}. Ten walls: medians of
-{PAIRS} alternating pairs after a warm-up; the running-bond wall: one pair (10,000 units not run: the
-selection QP alone takes about 2 s a sequence step at 1,000 units).
+{PAIRS} alternating pairs after a warm-up; the running-bond walls: one pair{not_big}.
 
 {header}
 {chr(10).join(ten + big)}
 
-Run time against error on Facade 3 (reference: flow_tolerance 1e-9, {lps} LPs, alpha {exact:.8f}):
+The selection side by side (same process, alternating; the running-bond wall one pair): each LP's
+forces by one solve of the regularised LP (the default) against the ipm LP followed by the selection
+QP (Clarabel):
+
+| wall | regularised: LPs | time [s] | per LP [s] | alpha | LP + QP: LPs | time [s] | per LP [s] | alpha | time ratio |
+|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|
+{chr(10).join(selection)}
+
+Run time against error on Facade 3 (reference: flow_tolerance 1e-10, {lps} LPs, alpha {exact:.8f}):
 
 | flow_tolerance | LPs | time [s] | alpha | error |
 |---:|---:|---:|---:|---:|

@@ -180,10 +180,10 @@ class NewtonSystem:
     where ``s dy + y ds = rc`` is the complementarity target.
     """
 
-    def __init__(self, normal: NormalMatrix, s, y, a, rp, ra, rd):
-        self.normal, self.s, self.y, self.a = normal, s, y, a
+    def __init__(self, normal: NormalMatrix, s, y, a, rp, ra, rd, weight):
+        self.normal, self.s, self.y, self.a, self.w = normal, s, y, a, weight
         self.rp, self.ra, self.rd = rp, ra, rd
-        self.d = y / s
+        self.d = y / (s + weight * y)
         normal.factorise(self.d)
         self.q = normal.factor.solve(a)
         self.aq = dot(a, self.q)
@@ -199,7 +199,7 @@ class NewtonSystem:
 
     def direction(self, rc: np.ndarray) -> Direction:
         dx, dy, dlam, g_dx = self._through_factor(rc / self.y - self.rp, self.rd, -self.ra)
-        return Direction(dx, dy, dlam, g_dx + self.rp)
+        return Direction(dx, dy, dlam, g_dx + self.w * dy + self.rp)
 
     def refine(self, step: Direction, rc: np.ndarray, dual_target: float) -> Direction:
         """Iterative refinement on the unreduced equations until the dual equation holds to ``dual_target``.
@@ -210,7 +210,7 @@ class NewtonSystem:
         """
         Gt, a = self.normal.Gt, self.a
         f1 = rc / self.y - self.rp
-        dx, dy, dlam, g_dx = step.dx, step.dy, step.dlam, step.ds - self.rp
+        dx, dy, dlam, g_dx = step.dx, step.dy, step.dlam, step.ds - self.rp - self.w * step.dy
         previous = np.inf
         for _ in range(REFINEMENT_STEPS):
             r2 = self.rd - Gt @ dy - a * dlam
@@ -218,31 +218,40 @@ class NewtonSystem:
             if size <= dual_target or size > 0.5 * previous:
                 break
             previous = size
-            r1 = f1 - g_dx - dy * (self.s / self.y)
+            r1 = f1 - g_dx - dy * (self.s / self.y + self.w)
             ex, ey, el, g_ex = self._through_factor(r1, r2, -self.ra - dot(a, dx))
             dx, dy, dlam, g_dx = dx + ex, dy + ey, dlam + el, g_dx + g_ex
-        return Direction(dx, dy, dlam, g_dx + self.rp)
+        return Direction(dx, dy, dlam, g_dx + self.w * dy + self.rp)
 
 
-def solve(cost, constraints, live, tolerance: float) -> IPMResult:
-    """Solve ``min c.x, G x >= 0, a.x = 1`` to ``tolerance`` (relative residuals and gap) or raise IPMFailure."""
+def solve(cost, constraints, live, tolerance: float, weight: np.ndarray | None = None,
+          normal: NormalMatrix | None = None) -> IPMResult:
+    """Solve ``min c.x, G x >= 0, a.x = 1`` to ``tolerance`` (relative residuals and gap) or raise IPMFailure.
+
+    With ``weight`` (``w >= 0``, one per row) the static side becomes ``max lam - sum(w y^2) / 2``:
+    the programme regularised by a quadratic in the multipliers, whose primal constraint is
+    ``G x + w y >= 0``. The Newton steps keep their form, with ``D = y / (s + w y)``.
+    ``normal``: the :class:`NormalMatrix` of ``constraints`` when the caller has it (a sequence of
+    LPs with the same ``G``).
+    """
     c = np.asarray(cost, dtype=float)
     a = np.asarray(live, dtype=float)
-    normal = NormalMatrix(constraints)
+    normal = NormalMatrix(constraints) if normal is None else normal
     G, Gt = normal.G, normal.Gt
     m = G.shape[0]
     if m == 0:
         raise IPMFailure("no constraints")
+    w = np.zeros(m) if weight is None else np.asarray(weight, dtype=float)
 
     x, s, y, lam = starting_point(normal, c, a)
     scale_c = 1.0 + np.abs(c).max()
     step_p = step_d = 0.0
     for iteration in range(MAX_ITERATIONS + 1):
-        rp = G @ x - s
+        rp = G @ x + w * y - s
         ra = dot(a, x) - 1.0
         rd = c - Gt @ y - lam * a
         mu = dot(s, y) / m
-        primal_obj = dot(c, x)
+        primal_obj = dot(c, x) + dot(w * y, y)  # the gap of the regularised pair is c.x + y.w.y - lam
         primal_err = max(np.abs(rp).max() / (1.0 + np.abs(s).max()), abs(ra))
         dual_err = np.abs(rd).max() / scale_c
         gap_err = max(abs(primal_obj - lam), m * mu) / (1.0 + abs(primal_obj))
@@ -253,7 +262,7 @@ def solve(cost, constraints, live, tolerance: float) -> IPMResult:
         if not (np.abs(x).max() < DIVERGENCE and np.abs(y).max() < DIVERGENCE and np.isfinite(mu)):
             raise IPMFailure(f"the iterates diverge after {iteration} iterations (no finite optimum)")
 
-        newton = NewtonSystem(normal, s, y, a, rp, ra, rd)
+        newton = NewtonSystem(normal, s, y, a, rp, ra, rd, w)
         # Mehrotra: the affine-scaling predictor sets the centring and the second-order term
         affine = newton.direction(-s * y)
         step_p, step_d = affine.steps(s, y)
@@ -276,6 +285,8 @@ def solve(cost, constraints, live, tolerance: float) -> IPMResult:
         dual_target = 0.1 * max(np.abs(rd).max(), tolerance * scale_c * 1e-6)
         step = newton.refine(step, rc, dual_target)
         step_p, step_d = step.steps(s, y)
+        if weight is not None:  # y is in the primal residual too: one step for all
+            step_p = step_d = min(step_p, step_d)
         step_p = STEP_TO_BOUNDARY * step_p
         step_d = STEP_TO_BOUNDARY * step_d
         x = x + step_p * step.dx
@@ -307,3 +318,4 @@ def starting_point(normal: NormalMatrix, c: np.ndarray, a: np.ndarray):
     s = s + 0.5 * sy / y.sum()
     y = y + 0.5 * sy / s.sum()
     return x, s, y, lam
+

@@ -60,8 +60,11 @@ def solve(model: xr.Dataset, options: Mapping[str, Any], progress=mf.no_progress
             la_flow_converged=int(flow.converged),
             la_flow_last_change=flow.change,
             la_alpha_associative=flow.alpha_associative,
-            la_flow_selection="the fixed point of the sequence of LPs started from the associative solution's "
-                              f"normal forces, {options['solver']} backend (docs/la.md)",
+            la_flow_selection="the first fixed point of the sequence of LPs started from the associative solution's "
+                              "normal forces; each LP's contact forces with the least squared normal forces, "
+                              + (f"by the LP regularised with weight {flow.selection_weight:g} (ipm)"
+                                 if options["solver"] == "ipm" else f"by a QP after the {options['solver']} LP")
+                              + " (docs/la.md)",
         )
         if not flow.converged:
             result.attrs["stop_reason"] = (f"the non-associative iteration did not converge in {len(flow.alphas)} "

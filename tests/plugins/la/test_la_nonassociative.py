@@ -96,3 +96,64 @@ def test_an_iteration_that_does_not_converge_says_so(walls, caplog):
     assert result.attrs["la_flow_converged"] == 0
     assert "did not converge" in result.attrs["stop_reason"]
     assert "did not converge" in caplog.text
+
+
+def first_nonassociative_lp(case: str):
+    """The first LP of the sequence on a bundled wall: capacities from the associative normal forces."""
+    from masonryfw_la import assembly, backends, nonassociative
+
+    model = mf.open_model(case)
+    wall = assembly.Wall.from_model(model)
+    scales = assembly.model_scales(model, wall)
+    kin = assembly.interface_kinematics(wall, scales)
+    lp = assembly.assemble(wall, scales, kin)
+    first = backends.solve_lp("highs", lp.cost, lp.constraints, lp.live, 1e-10)
+    normal = nonassociative.end_normal_forces(lp, first.y, wall.n_interface, scales)
+    return assembly.assemble(wall, scales, kin, normal_force=normal)
+
+
+@pytest.mark.parametrize("case", ["test-12c", "panel-1"])
+def test_the_regularised_lp_selects_the_least_squared_normal_forces(case, monkeypatch):
+    """One regularised ipm solve gives the LP's alpha and the forces of the selection QP (a second
+    formulation: HiGHS's LP, then Clarabel on the optimal face)."""
+    from masonryfw_la import backends, ipm, nonassociative
+
+    lp = first_nonassociative_lp(case)
+    exact = backends.solve_lp("highs", lp.cost, lp.constraints, lp.live, 1e-10)
+    monkeypatch.setattr(nonassociative, "SELECTION_TOLERANCE", 1e-10)
+    selected = nonassociative.least_compression(lp, exact.alpha_primal, 1e-10)
+    rows = nonassociative.selection_rows(lp) > 0
+    regularised = ipm.solve(lp.cost, lp.constraints, lp.live, nonassociative.SELECTION_IPM_TOLERANCE,
+                            weight=nonassociative.SELECTION_WEIGHT * rows)
+    assert regularised.lam == pytest.approx(exact.alpha_primal, abs=1e-9)
+    assert np.abs(regularised.y[rows] - selected[rows]).max() < 5e-5  # forces over the dead load
+    equilibrium = lp.constraints.T @ regularised.y + regularised.lam * lp.live - lp.cost
+    assert np.abs(equilibrium).max() < 1e-8
+
+
+def test_an_inexact_regularisation_is_caught_and_its_weight_lowered(walls, monkeypatch):
+    """With a weight far above the exactness threshold the regularised alpha falls short of the plain
+    LP's; the check at convergence lowers the weight until they agree, and the sequence ends where
+    it does from the default weight and, to the selections' accuracy, where the QP selection's does."""
+    from masonryfw_la import nonassociative
+
+    model = mf.open_model("panel-2")
+    default = float(walls.solve(model, **NONASSOCIATIVE).collapse_multiplier)
+    by_qp = float(walls.solve(model, solver="highs", **NONASSOCIATIVE).collapse_multiplier)
+    monkeypatch.setattr(nonassociative, "SELECTION_WEIGHT", 10.0)
+    result = walls.solve(model, **NONASSOCIATIVE)
+    assert result.attrs["la_flow_converged"] == 1
+    weight = float(result.attrs["la_flow_selection"].split("weight ")[1].split(" ")[0])
+    assert weight <= 0.01
+    assert float(result.collapse_multiplier) == pytest.approx(default, abs=2e-6)
+    assert float(result.collapse_multiplier) == pytest.approx(by_qp, abs=2e-5)
+
+
+@pytest.mark.parametrize("case", ["panel-1", "panel-2"])
+def test_the_sequence_stops_within_its_tolerance_of_its_limit(walls, case):
+    """A convergence study: the default stop against the same sequence run 10,000 times tighter."""
+    model = mf.open_model(case)
+    default = walls.solve(model, **NONASSOCIATIVE)
+    limit = walls.solve(model, flow="nonassociative", flow_tolerance=1e-10, flow_iterations=400)
+    assert limit.attrs["la_flow_converged"] == 1
+    assert float(default.collapse_multiplier) == pytest.approx(float(limit.collapse_multiplier), abs=2e-6)
