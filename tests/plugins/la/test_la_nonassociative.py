@@ -133,8 +133,8 @@ def test_the_regularised_lp_selects_the_least_squared_normal_forces(case, monkey
 
 def test_an_inexact_regularisation_is_caught_and_its_weight_lowered(walls, monkeypatch):
     """With a weight far above the exactness threshold the regularised alpha falls short of the plain
-    LP's; the check at convergence lowers the weight until they agree, and the sequence ends where
-    it does from the default weight and, to the selections' accuracy, where the QP selection's does."""
+    LP's (or the interior point does not converge); the weight is lowered until they agree, and the
+    sequence ends, to the selections' accuracy, where it does from the default weight and with the QP."""
     from masonryfw_la import nonassociative
 
     model = mf.open_model("panel-2")
@@ -145,7 +145,8 @@ def test_an_inexact_regularisation_is_caught_and_its_weight_lowered(walls, monke
     assert result.attrs["la_flow_converged"] == 1
     weight = float(result.attrs["la_flow_selection"].split("weight ")[1].split(" ")[0])
     assert weight < 10.0  # lowered (panel-2 is exact from 0.1 down)
-    assert float(result.collapse_multiplier) == pytest.approx(default, abs=2e-6)
+    # the fixed points of the selections differ by their accuracy (about 1e-5 on this wall)
+    assert float(result.collapse_multiplier) == pytest.approx(default, abs=2e-5)
     assert float(result.collapse_multiplier) == pytest.approx(by_qp, abs=2e-5)
 
 
