@@ -42,6 +42,7 @@ MAX_CORRECTORS = 2  # Gondzio centrality correctors per iteration
 REGULARISATION = 1e-13  # diagonal shift of M, relative to each diagonal entry
 MAX_REGULARISATION = 1e-5
 REFINEMENT_STEPS = 4
+STALL = 5  # iterations without halving the error: stalled (see ``acceptable``)
 DIVERGENCE = 1e12  # |x| or |y| beyond this (non-dimensional): no finite optimum
 
 
@@ -225,14 +226,15 @@ class NewtonSystem:
 
 
 def solve(cost, constraints, live, tolerance: float, weight: np.ndarray | None = None,
-          normal: NormalMatrix | None = None) -> IPMResult:
+          normal: NormalMatrix | None = None, acceptable: float | None = None) -> IPMResult:
     """Solve ``min c.x, G x >= 0, a.x = 1`` to ``tolerance`` (relative residuals and gap) or raise IPMFailure.
 
     With ``weight`` (``w >= 0``, one per row) the static side becomes ``max lam - sum(w y^2) / 2``:
     the programme regularised by a quadratic in the multipliers, whose primal constraint is
     ``G x + w y >= 0``. The Newton steps keep their form, with ``D = y / (s + w y)``.
     ``normal``: the :class:`NormalMatrix` of ``constraints`` when the caller has it (a sequence of
-    LPs with the same ``G``).
+    LPs with the same ``G``). ``acceptable``: a looser tolerance at which an iterate that has
+    stopped improving (:data:`STALL` iterations without halving its error) is returned.
     """
     c = np.asarray(cost, dtype=float)
     a = np.asarray(live, dtype=float)
@@ -246,6 +248,7 @@ def solve(cost, constraints, live, tolerance: float, weight: np.ndarray | None =
     x, s, y, lam = starting_point(normal, c, a)
     scale_c = 1.0 + np.abs(c).max()
     step_p = step_d = 0.0
+    errors: list[float] = []
     for iteration in range(MAX_ITERATIONS + 1):
         rp = G @ x + w * y - s
         ra = dot(a, x) - 1.0
@@ -255,7 +258,11 @@ def solve(cost, constraints, live, tolerance: float, weight: np.ndarray | None =
         primal_err = max(np.abs(rp).max() / (1.0 + np.abs(s).max()), abs(ra))
         dual_err = np.abs(rd).max() / scale_c
         gap_err = max(abs(primal_obj - lam), m * mu) / (1.0 + abs(primal_obj))
-        if max(primal_err, dual_err, gap_err) < tolerance:
+        error = max(primal_err, dual_err, gap_err)
+        if error < tolerance:
+            return IPMResult(x=x, y=y, lam=float(lam), iterations=iteration)
+        errors.append(error)
+        if acceptable is not None and error < acceptable and len(errors) > STALL and error > 0.5 * errors[-STALL - 1]:
             return IPMResult(x=x, y=y, lam=float(lam), iterations=iteration)
         if iteration == MAX_ITERATIONS:
             break
