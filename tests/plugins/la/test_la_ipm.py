@@ -109,3 +109,20 @@ def test_la_ipm_tied_mechanisms_come_out_symmetric(walls):
     assert np.abs(centroid[image] - mirrored).max() < 1e-9  # every block has its mirror image
     u = mf.block_motion(result)
     np.testing.assert_allclose(u[image] * [-1, 1, -1], u, atol=1e-6 * np.abs(u).max())
+
+
+def test_la_ipm_returns_a_stalled_iterate_only_at_the_acceptable_tolerance():
+    """Asked for more than double precision gives, the interior point stalls: an error, or, with an
+    acceptable tolerance, the stalled iterate, whose alpha is HiGHS's exact vertex's to that tolerance."""
+    from masonryfw_la import assembly
+
+    model = mf.open_model("test-12c")
+    wall = assembly.Wall.from_model(model)
+    scales = assembly.model_scales(model, wall)
+    lp = assembly.assemble(wall, scales, assembly.interface_kinematics(wall, scales))
+    exact = backends.solve_lp("highs", lp.cost, lp.constraints, lp.live, 1e-10).alpha_primal
+    with pytest.raises(ipm.IPMFailure, match="not converged"):
+        ipm.solve(lp.cost, lp.constraints, lp.live, 1e-20)
+    stalled = ipm.solve(lp.cost, lp.constraints, lp.live, 1e-20, acceptable=1e-9)
+    assert stalled.iterations < ipm.MAX_ITERATIONS
+    assert float(lp.cost @ stalled.x) == pytest.approx(exact, rel=1e-9)
