@@ -72,6 +72,7 @@ SELECTION_TOLERANCE = 1e-7
 SELECTION_WEIGHT = 1e-2
 SELECTION_BLOCKS = 100
 MIN_SELECTION_WEIGHT = 1e-7
+RETRY_WEIGHT = 0.1
 #: The regularised LP is solved this tightly (its selection is then within 2e-5 W of the QP's, measured), or
 #: to the LP's tolerance where it stalls above this (Test 8C: some of its LPs stall at 9e-10).
 SELECTION_IPM_TOLERANCE = 1e-10
@@ -131,9 +132,7 @@ def least_compression(lp: assembly.KinematicLP, alpha: float, tolerance: float) 
     import scipy.sparse as sp
 
     n_row, n_col = lp.constraints.shape
-    n_coh = lp.cohesive_ends.size
-    weight = np.zeros(n_row + 1)
-    weight[n_row - n_coh:n_row] = 1.0  # the third block of the cohesive rows: dn >= 0
+    weight = np.append(selection_rows(lp), 0.0)  # nothing on the live multiplier
     slack = 10 * tolerance * max(1.0, abs(alpha))
     matrix = sp.vstack([
         sp.hstack([lp.constraints.T, sp.csr_matrix(lp.live[:, None])]),  # = cost (zero cone)
@@ -184,23 +183,26 @@ def selected_solution(selection: Selection, lp: assembly.KinematicLP) -> backend
     a threshold weight its optimum is the LP's optimum with the least squared normal forces,
     Mangasarian & Meyer 1979, Friedlander & Tseng 2007; :func:`solve` checks it against the plain
     LP at the end). ``alpha_primal`` is then the static multiplier, a lower bound of the LP's.
-    Other backends, and an LP the regularised interior point fails on (measured: one LP of Test
-    8C's sequence stalls at a gap of 2e-8): the LP, then :func:`least_compression`.
+    An LP the regularised interior point fails on is tried once more with the weight times
+    :data:`RETRY_WEIGHT` (the 10,000-unit wall's 32nd LP diverged at 1e-4), then, like the other
+    backends' LPs, solved plainly and followed by :func:`least_compression` (one LP of Test 8C's
+    sequence stalls at a gap of 2e-8 whatever the weight).
     """
     from . import ipm
 
     if selection.regularised:
         if selection.normal_matrix is None:
             selection.normal_matrix = ipm.NormalMatrix(lp.constraints)
-        try:
-            result = ipm.solve(lp.cost, lp.constraints, lp.live, min(selection.tolerance, SELECTION_IPM_TOLERANCE),
-                               weight=selection.weight * selection_rows(lp), normal=selection.normal_matrix,
-                               acceptable=selection.tolerance)
-        except ipm.IPMFailure as failure:
-            LOG.info("la: the regularised LP failed (%s); this one by the LP and the selection QP", failure)
-        else:
-            return backends.LPSolution(x=result.x, y=result.y, alpha_primal=result.lam, alpha_dual=result.lam,
-                                       status="optimal (regularised)", iterations=result.iterations)
+        for weight in (selection.weight, RETRY_WEIGHT * selection.weight):
+            try:
+                result = ipm.solve(lp.cost, lp.constraints, lp.live, min(selection.tolerance, SELECTION_IPM_TOLERANCE),
+                                   weight=weight * selection_rows(lp), normal=selection.normal_matrix,
+                                   acceptable=selection.tolerance)
+            except ipm.IPMFailure as failure:
+                LOG.info("la: the regularised LP with weight %g failed (%s)", weight, failure)
+            else:
+                return backends.LPSolution(x=result.x, y=result.y, alpha_primal=result.lam, alpha_dual=result.lam,
+                                           status="optimal (regularised)", iterations=result.iterations)
     solution = backends.solve_lp(selection.backend, lp.cost, lp.constraints, lp.live, selection.tolerance)
     return replace(solution, y=least_compression(lp, solution.alpha_primal, selection.tolerance))
 
