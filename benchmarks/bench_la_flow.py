@@ -37,18 +37,23 @@ def timed(model, options):
     return time.perf_counter() - start, result
 
 
+def alternated(run_a, run_b, pairs):
+    """Median seconds and last result of ``run_a()`` and of ``run_b()``, run in turn ``pairs`` times."""
+    a_times, b_times = [], []
+    for _ in range(pairs):
+        seconds, a = run_a()
+        a_times.append(seconds)
+        seconds, b = run_b()
+        b_times.append(seconds)
+    return statistics.median(a_times), a, statistics.median(b_times), b
+
+
 def pair_rows(models, pairs):
     rows = []
     for name, model in models:
         if pairs > 1:
             timed(model, {})
-        a_times, n_times = [], []
-        for _ in range(pairs):
-            a, assoc = timed(model, {})
-            n, non = timed(model, NON)
-            a_times.append(a)
-            n_times.append(n)
-        ta, tn = statistics.median(a_times), statistics.median(n_times)
+        ta, assoc, tn, non = alternated(lambda: timed(model, {}), lambda: timed(model, NON), pairs)
         rows.append(f"| {name} | {model.sizes['block']} | {float(assoc.collapse_multiplier):.5f} | "
                     f"{float(non.collapse_multiplier):.6f} | {non.attrs['la_flow_iterations']} | {ta:.3f} | {tn:.3f} | "
                     f"{tn / ta:.1f} |")
@@ -69,16 +74,10 @@ def with_qp_selection(model):
 def selection_rows(models, pairs):
     rows = []
     for name, model in models:
-        reg_times, qp_times = [], []
-        for _ in range(pairs):
-            t, reg = timed(model, NON)
-            reg_times.append(t)
-            t, qp = with_qp_selection(model)
-            qp_times.append(t)
-        tr, tq = statistics.median(reg_times), statistics.median(qp_times)
-        rows.append(f"| {name} | {reg.attrs['la_flow_iterations']} | {tr:.2f} | {tr / reg.attrs['la_flow_iterations']:.3f} | "
-                    f"{float(reg.collapse_multiplier):.6f} | {qp.attrs['la_flow_iterations']} | {tq:.2f} | "
-                    f"{tq / qp.attrs['la_flow_iterations']:.3f} | {float(qp.collapse_multiplier):.6f} | {tq / tr:.1f} |")
+        tr, reg, tq, qp = alternated(lambda: timed(model, NON), lambda: with_qp_selection(model), pairs)
+        lr, lq = reg.attrs["la_flow_iterations"], qp.attrs["la_flow_iterations"]
+        rows.append(f"| {name} | {lr} | {tr:.2f} | {tr / lr:.3f} | {float(reg.collapse_multiplier):.6f} | {lq} | "
+                    f"{tq:.2f} | {tq / lq:.3f} | {float(qp.collapse_multiplier):.6f} | {tq / tr:.1f} |")
         print(rows[-1], flush=True)
     return rows
 

@@ -106,6 +106,7 @@ class FlowIteration:
     converged: bool
     change: float  # the last step's largest normal-force change (over the dead load)
     selection_weight: float  # of the ipm's regularised LPs (the other backends' selection is a QP)
+    stop_reason: str = ""  # why an unconverged sequence stopped
 
 
 def end_normal_forces(lp: assembly.KinematicLP, y: np.ndarray, n_interface: int,
@@ -251,8 +252,17 @@ def solve(wall: assembly.Wall, scales: assembly.Scales, kin: assembly.Kinematics
     change, rho = np.inf, 0.0
     previous: np.ndarray | None = None  # the last plain (not extrapolated) residual
     for k in range(cap):
-        lp = assembly.assemble(wall, scales, kin, normal_force=normal)
-        solution = selected_solution(selection, lp)
+        try:
+            lp_k = assembly.assemble(wall, scales, kin, normal_force=normal)
+            solution_k = selected_solution(selection, lp_k)
+        except mf.SolveError as error:
+            if not alphas:
+                raise
+            reason = f"LP {k + 1} of the non-associative sequence failed ({error}): the last iterate is reported"
+            LOG.warning("la: %s", reason)
+            return FlowIteration(lp, admissible(selection, lp, solution), alpha_associative, tuple(alphas), False,
+                                 change, selection.weight, reason)
+        lp, solution = lp_k, solution_k
         residual = end_normal_forces(lp, solution.y, wall.n_interface, scales) - normal
         change = float(np.abs(residual).max(initial=0.0))
         alpha = solution.alpha_primal
@@ -281,4 +291,5 @@ def solve(wall: assembly.Wall, scales: assembly.Scales, kin: assembly.Kinematics
     LOG.warning("la: the non-associative iteration did not converge in %d LPs (alpha %s, normal forces still "
                 "moving %.2e W); the last iterate is reported", cap, alphas[-3:], change)
     return FlowIteration(lp, admissible(selection, lp, solution), alpha_associative, tuple(alphas), False, change,
-                         selection.weight)
+                         selection.weight, f"the non-associative iteration did not converge in {cap} LPs: the last "
+                                           "iterate is reported")

@@ -67,8 +67,7 @@ def solve(model: xr.Dataset, options: Mapping[str, Any], progress=mf.no_progress
                               + " (docs/la.md)",
         )
         if not flow.converged:
-            result.attrs["stop_reason"] = (f"the non-associative iteration did not converge in {len(flow.alphas)} "
-                                           "LPs: the last iterate is reported")
+            result.attrs["stop_reason"] = flow.stop_reason
     result.attrs.update(
         la_backend=options["solver"],
         la_time_assembly_s=t_assembly,

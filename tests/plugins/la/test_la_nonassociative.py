@@ -158,3 +158,25 @@ def test_the_sequence_stops_within_its_tolerance_of_its_limit(walls, case):
     limit = walls.solve(model, flow="nonassociative", flow_tolerance=1e-10, flow_iterations=400)
     assert limit.attrs["la_flow_converged"] == 1
     assert float(default.collapse_multiplier) == pytest.approx(float(limit.collapse_multiplier), abs=2e-6)
+
+
+def test_an_lp_that_fails_mid_sequence_stops_it_with_the_last_iterate(walls, monkeypatch, caplog):
+    """Minutes of work are not thrown away for one LP: the last iterate, flagged, with the reason."""
+    from masonryfw_la import nonassociative
+
+    solved = nonassociative.selected_solution
+    calls = []
+
+    def failing_third(selection, lp):
+        calls.append(lp)
+        if len(calls) == 3:
+            raise mf.SolveError("la: the least-compression contact forces were not found (Clarabel: MaxIterations)")
+        return solved(selection, lp)
+
+    monkeypatch.setattr(nonassociative, "selected_solution", failing_third)
+    result = walls.solve(mf.open_model("test-12c"), **NONASSOCIATIVE)
+    assert result.attrs["la_flow_converged"] == 0
+    assert result.attrs["la_flow_iterations"] == 2
+    assert "LP 3 of the non-associative sequence failed" in result.attrs["stop_reason"]
+    assert "MaxIterations" in caplog.text
+    assert 0.7 < float(result.collapse_multiplier) < 0.76  # between the non-associative 0.7465 and the associative 0.7517
