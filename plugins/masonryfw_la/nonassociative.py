@@ -23,7 +23,7 @@ Converged when the estimated distance to the limit, the last step over ``1 - rho
 is at most ``tolerance * max(1, |alpha|)`` for alpha's last two steps (one alone can
 be a turning point) and at most :data:`FORCE_TOLERANCE` times the total dead load
 for every end's normal force. Measured against sequences run 250-400 LPs: alpha
-within 1e-6 of the limit on the bundled walls, 2.4e-6 on Facade 3 (a test on the last step alone left
+within 1e-6 of the limit on the bundled walls, 2.3e-6 on Facade 3 (a test on the last step alone left
 errors up to 3e-5, Test 12C). The fixed point is the solution reported: the forces of the
 last LP, whose capacities are (to the tolerance) those of its own normal forces.
 When the cap on the iterations is reached first, the last iterate is reported with
@@ -251,12 +251,13 @@ def solve(wall: assembly.Wall, scales: assembly.Scales, kin: assembly.Kinematics
     alphas: list[float] = []
     change, rho = np.inf, 0.0
     previous: np.ndarray | None = None  # the last plain (not extrapolated) residual
+    solution: backends.LPSolution | None = None
     for k in range(cap):
         try:
             lp_k = assembly.assemble(wall, scales, kin, normal_force=normal)
             solution_k = selected_solution(selection, lp_k)
         except mf.SolveError as error:
-            if not alphas:
+            if solution is None:
                 raise
             reason = f"LP {k + 1} of the non-associative sequence failed ({error}): the last iterate is reported"
             LOG.warning("la: %s", reason)
