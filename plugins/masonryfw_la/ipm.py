@@ -170,11 +170,11 @@ class Direction:
 
 
 class NewtonSystem:
-    """The Newton equations at one iterate, reduced to ``M(y / s)`` bordered by ``a``.
+    """The Newton equations at one iterate, reduced to ``M(y / (s + w y))`` bordered by ``a``.
 
-    Unreduced (``s`` eliminated with ``ds = G dx + rp``)::
+    Unreduced (``s`` eliminated with ``ds = G dx + w dy + rp``; ``w = 0`` but for a regularised solve)::
 
-        G dx + (s / y) dy = rc / y - rp
+        G dx + (s / y + w) dy = rc / y - rp
         G^T dy + a dlam   = rd
         a.dx              = -ra
 
@@ -325,4 +325,3 @@ def starting_point(normal: NormalMatrix, c: np.ndarray, a: np.ndarray):
     s = s + 0.5 * sy / y.sum()
     y = y + 0.5 * sy / s.sum()
     return x, s, y, lam
-
