@@ -56,7 +56,10 @@ def wall_spec(units: int) -> dict:
 def run(command: list[str], limit: float) -> tuple[float, float, int]:
     """Wall seconds, peak RSS [MiB] and exit status of ``command``; SIGINT after ``limit`` seconds."""
     start = time.perf_counter()
-    process = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    # SIGINT back to its default in the child: started from a background job it would inherit "ignored",
+    # and Python would then install no KeyboardInterrupt handler (a Ctrl-C that never arrives)
+    process = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+                               preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     interrupted = False
     while True:
         pid, status, usage = os.wait4(process.pid, os.WNOHANG)
