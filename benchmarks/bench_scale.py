@@ -77,7 +77,8 @@ def numbers(path: Path) -> str:
     """The result's key numbers, briefly."""
     if not path.exists():
         return "no result"
-    result = mf.open_dataset(path)
+    with mf.open_dataset(path) as result:
+        result.load()
     shown = {k.name: k.value for k in mf.key_numbers(result)}
     parts = []
     if "alpha" in shown:

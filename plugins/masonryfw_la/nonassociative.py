@@ -76,6 +76,8 @@ RETRY_WEIGHT = 0.1
 #: The regularised LP is solved this tightly (its selection is then within 2e-5 W of the QP's, measured), or
 #: to the LP's tolerance where it stalls above this (Test 8C: some of its LPs stall at 9e-10).
 SELECTION_IPM_TOLERANCE = 1e-10
+#: The status of a regularised solve, whose mechanism and alpha are replaced by the plain LP's when reported.
+REGULARISED = "optimal (regularised)"
 
 
 def contraction(residual: np.ndarray, previous: np.ndarray) -> float:
@@ -203,7 +205,7 @@ def selected_solution(selection: Selection, lp: assembly.KinematicLP) -> backend
                 LOG.info("la: the regularised LP with weight %g failed (%s)", weight, failure)
             else:
                 return backends.LPSolution(x=result.x, y=result.y, alpha_primal=result.lam, alpha_dual=result.lam,
-                                           status="optimal (regularised)", iterations=result.iterations)
+                                           status=REGULARISED, iterations=result.iterations)
     solution = backends.solve_lp(selection.backend, lp.cost, lp.constraints, lp.live, selection.tolerance)
     return replace(solution, y=least_compression(lp, solution.alpha_primal, selection.tolerance))
 
@@ -211,7 +213,7 @@ def selected_solution(selection: Selection, lp: assembly.KinematicLP) -> backend
 def admissible(selection: Selection, lp: assembly.KinematicLP, solution: backends.LPSolution) -> backends.LPSolution:
     """The solution to report: a regularised one gets the plain LP's mechanism and alpha (its own
     mechanism may open by ``weight y_n``) and keeps its selected forces."""
-    if not solution.status.endswith("(regularised)"):
+    if solution.status != REGULARISED:
         return solution
     plain = backends.solve_lp(selection.backend, lp.cost, lp.constraints, lp.live, selection.tolerance)
     return replace(plain, y=solution.y)
