@@ -10,10 +10,11 @@
    lowest and final reaction over R0, and the crack pattern against the default run
    (crack F1, macro-block ARI of the ``compare`` plugin).
 
-4. The deformable mode: element-steps per second of the CST update (the kernel alone and the
+4. Threads: one against two, alternating pairs on Test 12C and Facade 3.
+5. The deformable mode: element-steps per second of the CST update (the kernel alone and the
    whole explicit step), and Test 12C in both modes.
 
-Run: ``python benchmarks/bench_fdem.py`` (a few minutes); ``--deformable`` for part 4 only.
+Run: ``python benchmarks/bench_fdem.py`` (a few minutes); ``--deformable`` for part 5 only.
 """
 from __future__ import annotations
 
@@ -76,6 +77,24 @@ def sleep_rows(case: str) -> list[str]:
     return rows
 
 
+def thread_rows(case: str, pairs: int = 3) -> list[str]:
+    """One thread against two (option threads), in alternating pairs: medians and the ratio."""
+    import numpy as np
+
+    model = mf.open_model(case)
+    times: dict[int, list[float]] = {1: [], 2: []}
+    results = {}
+    for _ in range(pairs):
+        for threads in (1, 2):
+            results[threads], seconds = timed(model, {"threads": threads})
+            times[threads].append(seconds)
+    same = bool(np.array_equal(results[1].block_displacement.values, results[2].block_displacement.values))
+    one, two = (float(np.median(times[k])) for k in (1, 2))
+    ratios = [a / b for a, b in zip(times[1], times[2])]
+    return [f"| {case} | {results[1].attrs['fdem_face_pairs']} | {one:.1f} | {two:.1f} | {float(np.median(ratios)):.2f} "
+            f"({min(ratios):.2f}-{max(ratios):.2f}) | {'yes' if same else 'NO'} |"]
+
+
 def sweep_rows(case: str) -> list[str]:
     model = mf.open_model(case)
     base = {"plateau_tolerance": 0.0}
@@ -114,15 +133,24 @@ def main() -> None:
         "|---|---|---|---|---|---|---|---|---|---|",
         *sleep_rows("facade-3"),
     ]
+    print("threads", flush=True)
+    threads = [
+        "| case | face pairs | 1 thread [s] | 2 threads [s] | speed-up, median of pairs (range) | same trajectory, bit for bit |",
+        "|---|---|---|---|---|---|",
+        *thread_rows("test-12c"),
+        *thread_rows("facade-3"),
+    ]
     sweep = [
         "| option | time [s] | steps | R min / R0 | R end / R0 | crack F1 vs default | ARI vs default | max energy error |",
         "|---|---|---|---|---|---|---|---|",
         *sweep_rows("test-12c"),
     ]
     body = (
-        "Rigid mode, serial numba kernels (`@njit(cache=True)`), compile time excluded. "
+        "Rigid mode, numba kernels (`@njit(cache=True)`, the contact and block loops `parallel=True` on "
+        f"{os.cpu_count()} cores), compile time excluded. "
         "R0 = the moving support's dead reaction (uniform distribution, the paper's loading).\n\n"
         "### Throughput\n\n" + "\n".join(throughput) + "\n\n"
+        "### Threads (option `threads`; default: all cores)\n\n" + "\n".join(threads) + "\n\n"
         "### Sleeping blocks at rest\n\n" + "\n".join(sleeping) + "\n\n"
         "### Run time against error (Test 12C, 12 mm, no plateau stop; one option changed at a time)\n\n"
         + "\n".join(sweep) + "\n\n"

@@ -7,7 +7,7 @@ timed from outside with its peak resident memory (``os.wait4``); one that outliv
 time limit is interrupted with Ctrl-C (SIGINT), which keeps an incremental solver's history
 (exit 130), so the table says how far it got. Key numbers come from the result file.
 
-    python bench_scale.py [--sizes 300,1000,2400,10000] [--solvers la,fdem,jmm] [--limit 600]
+    python bench_scale.py [--sizes 300,1000,2400,10000] [--solvers la,fdem,jmm] [--limit 600] [--la-sizes 40000]
 
 Writes the ``scale`` section of docs/benchmarks.md.
 """
@@ -28,7 +28,7 @@ from _report import write_section
 import masonryfw as mf
 
 SIZES = (300, 1_000, 2_400, 10_000)
-SOLVERS = ("la", "fdem", "jmm")
+SOLVERS = ("la", "fdem", "jmm", "jmm-limit")
 
 
 def wall_spec(units: int) -> dict:
@@ -93,18 +93,34 @@ def numbers(path: Path) -> str:
     return ", ".join(parts)
 
 
+def growth(finished: dict[str, list[tuple[int, float]]]) -> str:
+    """``k`` of ``time ~ blocks^k`` between consecutive finished runs of each solver."""
+    parts = []
+    for solver, runs in finished.items():
+        steps = [f"{a:,}-{b:,}: {math.log(tb / ta) / math.log(b / a):.2f}"
+                 for (a, ta), (b, tb) in zip(runs, runs[1:])]
+        if steps:
+            parts.append(f"{solver} " + ", ".join(steps))
+    return "; ".join(parts) or "fewer than two finished sizes"
+
+
 def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--sizes", default=",".join(map(str, SIZES)))
     parser.add_argument("--solvers", default=",".join(SOLVERS))
     parser.add_argument("--limit", type=float, default=600.0, help="seconds before a solve is interrupted")
+    parser.add_argument("--la-sizes", default="40000", help="more sizes, for la alone")
     args = parser.parse_args(argv)
     sizes = [int(s) for s in args.sizes.split(",")]
     solvers = args.solvers.split(",")
+    la_sizes = [int(s) for s in args.la_sizes.split(",") if s]
     load = os.getloadavg()
     rows = []
+    finished: dict[str, list[tuple[int, float]]] = {}
     with tempfile.TemporaryDirectory() as tmp:
-        for size in sizes:
+        for size in sizes + la_sizes:
+            if size not in sizes and "la" not in solvers:
+                continue
             spec = Path(tmp, f"wall-{size}.toml")
             spec.write_text(mf.dump_toml(wall_spec(size)))
             model = Path(tmp, f"wall-{size}.nc")
@@ -112,21 +128,30 @@ def main(argv=None) -> None:
                                       args.limit)
             blocks = mf.open_dataset(model).sizes["block"]
             print(f"{size}: {blocks} blocks, built in {seconds:.1f} s", flush=True)
-            for solver in solvers:
+            for solver in solvers if size in sizes else ["la"]:
                 out = Path(tmp, f"wall-{size}.{solver}.nc")
+                expected = mf.estimate(mf.open_dataset(model), solver)
                 seconds, peak, code = run([sys.executable, "-m", "masonryfw", "solve", str(model), "--plugin",
                                            solver, "-o", str(out), "--no-progress"], args.limit)
-                rows.append(f"| {size:,} | {blocks:,} | {solver} | {seconds:.1f} | {peak:.0f} | {code} | {numbers(out)} |")
+                rows.append(f"| {size:,} | {blocks:,} | {solver} | {seconds:.1f} | {expected.seconds:.1f} | {peak:.0f} "
+                            f"| {expected.memory / 2**20:.0f} | {code} | {numbers(out)} |")
                 print(rows[-1], flush=True)
+                if code == 0:
+                    finished.setdefault(solver, []).append((blocks, seconds))
     body = f"""
 Running-bond walls of 200 x 50 mm units in issue 16's proportions (2,400 units: 8 m x 3 m; the right
 40 % of the base settling; gamma 18 kN/m3, mu = tan 30 deg, E = 3 GPa), each solver at its defaults,
 one CLI process per solve, timed from outside with its peak memory; interrupted (Ctrl-C, the history
-kept, exit 130) after {args.limit:.0f} s. Load average before: {load[0]:.2f}, {load[1]:.2f}, {load[2]:.2f}.
+kept, exit 130) after {args.limit:.0f} s. "Estimated": what the solver's `estimate` hook said before the
+run (the CLI prints it for runs over a minute; fdem's is to the target settlement, jmm's assumes 500
+Newton iterations). Load average before: {load[0]:.2f}, {load[1]:.2f}, {load[2]:.2f}.
 
-| units | blocks | solver | wall time [s] | peak memory [MiB] | exit | key numbers |
-|---:|---:|---|---:|---:|---:|---|
+| units | blocks | solver | wall time [s] | estimated [s] | peak memory [MiB] | estimated [MiB] | exit | key numbers |
+|---:|---:|---|---:|---:|---:|---:|---:|---|
 {chr(10).join(rows)}
+
+Growth of the whole-process time (about 1 s of it is start-up) with the number of blocks, time ~ blocks^k between consecutive finished
+sizes: {growth(finished)}.
 """
     write_section("scale", "Scale: every solver against the number of units", body)
     print(body)

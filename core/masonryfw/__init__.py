@@ -39,6 +39,7 @@ from .geometry import (
 from .hookspecs import (
     AUTO,
     Comparator,
+    Estimate,
     Option,
     Plotter,
     Solver,
@@ -56,6 +57,7 @@ from .model import checked_model, model_part, open_model
 from .plugins import (
     compare,
     core_version,
+    estimate,
     get_comparator,
     get_plotter,
     get_solver,
@@ -67,6 +69,7 @@ from .plugins import (
     solver_version,
 )
 from .progress import ProgressCallback, no_progress
+from .resources import available_memory, duration_text, size_text
 from .schema import FORMAT_VERSION, flags, load_schema, variable_attrs
 from .semantics import (
     INTACT_SHARE,

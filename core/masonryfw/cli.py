@@ -22,6 +22,7 @@ from masonryfw.plugins import command_plugin, installed_plugins, plugin_commands
 
 #: Exit status of a run stopped by Ctrl-C (128 + SIGINT), as shells report it.
 INTERRUPTED = 130
+LONG_RUN = 60.0  # seconds: the solve command prints the estimate of a run longer than this
 
 
 def _error_message(exc: BaseException) -> str:
@@ -323,6 +324,10 @@ def solve(model: str, solver: str, output: str | None, options: dict[str, str], 
     out = Path(output) if output else Path(f"{Path(model).stem if inputs else model}.{solver}.nc")
     mf.check_output_path(out, inputs)
     dataset = mf.open_model(model)
+    expected = mf.estimate(dataset, solver, options)
+    if expected is not None and expected.seconds > LONG_RUN:
+        click.echo(f"{solver}: expect about {mf.duration_text(expected.seconds)} and "
+                   f"{mf.size_text(expected.memory)} ({expected.basis}); Ctrl-C keeps what is computed", err=True)
     bar = _progress_bar(progress)
     try:
         result = mf.solve(dataset, solver, options, progress=bar)

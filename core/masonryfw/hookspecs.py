@@ -224,6 +224,23 @@ class Variant:
 
 
 @dataclass(frozen=True)
+class Estimate:
+    """What a solve will cost, known before it starts (:attr:`Solver.estimate`).
+
+    ``seconds`` and ``memory`` (peak resident bytes of the whole process) are rough: a
+    solver fits them to its own benchmarks (docs/benchmarks.md, section "scale") and says
+    in ``basis`` what they scale with. ``advice`` says which option makes the run smaller
+    (``"--option mesh_size=... larger than 0.025 m"``); the core repeats it when it refuses a
+    run that cannot fit.
+    """
+
+    seconds: float
+    memory: float
+    basis: str
+    advice: str = ""
+
+
+@dataclass(frozen=True)
 class Solver:
     """A named solver: ``solve(model, options, progress) -> primary result variables``.
 
@@ -236,6 +253,11 @@ class Solver:
     Interruption: a solve that catches ``KeyboardInterrupt`` returns what it has
     computed with the attribute ``interrupted = 1``; with nothing to return it
     lets the ``KeyboardInterrupt`` propagate.
+
+    ``estimate`` (optional): ``estimate(model, options) -> Estimate``, cheap (counts,
+    no factorisation, no time stepping). The core refuses a run whose memory does
+    not fit before it starts, and the CLI prints the estimate of a run longer than a
+    minute.
     """
 
     name: str
@@ -245,6 +267,7 @@ class Solver:
     options: tuple[Option, ...] = field(default_factory=tuple)
     variants: tuple[Variant, ...] = field(default_factory=tuple)
     gallery: bool = True
+    estimate: Callable[[xr.Dataset, Mapping[str, Any]], Estimate] | None = None
 
 
 @dataclass(frozen=True)

@@ -6,6 +6,12 @@ cvxopt) is 5-8x faster than SciPy's SuperLU on the 2-D matrices masonry models g
 (docs/benchmarks.md), and its ordering is computed once per pattern. SuperLU is the
 fallback when cvxopt is not installed: cvxopt is GPL-3, so a GPL-free install drops it
 and keeps working, slower, with the same results.
+
+The ordering of a large pattern (``ND_MIN_SIZE`` columns and more) is METIS's nested
+dissection (pymetis, MIT and Apache-2.0) rather than CHOLMOD's AMD: cvxopt's CHOLMOD is
+built without METIS, and on the 2-D meshes and contact graphs of big walls nested
+dissection halves the fill's work (jmm, 307,680 DOFs: a factor in 0.33 s against 0.65 s;
+docs/architecture.md). Without pymetis, AMD.
 """
 from __future__ import annotations
 
@@ -36,8 +42,30 @@ def cholesky_factor(lower: sp.csc_matrix, use_cholmod: bool | None = None) -> Ch
     return CholmodFactor(lower) if use_cholmod else SuperLUFactor(lower)
 
 
+ND_MIN_SIZE = 20_000  # columns from which nested dissection pays for its own time (see fill_reducing_order)
+
+
+def fill_reducing_order(lower: sp.csc_matrix) -> np.ndarray | None:
+    """METIS's nested dissection of the graph of ``lower`` (a permutation), or None: pattern smaller than
+    ``ND_MIN_SIZE`` or no pymetis (then CHOLMOD's AMD). Measured on the 307,680-DOF jmm pattern of the
+    2,432-block scale wall: 2.1 s once, then every factor in 0.33 s against 0.65 s (AMD); on la's
+    30,196-column LP of 10,067 blocks the factor and the solve 16 and 30 % faster."""
+    if lower.shape[0] < ND_MIN_SIZE:
+        return None
+    try:
+        import pymetis
+    except ImportError:
+        return None
+    graph = (lower + lower.T).tocsr()
+    graph.setdiag(0)
+    graph.eliminate_zeros()
+    order, _ = pymetis.nested_dissection(pymetis.CSRAdjacency(graph.indptr, graph.indices))  # (perm, iperm)
+    return np.asarray(order, dtype=np.int64)
+
+
 class CholmodFactor:
-    """Supernodal Cholesky of the lower triangle; one symbolic analysis (AMD) per pattern."""
+    """Supernodal Cholesky of the lower triangle; one symbolic analysis per pattern (nested dissection for a
+    large pattern, :func:`fill_reducing_order`, else AMD)."""
 
     name = "cholmod"
 
@@ -54,12 +82,15 @@ class CholmodFactor:
             cvxopt.matrix(np.ones(lower.nnz)), cvxopt.matrix(lower.indices.astype(int)),
             cvxopt.matrix(columns), (n, n),
         )
+        order = fill_reducing_order(lower)
+        self._order = None if order is None else cvxopt.matrix(order.astype(int))
         self._symbolic = None
 
     def factorise(self, values: np.ndarray) -> bool:
         self._matrix.V = self._cvxopt.matrix(np.asarray(values, dtype=float))
         if self._symbolic is None:
-            self._symbolic = self._cholmod.symbolic(self._matrix, uplo="L")
+            ordered = {} if self._order is None else {"p": self._order}
+            self._symbolic = self._cholmod.symbolic(self._matrix, uplo="L", **ordered)
         try:
             self._cholmod.numeric(self._matrix, self._symbolic)
         except ArithmeticError:

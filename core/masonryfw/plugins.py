@@ -29,11 +29,21 @@ from .checks import check
 from .damage import DERIVED_STEP_VARIABLES, damage_variables
 from .dofs import block_motion
 from .errors import MasonryError, ModelError, PluginError, SolveError
-from .hookspecs import PROJECT, Comparator, MasonryfwSpec, Plotter, Solver, resolve_options, unknown_name_message
+from .hookspecs import (
+    PROJECT,
+    Comparator,
+    Estimate,
+    MasonryfwSpec,
+    Plotter,
+    Solver,
+    resolve_options,
+    unknown_name_message,
+)
 from .hookspecs import resolved as resolved_function
 from .io import CONVENTIONS, add_history, content_sha256
 from .model import checked_model
 from .progress import ProgressCallback, no_progress
+from .resources import require_memory
 from .schema import FORMAT_VERSION, variable_attrs
 from .semantics import DERIVED_RESULT_VARIABLES, FLOW_RULES, ROTATIONS, derived_variables, plastic_crack_indicator
 
@@ -369,6 +379,29 @@ def _derive_comparable_fields(name: str, model: xr.Dataset, produced: xr.Dataset
     return produced.assign(derived)
 
 
+def estimate(model: xr.Dataset, plugin: str, options: Mapping[str, Any] | None = None) -> Estimate | None:
+    """The time and peak memory the solver called ``plugin`` expects on ``model`` (None if it gives none).
+
+    Raises :class:`SolveError` when the memory would not fit (:func:`masonryfw.resources.require_memory`):
+    the check :func:`solve` makes before it starts.
+    """
+    model = checked_model(model)
+    solver: Solver = _lookup("solver", plugin).record
+    resolved = resolve_options(f"solver {solver.name!r}", solver.options, dict(options or {}))
+    return _checked_estimate(solver, model, resolved)
+
+
+def _checked_estimate(solver: Solver, model: xr.Dataset, resolved: Mapping[str, Any]) -> Estimate | None:
+    if solver.estimate is None:
+        return None
+    function = _call_plugin("solver", solver.name, resolved_function, solver.estimate)
+    expected = _call_plugin("solver", solver.name, function, model, resolved)
+    if not isinstance(expected, Estimate):
+        raise SolveError(f"solver {solver.name}'s estimate returned {type(expected).__name__}, not an Estimate")
+    require_memory(solver.name, expected)
+    return expected
+
+
 def solve(
     model: xr.Dataset,
     plugin: str,
@@ -379,7 +412,8 @@ def solve(
 
     The model is checked unless it already is (:func:`masonryfw.checked_model`;
     every problem raises one :class:`ModelError`); the options are resolved and
-    checked against the solver's declared rules. The result holds the model's
+    checked against the solver's declared rules; a run whose estimated memory
+    (:func:`estimate`) exceeds what is available is refused. The result holds the model's
     variables, the solver's primary variables, the comparable fields the core
     derives from ``block_displacement`` (:mod:`masonryfw.semantics`) and the
     provenance attributes of docs/format.md. A result may be given: its model is
@@ -390,6 +424,7 @@ def solve(
     item = _lookup("solver", plugin)
     solver: Solver = item.record
     resolved = resolve_options(f"solver {solver.name!r}", solver.options, dict(options or {}))
+    _checked_estimate(solver, model, resolved)  # a run that cannot fit in memory is refused here
     function = _call_plugin("solver", solver.name, resolved_function, solver.solve)  # imported before the clock
 
     start = time.perf_counter()

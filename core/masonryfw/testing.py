@@ -41,7 +41,7 @@ from . import blocks
 from .checks import check
 from .errors import PluginError
 from .model import checked_model
-from .plugins import get_solver, solve
+from .plugins import estimate, get_solver, solve
 from .schema import flags, load_schema
 from .semantics import key_numbers
 
@@ -197,6 +197,13 @@ class SolverConformance:
             assert int(result.attrs.get("interrupted", 0)) == 1, (
                 f"{self.solver} swallowed a KeyboardInterrupt at progress call {at} and returned as if complete")
             assert check(result) == []
+
+    def test_an_estimate_is_finite_and_positive(self):
+        expected = estimate(self.conformance_model(), self.solver, self.options)
+        if expected is None:
+            return  # the hook is optional
+        assert 0 < expected.seconds < float("inf") and 0 < expected.memory < float("inf"), expected
+        assert expected.basis, f"{self.solver}: an estimate says what it is based on"
 
     def test_every_default_obeys_its_rules(self):
         for option in get_solver(self.solver).options:

@@ -25,5 +25,6 @@ def masonryfw_solvers():
             solve=mf.lazy("masonryfw_fdem.solver:solve"),
             version=__version__,
             options=OPTIONS,
+            estimate=mf.lazy("masonryfw_fdem.estimate:estimate"),
         )
     ]

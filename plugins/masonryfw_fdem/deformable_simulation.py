@@ -94,7 +94,7 @@ def initial_state(scene: Scene, controls: Controls, mesh: deformable.Mesh, load:
         faces=np.zeros((0, 4), np.int64), props=np.zeros((0, 4)), shear=np.zeros((0, 2)),
         bonded=np.zeros((0, 2), np.int64), normal=np.zeros((0, 2)), energy=np.zeros((0, 2)),
         acc=np.zeros(kernels.N_ACC), active=(~scene.driven).astype(np.int64),
-        calm=np.zeros(scene.driven.size, dtype=np.int64),
+        calm=np.zeros(scene.driven.size, dtype=np.int64), face_force=np.zeros((0, 4)),
         mesh=mesh, x=mesh.x0.copy(), y=mesh.y0.copy(), node_vel=np.zeros((mesh.x0.size, 2)))
     state.set_loads(scene, load)
     state.detect(scene, controls, first=True)

@@ -27,7 +27,7 @@ detection buffer since the last detection.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+from numba import njit, prange
 
 # Indices into the scalar state vector ``acc`` (accumulators carried between chunks).
 TIME, SETTLEMENT, WORK_GRAVITY, WORK_SUPPORT, DISSIPATED_DAMPING, DISSIPATED_FRICTION, RELEASED = range(7)
@@ -35,12 +35,13 @@ N_ACC = 7
 
 # error_model="numpy": float division by zero gives inf/nan instead of a checked branch (3x faster)
 jit = njit(cache=True, error_model="numpy")
+pjit = njit(cache=True, error_model="numpy", parallel=True)
 
 
-@jit
+@pjit
 def place_vertices(pos, lx, ly, offs, vx, vy):
-    """Current positions ``vx, vy`` of all nodes (one sine and cosine per block)."""
-    for b in range(offs.size - 1):
+    """Current positions ``vx, vy`` of all nodes (one sine and cosine per block; blocks in parallel)."""
+    for b in prange(offs.size - 1):
         c = np.cos(pos[b, 2])
         s = np.sin(pos[b, 2])
         for k in range(offs[b], offs[b + 1]):
@@ -231,11 +232,15 @@ def wake_sleepers(pos, vel, vx, vy, offs, faces, kn, min_half, normal, active, d
                 break
 
 
-@jit
+@pjit
 def contact_forces(pos, vel, vx, vy, offs, faces, props, kn, kt, min_half, contact_damping, inv_mass,
                    dt, shear, bonded, normal, energy, force, acc, update_history, active, driven, calm,
-                   wake_speed):
+                   wake_speed, face_force):
     """Add the contact forces of every face pair to ``force`` (block, 3).
+
+    Each pair's forces go to ``face_force`` (face, 4) first: the force on B (x, y), its moment on B
+    and on A (A gets minus the force), the pairs in parallel with numba's threads; then into
+    ``force`` in face order: the same sums, bit for bit, with any number of threads.
 
     ``props`` (face, 4): friction, cohesion and tensile strength per unit length
     (already times the thickness), and the model interface (post-processing only). ``shear`` (face, 2) is the
@@ -254,7 +259,7 @@ def contact_forces(pos, vel, vx, vy, offs, faces, props, kn, kt, min_half, conta
     touching sliding, which has no normal relative velocity.
 
     Sleeping: a pair of two inactive blocks (asleep, or supports standing still) is
-    skipped, its forces and spring energy frozen; :func:`wake_sleepers` runs first, so
+    skipped, its forces (kept in ``face_force``) and spring energy frozen, still acting on both; :func:`wake_sleepers` runs first, so
     every block integrated in this step gets all its contact forces. A loaded end sliding
     or opening faster than ``wake_speed`` resets both blocks' calm counters: nothing
     touched by a moving block falls asleep.
@@ -262,11 +267,15 @@ def contact_forces(pos, vel, vx, vy, offs, faces, props, kn, kt, min_half, conta
     if wake_speed > 0.0:
         wake_sleepers(pos, vel, vx, vy, offs, faces, kn, min_half, normal, active, driven, calm, wake_speed)
     stored = 0.0
-    for f in range(faces.shape[0]):
+    d_friction = 0.0
+    d_damping = 0.0
+    released = 0.0
+    for f in prange(faces.shape[0]):
         a, ea, b, eb = faces[f, 0], faces[f, 1], faces[f, 2], faces[f, 3]
-        if not active[a] and not active[b]:
+        if not active[a] and not active[b]:  # frozen: its forces and spring energy as they were
             stored += energy[f, 0] + energy[f, 1]
             continue
+        fbx = fby = mb = ma = 0.0
         g = face_geometry(vx, vy, offs, a, ea, b, eb)
         nx, ny, ox, oy, s_lo, s_hi = g[0], g[1], g[2], g[3], g[4], g[5]
         tx, ty = ny, -nx
@@ -274,11 +283,12 @@ def contact_forces(pos, vel, vx, vy, offs, faces, props, kn, kt, min_half, conta
         if half <= min_half:
             if update_history:  # the faces slid apart: the contact (and any bond) is gone
                 for e in range(2):
-                    acc[RELEASED] += energy[f, e]
+                    released += energy[f, e]
                     energy[f, e] = 0.0
                     shear[f, e] = 0.0
                     bonded[f, e] = 0
             normal[f, 0] = normal[f, 1] = 0.0
+            face_force[f, 0] = face_force[f, 1] = face_force[f, 2] = face_force[f, 3] = 0.0
             continue
         knp = kn * half
         ktp = kt * half
@@ -298,10 +308,10 @@ def contact_forces(pos, vel, vx, vy, offs, faces, props, kn, kt, min_half, conta
             ft = shear[f, e]
             if bonded[f, e] and fn_elastic < -ten and update_history:
                 bonded[f, e] = 0
-                acc[DISSIPATED_FRICTION] += 0.5 * fn_elastic * fn_elastic / knp
+                d_friction += 0.5 * fn_elastic * fn_elastic / knp
             if not bonded[f, e] and fn_elastic <= 0.0:  # open dry end: no force at all
                 if update_history:
-                    acc[DISSIPATED_FRICTION] += 0.5 * ft * ft / ktp
+                    d_friction += 0.5 * ft * ft / ktp
                     shear[f, e] = 0.0
                 normal[f, e] = 0.0
                 energy[f, e] = 0.0
@@ -312,7 +322,7 @@ def contact_forces(pos, vel, vx, vy, offs, faces, props, kn, kt, min_half, conta
             if not bonded[f, e] and fn < 0.0:
                 fn = 0.0
             if update_history:
-                acc[DISSIPATED_DAMPING] -= (fn - fn_elastic) * opening_rate * dt
+                d_damping -= (fn - fn_elastic) * opening_rate * dt
                 slip = (dvx * tx + dvy * ty) * dt
                 trial = ft - ktp * slip
                 cap = mu * max(fn, 0.0) + (coh if bonded[f, e] else 0.0)
@@ -320,13 +330,13 @@ def contact_forces(pos, vel, vx, vy, offs, faces, props, kn, kt, min_half, conta
                     if bonded[f, e]:  # brittle: the bond is lost at the first violation
                         bonded[f, e] = 0
                         if fn < 0.0:
-                            acc[DISSIPATED_FRICTION] += 0.5 * fn_elastic * fn_elastic / knp
+                            d_friction += 0.5 * fn_elastic * fn_elastic / knp
                             fn = 0.0
                             fn_elastic = 0.0
                         cap = mu * fn
                     limited = cap if trial > 0.0 else -cap
                     # friction work on the plastic part of the slip increment
-                    acc[DISSIPATED_FRICTION] += cap * (abs(trial) - cap) / ktp
+                    d_friction += cap * (abs(trial) - cap) / ktp
                     ft = limited
                 else:
                     ft = trial
@@ -338,13 +348,44 @@ def contact_forces(pos, vel, vx, vy, offs, faces, props, kn, kt, min_half, conta
             normal[f, e] = fn
             fx = fn * nx + ft * tx
             fy = fn * ny + ft * ty
-            force[b, 0] += fx
-            force[b, 1] += fy
-            force[b, 2] += (px - pos[b, 0]) * fy - (py - pos[b, 1]) * fx
-            force[a, 0] -= fx
-            force[a, 1] -= fy
-            force[a, 2] -= (px - pos[a, 0]) * fy - (py - pos[a, 1]) * fx
+            fbx += fx
+            fby += fy
+            mb += (px - pos[b, 0]) * fy - (py - pos[b, 1]) * fx
+            ma -= (px - pos[a, 0]) * fy - (py - pos[a, 1]) * fx
+        face_force[f, 0] = fbx
+        face_force[f, 1] = fby
+        face_force[f, 2] = mb
+        face_force[f, 3] = ma
+    acc[DISSIPATED_FRICTION] += d_friction
+    acc[DISSIPATED_DAMPING] += d_damping
+    acc[RELEASED] += released
+    for f in range(faces.shape[0]):  # in face order: the same sums with any number of threads
+        a, b = faces[f, 0], faces[f, 2]
+        force[b, 0] += face_force[f, 0]
+        force[b, 1] += face_force[f, 1]
+        force[b, 2] += face_force[f, 2]
+        force[a, 0] -= face_force[f, 0]
+        force[a, 1] -= face_force[f, 1]
+        force[a, 2] += face_force[f, 3]
     return stored
+
+
+@jit
+def unbalanced_beyond(i, force, load, added_load, load_share, added_share, free, radius, share):
+    """Whether block ``i``'s unbalanced force (translation, plus the moment over its radius) exceeds
+    ``share`` of its applied load (translation)."""
+    unbalanced = 0.0
+    applied = 0.0
+    for d in range(3):
+        if not free[i, d]:
+            continue
+        load_d = load_share * load[i, d] + added_share * added_load[i, d]
+        if d < 2:
+            unbalanced += abs(force[i, d] + load_d)
+            applied += abs(load_d)
+        else:
+            unbalanced += abs(force[i, d] + load_d) / radius[i]
+    return unbalanced > share * applied
 
 
 @jit
@@ -368,11 +409,87 @@ def smooth_share(tau, duration):
     return 0.5 * (1.0 - np.cos(np.pi * tau / duration))
 
 
+@pjit
+def integrate_velocities(dt, force, vel, mass, free, driven, active, calm, radius, load, added_load, load_share,
+                         added_share, damping, direction, rate_now, sleeping, wake_force):
+    """The velocity update of every block (in parallel): driven blocks follow the support's motion, free
+    ones the unbalanced force with Cundall's local damping; a sleeper wakes when :func:`unbalanced_beyond`.
+    Returns the work of the supports, the work of the loads and the damping's dissipation in the step."""
+    work_support = 0.0
+    work_gravity = 0.0
+    damped = 0.0
+    for i in prange(force.shape[0]):
+        if driven[i]:
+            for d in range(3):
+                v = rate_now * direction[i, d]
+                work_support -= force[i, d] * v * dt
+                vel[i, d] = v
+            continue
+        if not active[i]:
+            if not sleeping or not unbalanced_beyond(i, force, load, added_load, load_share, added_share, free,
+                                                     radius, wake_force):
+                continue
+            active[i] = 1  # loaded out of its equilibrium: awake from this step on
+            calm[i] = 0
+        for d in range(3):
+            if not free[i, d]:
+                vel[i, d] = 0.0
+                continue
+            applied = load_share * load[i, d] + added_share * added_load[i, d]
+            f = force[i, d] + applied
+            v_old = vel[i, d]
+            damp = 0.0
+            if v_old > 0.0:
+                damp = -damping * abs(f)
+            elif v_old < 0.0:
+                damp = damping * abs(f)
+            v_new = v_old + dt * (f + damp) / mass[i, d]
+            vel[i, d] = v_new
+            work_gravity += applied * v_new * dt
+            damped -= damp * v_new * dt
+    return work_support, work_gravity, damped
+
+
+@pjit
+def move_blocks(dt, pos, vel, pos0, mass, driven, active, calm, radius, direction, settlement, sleeping,
+                sleep_speed, sleep_steps):
+    """The position update of every block (in parallel); a block slow for ``sleep_steps`` steps falls asleep
+    and its kinetic energy, returned, is dissipated."""
+    dissipated = 0.0
+    for i in prange(pos.shape[0]):
+        if driven[i]:
+            for d in range(3):
+                pos[i, d] = pos0[i, d] + settlement * direction[i, d]
+        elif active[i]:
+            for d in range(3):
+                pos[i, d] += dt * vel[i, d]
+            if sleeping:
+                speed = np.hypot(vel[i, 0], vel[i, 1]) + abs(vel[i, 2]) * radius[i]
+                calm[i] = calm[i] + 1 if speed < sleep_speed else 0
+                if calm[i] >= sleep_steps:
+                    active[i] = 0
+                    for d in range(3):
+                        dissipated += 0.5 * mass[i, d] * vel[i, d] * vel[i, d]
+                        vel[i, d] = 0.0
+    return dissipated
+
+
+@pjit
+def farthest_move(pos, pos_detect, radius):
+    """The largest motion of a block since the last detection (centroid plus rotation times radius)."""
+    moved = np.empty(pos.shape[0])
+    for i in prange(pos.shape[0]):
+        moved[i] = np.hypot(pos[i, 0] - pos_detect[i, 0], pos[i, 1] - pos_detect[i, 1]) \
+            + abs(pos[i, 2] - pos_detect[i, 2]) * radius[i]
+    return moved.max()
+
+
 @jit
 def advance(n_steps, dt, pos, vel, pos0, pos_detect, radius, lx, ly, offs, faces, props, kn, kt,
             min_half, contact_damping, inv_mass, shear, bonded, normal, energy, mass, free, driven, moving,
             direction, load, load_ramp, added_load, added_start, added_time, damping, rate, ramp_time,
-            start_time, target, half_buffer, active, calm, sleep_speed, sleep_steps, acc, out):
+            start_time, target, half_buffer, active, calm, sleep_speed, sleep_steps, wake_force, face_force,
+            acc, out):
     """Up to ``n_steps`` explicit central-difference steps.
 
     Local non-viscous damping (Cundall): each free component of the unbalanced
@@ -387,7 +504,10 @@ def advance(n_steps, dt, pos, vel, pos0, pos_detect, radius, lx, ly, offs, faces
     Sleeping (``sleep_speed`` > 0, settlement phase only), as rigid-body engines do: a
     free block slower than ``sleep_speed`` (centroid speed plus spin times radius) for
     ``sleep_steps`` steps in a row stops being integrated until a contact wakes it
-    (see :func:`contact_forces`); moving supports are active while they move.
+    (see :func:`contact_forces`) or its unbalanced force (translation, and the moment over its
+    radius) exceeds ``wake_force`` times its load: a neighbour creeping below the sleep speed
+    still loads it more and more, and it must follow. Moving supports are active while they move.
+    ``face_force`` (face, 4): each pair's forces, kept for the frozen pairs of sleepers.
 
     ``out`` receives: steps done, rebuild needed (0/1), reaction on the moving
     supports (upward force on the wall), kinetic energy, stored energy,
@@ -415,59 +535,22 @@ def advance(n_steps, dt, pos, vel, pos0, pos_detect, radius, lx, ly, offs, faces
                 active[i] = 1 if (moving[i] and rate_now != 0.0) else 0
         stored = contact_forces(pos, vel, vx, vy, offs, faces, props, kn, kt, min_half, contact_damping,
                                 inv_mass, dt, shear, bonded, normal, energy, force, acc, True, active,
-                                driven, calm, sleep_speed if sleeping else 0.0)
+                                driven, calm, sleep_speed if sleeping else 0.0, face_force)
         load_share = 1.0
         if time < load_ramp:
             load_share = 0.5 * (1.0 - np.cos(np.pi * time / load_ramp))
-        for i in range(n_block):
-            if driven[i]:
-                for d in range(3):
-                    v = rate_now * direction[i, d]
-                    acc[WORK_SUPPORT] -= force[i, d] * v * dt
-                    vel[i, d] = v
-                continue
-            if not active[i]:
-                continue
-            for d in range(3):
-                if not free[i, d]:
-                    vel[i, d] = 0.0
-                    continue
-                applied = load_share * load[i, d] + added_share * added_load[i, d]
-                f = force[i, d] + applied
-                v_old = vel[i, d]
-                damp = 0.0
-                if v_old > 0.0:
-                    damp = -damping * abs(f)
-                elif v_old < 0.0:
-                    damp = damping * abs(f)
-                v_new = v_old + dt * (f + damp) / mass[i, d]
-                vel[i, d] = v_new
-                acc[WORK_GRAVITY] += applied * v_new * dt
-                acc[DISSIPATED_DAMPING] -= damp * v_new * dt
+        work_support, work_gravity, damped = integrate_velocities(
+            dt, force, vel, mass, free, driven, active, calm, radius, load, added_load, load_share, added_share,
+            damping, direction, rate_now, sleeping, wake_force)
+        acc[WORK_SUPPORT] += work_support
+        acc[WORK_GRAVITY] += work_gravity
+        acc[DISSIPATED_DAMPING] += damped
         acc[SETTLEMENT] += rate_now * dt
-        for i in range(n_block):
-            if driven[i]:
-                for d in range(3):
-                    pos[i, d] = pos0[i, d] + acc[SETTLEMENT] * direction[i, d]
-            elif active[i]:
-                for d in range(3):
-                    pos[i, d] += dt * vel[i, d]
-                if sleeping:
-                    speed = np.hypot(vel[i, 0], vel[i, 1]) + abs(vel[i, 2]) * radius[i]
-                    calm[i] = calm[i] + 1 if speed < sleep_speed else 0
-                    if calm[i] >= sleep_steps:  # the kinetic energy it still had is dissipated
-                        active[i] = 0
-                        for d in range(3):
-                            acc[DISSIPATED_DAMPING] += 0.5 * mass[i, d] * vel[i, d] * vel[i, d]
-                            vel[i, d] = 0.0
+        acc[DISSIPATED_DAMPING] += move_blocks(dt, pos, vel, pos0, mass, driven, active, calm, radius, direction,
+                                               acc[SETTLEMENT], sleeping, sleep_speed, sleep_steps)
         acc[TIME] = time + dt
         steps += 1
-        moved = 0.0
-        for i in range(n_block):
-            m = np.hypot(pos[i, 0] - pos_detect[i, 0], pos[i, 1] - pos_detect[i, 1]) \
-                + abs(pos[i, 2] - pos_detect[i, 2]) * radius[i]
-            moved = max(moved, m)
-        if moved > half_buffer:
+        if farthest_move(pos, pos_detect, radius) > half_buffer:
             rebuild = 1
             break
         if target > 0.0 and acc[SETTLEMENT] >= target:
@@ -477,7 +560,7 @@ def advance(n_steps, dt, pos, vel, pos0, pos_detect, radius, lx, ly, offs, faces
     place_vertices(pos, lx, ly, offs, vx, vy)
     stored = contact_forces(pos, vel, vx, vy, offs, faces, props, kn, kt, min_half, contact_damping,
                             inv_mass, dt, shear, bonded, normal, energy, force, acc, False, active,
-                            driven, calm, 0.0)
+                            driven, calm, 0.0, face_force)
     reaction = 0.0
     kinetic = 0.0
     unbalanced = 0.0

@@ -62,6 +62,7 @@ class Controls:
     min_cos: float
     sleep_speed: float  # 0: no sleeping
     sleep_steps: int
+    wake_force: float
     plateau_tolerance: float
     plateau_window: float
     snapshots: tuple[float, ...]
@@ -122,6 +123,7 @@ class State:
     acc: np.ndarray
     active: np.ndarray  # (block,) 1 while integrated (free blocks not asleep)
     calm: np.ndarray  # (block,) consecutive slow steps
+    face_force: np.ndarray  # (face, 4) each pair's forces (kernels.contact_forces), frozen while both sleep
     steps: int = 0
     rebuilds: int = 0
     gravity_steps: int = 0
@@ -169,12 +171,16 @@ def initial_state(scene: Scene, controls: Controls) -> State:
     return State(pos=pos, vel=np.zeros_like(pos), pos_detect=pos.copy(), faces=faces, props=props,
                  shear=shear, bonded=bonded, normal=np.zeros((faces.shape[0], 2)), energy=energy,
                  acc=np.zeros(kernels.N_ACC), active=(~scene.driven).astype(np.int64),
-                 calm=np.zeros(scene.driven.size, dtype=np.int64))
+                 calm=np.zeros(scene.driven.size, dtype=np.int64), face_force=np.zeros((faces.shape[0], 4)))
 
 
 def rebuild(scene: Scene, controls: Controls, state: State) -> None:
+    """New face pairs at the current positions; every free block wakes (the new pairs have no frozen forces)."""
     state.faces, state.props, state.shear, state.bonded, state.energy = detect(scene, controls, state, state.pos)
     state.normal = np.zeros((state.faces.shape[0], 2))
+    state.face_force = np.zeros((state.faces.shape[0], 4))
+    state.active[~scene.driven] = 1
+    state.calm[:] = 0
     state.pos_detect = state.pos.copy()
     state.rebuilds += 1
 
@@ -188,7 +194,8 @@ def advance(scene: Scene, controls: Controls, state: State, n_steps: int, rate: 
                     state.energy, scene.mass, scene.free, scene.driven, scene.moving, scene.direction, state.load,
                     controls.load_ramp, state.added, state.added_start, state.added_time, controls.damping, rate,
                     controls.ramp_time, state.settlement_start, target, 0.5 * controls.buffer, state.active,
-                    state.calm, controls.sleep_speed, controls.sleep_steps, state.acc, out)
+                    state.calm, controls.sleep_speed, controls.sleep_steps, controls.wake_force, state.face_force,
+                    state.acc, out)
 
 
 def chunk(scene: Scene, controls: Controls, state: State, n_steps: int, rate: float, target: float) -> np.ndarray:

@@ -15,7 +15,7 @@ import xarray as xr
 
 import masonryfw as mf
 
-from . import postprocess
+from . import estimate, postprocess
 from .scene import Scene, build_scene
 from .simulation import Controls, History, State, initial_state, run
 
@@ -77,6 +77,7 @@ def make_controls(scene: Scene, options: Mapping[str, Any]) -> Controls:
         min_cos=float(np.cos(np.radians(options["max_contact_angle"]))),
         sleep_speed=options["sleep"] * rate,
         sleep_steps=options["sleep_steps"],
+        wake_force=options["wake_force"],
         plateau_tolerance=options["plateau_tolerance"],
         plateau_window=options["plateau_window"],
         snapshots=tuple(v / length for v in options["snapshots"]),
@@ -101,12 +102,20 @@ def solve(model: xr.Dataset, options: Mapping[str, Any], progress=mf.no_progress
     Numba's compilation (or cache loading) of the kernels on a first run is
     measured apart and reported as ``compile_time_s``.
     """
+    import numba
     from numba.core import event
 
     compiling = event.TimingListener()
-    with event.install_listener("numba:compile", compiling):
-        result = _solve(model, options, progress)
+    threads = estimate.threads(options)
+    before = numba.get_num_threads()
+    numba.set_num_threads(threads)
+    try:
+        with event.install_listener("numba:compile", compiling):
+            result = _solve(model, options, progress)
+    finally:
+        numba.set_num_threads(before)
     result.attrs["compile_time_s"] = float(compiling.duration) if compiling.done else 0.0
+    result.attrs["fdem_threads"] = threads
     return result
 
 

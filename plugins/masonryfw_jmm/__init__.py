@@ -22,6 +22,7 @@ def masonryfw_solvers():
                     "gravity, then settlement steps (Newton) to the reaction plateau; plastic points",
             solve=mf.lazy("masonryfw_jmm.solver:solve"),
             options=INCREMENTAL_OPTIONS,
+            estimate=mf.lazy("masonryfw_jmm.estimate:estimate"),
         ),
         mf.Solver(
             name="jmm-limit",
@@ -29,6 +30,7 @@ def masonryfw_solvers():
                     "smallest moving-support reaction, alpha, plastic points",
             solve=mf.lazy("masonryfw_jmm.limit:solve"),
             options=LIMIT_OPTIONS,
+            estimate=mf.lazy("masonryfw_jmm.estimate:estimate_limit"),
             gallery=False,
         ),
     ]

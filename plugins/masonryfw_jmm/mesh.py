@@ -71,7 +71,7 @@ def support_segments(model: xr.Dataset) -> tuple[np.ndarray, np.ndarray]:
     return segments, np.where(support[sides[on, 0]], sides[on, 0], sides[on, 1])
 
 
-def _grid_lines(edges: np.ndarray, size: float, tol: float) -> np.ndarray:
+def grid_lines(edges: np.ndarray, size: float, tol: float) -> np.ndarray:
     """Sorted unique ``edges`` with every gap split into equal parts no longer than ``size``."""
     edges = np.unique(np.round(edges / tol) * tol)
     parts = np.maximum(np.ceil(np.diff(edges) / size * (1 - 1e-6)).astype(int), 1)  # 1e-6: sizes read from data
@@ -86,8 +86,8 @@ def structured_mesh(model: xr.Dataset, size: float) -> tuple[np.ndarray, np.ndar
     box = block_boxes(model)
     b = masonry(model)
     tol = 1e-9 * mf.model_scale(model.node_x.values, model.node_y.values)
-    xs = _grid_lines(box[:, [0, 2]].ravel(), size, tol)
-    ys = _grid_lines(box[b][:, [1, 3]].ravel(), size, tol)
+    xs = grid_lines(box[:, [0, 2]].ravel(), size, tol)
+    ys = grid_lines(box[b][:, [1, 3]].ravel(), size, tol)
     cx, cy = 0.5 * (xs[1:] + xs[:-1]), 0.5 * (ys[1:] + ys[:-1])
     owner = np.full((cy.size, cx.size), -1)
     i0, i1 = np.searchsorted(cx, box[b, 0]), np.searchsorted(cx, box[b, 2])

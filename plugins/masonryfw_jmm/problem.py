@@ -255,15 +255,25 @@ class Domain:
         return regularised(self.strength.scaled(self.stress), apex_shift)
 
 
+def masonry_height(model: xr.Dataset) -> float:
+    box = block_boxes(model)[masonry(model)]
+    return float(box[:, 3].max() - box[:, 1].min())
+
+
+def auto_mesh_size(model: xr.Dataset) -> float:
+    """The ``mesh_size`` option's automatic value: half the median unit height (a tenth of the masonry height
+    without units)."""
+    if (model.block_role.values == ROLE["unit"]).any():
+        return median_unit_height(model, bed_angles(model)) / 2
+    return masonry_height(model) / 20
+
+
 def wall_domain(model: xr.Dataset, mesh_size: float | None, beta: float | None,
                 dilatancy: float | None = None) -> Domain:
     """Mesh the wall (cells no larger than ``mesh_size``, auto: half the unit height), scale it, read its strength."""
-    blocks = masonry(model)
-    box = block_boxes(model)[blocks]
-    H = float(box[:, 3].max() - box[:, 1].min())
+    H = masonry_height(model)
     angles = bed_angles(model)
-    has_units = (model.block_role.values == ROLE["unit"]).any()
-    size = mesh_size if mesh_size is not None else (median_unit_height(model, angles) if has_units else H / 10) / 2
+    size = mesh_size if mesh_size is not None else auto_mesh_size(model)
     mesh = wall_mesh(model, size)
     gamma_ref = float(model.block_unit_weight.values[mesh.block].max())
     if not gamma_ref > 0:

@@ -19,5 +19,6 @@ def masonryfw_solvers():
             solve=mf.lazy("masonryfw_la.solver:solve"),
             options=OPTIONS,
             variants=VARIANTS,
+            estimate=mf.lazy("masonryfw_la.estimate:estimate"),
         )
     ]

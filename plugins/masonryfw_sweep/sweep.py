@@ -130,7 +130,8 @@ def dask_client(scheduler: str | None = None, workers: int | None = None) -> Ite
     """A client of the cluster at ``scheduler`` (left running), or of a new local cluster.
 
     The local cluster has ``workers`` processes (default: one per core available
-    to this process), one thread each, no dashboard; it is closed on exit.
+    to this process), one thread each (numba's too: fdem's parallel loops would otherwise
+    start a thread per core in every process), no dashboard; it is closed on exit.
     """
     Client, LocalCluster = _distributed("Client", "LocalCluster")
 
@@ -139,7 +140,8 @@ def dask_client(scheduler: str | None = None, workers: int | None = None) -> Ite
             yield client
         return
     with LocalCluster(n_workers=workers or available_cores(), threads_per_worker=1, processes=True,
-                      dashboard_address=None, silence_logs=logging.ERROR) as cluster, Client(cluster) as client:
+                      dashboard_address=None, silence_logs=logging.ERROR,
+                      env={"NUMBA_NUM_THREADS": "1"}) as cluster, Client(cluster) as client:
         yield client
 
 

@@ -68,9 +68,14 @@ def solve(model, options, progress):
     return xr.Dataset({"collapse_multiplier": ((), 0.5, mf.variable_attrs("collapse_multiplier"))})
 
 
+def estimate(model, options):
+    return mf.Estimate(seconds=float(os.environ.get("MASONRYFW_SPY_SECONDS", "1")), memory=1e6,
+                       basis="the spy's guess")
+
+
 @mf.hookimpl
 def masonryfw_solvers():
-    return [mf.Solver("spy", "leaves a mark", solve)]
+    return [mf.Solver("spy", "leaves a mark", solve, estimate=estimate)]
 '''
 
 
@@ -126,6 +131,29 @@ def test_unwritable_folder_is_refused_before_solving(spec, tmp_path, spy_site):
     done = run(["solve", spec, "--plugin", "spy", "-o", locked / "x.nc"], tmp_path,
                env={"PYTHONPATH": str(spy_site), "MASONRYFW_SPY_MARK": str(mark)})
     assert done.returncode == 1 and message in done.stderr and not mark.exists()
+
+
+# ---------------------------------------------------------------- estimates and memory before the work
+
+def test_a_long_run_prints_its_estimate_first(spec, tmp_path, spy_site):
+    env = {"PYTHONPATH": str(spy_site), "MASONRYFW_SPY_MARK": str(tmp_path / "mark")}
+    quick = run(["solve", spec, "--plugin", "spy", "-o", tmp_path / "a.nc"], tmp_path, env=env)
+    assert quick.returncode == 0 and "expect about" not in quick.stderr
+    long = run(["solve", spec, "--plugin", "spy", "-o", tmp_path / "b.nc"], tmp_path,
+               env={**env, "MASONRYFW_SPY_SECONDS": "5400"})
+    assert long.returncode == 0 and "spy: expect about 90 min and 1 MiB (the spy's guess)" in long.stderr
+
+
+def test_a_run_that_cannot_fit_in_memory_is_refused_naming_the_option(spec, tmp_path):
+    out = tmp_path / "r.nc"
+    done = run(["solve", spec, "--plugin", "jmm", "-o", out], tmp_path, env={"MASONRYFW_MEMORY_LIMIT": "150MiB"})
+    assert done.returncode == 1 and "Traceback" not in done.stderr, done.stderr
+    for words in ("needs about", "150 MiB is available", "--option mesh_size", "MASONRYFW_MEMORY_LIMIT"):
+        assert words in done.stderr, done.stderr
+    assert not out.exists()
+    coarse = run(["solve", spec, "--plugin", "jmm-limit", "-o", out, "--option", "mesh_size=0.1"], tmp_path,
+                 env={"MASONRYFW_MEMORY_LIMIT": "1GiB"})
+    assert coarse.returncode == 0, coarse.stderr
 
 
 @pytest.fixture(scope="module")

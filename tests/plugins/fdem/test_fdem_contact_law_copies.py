@@ -52,7 +52,8 @@ def compare_once(seed) -> dict:
     force, acc = np.zeros((2, 3)), np.zeros(N_ACC)
     stored = kernels.contact_forces(pos, vel, vx, vy, offs, faces, props, kn, kt, min_half, damping,
                                     1.0 / mass, dt, rigid["shear"], rigid["bonded"], rigid["normal"], rigid["energy"],
-                                    force, acc, True, np.ones(2, dtype=np.int64), driven, np.zeros(2, np.int64), 0.0)
+                                    force, acc, True, np.ones(2, dtype=np.int64), driven, np.zeros(2, np.int64), 0.0,
+                                    np.zeros((n_face, 4)))
 
     # the same state on nodes: each vertex moves with its block's rigid velocity; node inverse masses chosen
     # so that the nodal dashpot's mass (half the sum over the four nodes of a pair) is the blocks' reduced mass

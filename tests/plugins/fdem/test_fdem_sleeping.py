@@ -73,3 +73,25 @@ def test_sleeping_keeps_the_cracks_and_the_reaction_of_the_awake_run(small_wall,
     lowest_sleeping = sleeping_run.step_reaction.values[sleeping_run.step_phase.values == 1].min()
     assert abs(lowest_sleeping - lowest_awake) < 0.01 * r0
     assert abs(late_reaction(sleeping_run) - late_reaction(awake_run)) < 0.01 * r0
+
+
+def test_the_supports_carry_the_whole_weight_with_sleepers_on_them(small_wall, sleeping_run):
+    """Pairs of two still blocks (a sleeper on the fixed support) keep acting: at the end, at rest, the
+    supports' reactions add up to the masonry's weight (the frozen pairs were left out of them before)."""
+    weight = -small_wall.dead_load.values[small_wall.block_role.values < 2, 1].sum()
+    carried = sleeping_run.step_support_reaction.values[-1].sum()
+    assert sleeping_run.attrs["fdem_asleep_blocks"] > 0
+    assert carried == pytest.approx(weight, rel=1e-3)
+
+
+def test_a_sleeper_loaded_out_of_equilibrium_wakes(small_wall, awake_run):
+    """The part of the wall over the settling edge creeps below the sleep speed; its blocks, once asleep,
+    are loaded more and more by it and must follow (option wake_force): the plateau stays within 0.3 % of
+    R0 of the awake run's, where sleepers that only woke on a fast neighbour gave 0.5 % (0.6 % with sleep
+    0.003-0.0003: a lower sleep speed does not help)."""
+    r0 = dead_reaction(small_wall)
+    following = mf.solve(small_wall, "fdem", {"sleep": 0.01})
+    frozen = mf.solve(small_wall, "fdem", {"sleep": 0.01, "wake_force": 1e6})
+    awake = mf.solve(small_wall, "fdem", {})
+    assert abs(late_reaction(following) - late_reaction(awake)) < 0.003 * r0
+    assert abs(late_reaction(frozen) - late_reaction(awake)) > 0.004 * r0

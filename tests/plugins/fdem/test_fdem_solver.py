@@ -105,3 +105,14 @@ def test_wall_that_never_comes_to_rest_is_an_error(walls):
     model = walls.gravity_rotated(mf.build(walls.single_block_spec(0.4, 0.2, 30.0)), 40.0)
     with pytest.raises(mf.SolveError, match="did not come to rest"):
         mf.solve(model, "fdem", {})
+
+
+def test_the_threads_do_not_change_a_single_bit(small_wall):
+    """The face pairs' forces are computed in parallel but summed in face order: one thread and two give
+    the same trajectory, bit for bit (option threads)."""
+    options = {"settlement": 0.002, "plateau_tolerance": 0.0}
+    one = mf.solve(small_wall, "fdem", options | {"threads": 1})
+    two = mf.solve(small_wall, "fdem", options | {"threads": 2})
+    assert one.attrs["fdem_threads"] == 1
+    assert np.array_equal(one.block_displacement.values, two.block_displacement.values)
+    assert np.array_equal(one.step_reaction.values, two.step_reaction.values)

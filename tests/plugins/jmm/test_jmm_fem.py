@@ -6,6 +6,7 @@ import pytest
 import scipy.sparse.linalg as spla
 from skfem import MeshTri
 
+import masonryfw as mf
 from masonryfw_jmm.fem import Discretisation
 from masonryfw_jmm.material import JointStrength, ReturnMap, elastic_matrix
 from masonryfw_jmm.newton import NewtonSolver, State
@@ -149,3 +150,30 @@ def test_a_guess_at_the_solution_replaces_the_predictor():
     poor, poor_report = newton.step(loaded, 1.0, 0.2, guess=exact.u + noise)
     assert poor_report.residuals[0] == report.residuals[0]  # the tangent predictor kept
     np.testing.assert_allclose(poor.stress, exact.stress, atol=1e-8)
+
+
+@pytest.mark.parametrize("case, options", [("test-12c", {}), ("facade-3", {}), ("panel-2", {"mesh_size": 0.04}),
+                                           ("test-12c", {"element": "p1"})])
+def test_the_estimated_dofs_are_the_meshs_to_ten_percent(case, options):
+    """The estimate counts DOFs from the masonry's area; the mesher counts them on the mesh it makes."""
+    from masonryfw_jmm.estimate import mesh_dofs
+    from masonryfw_jmm.problem import build_problem
+
+    model = mf.checked_model(mf.open_model(case))
+    resolved = mf.resolve_options("jmm", mf.get_solver("jmm").options, options)
+    estimated, _ = mesh_dofs(model, resolved)
+    actual = build_problem(model, resolved).disc.ndof
+    assert abs(estimated / actual - 1) < 0.1, (estimated, actual)
+
+
+@pytest.mark.parametrize("case", ["arch-settlement", "lact3-arch", "lact3-portal"])
+def test_the_estimated_dofs_of_drawn_walls_are_the_meshs_to_a_quarter(case):
+    """gmsh's unstructured cells are estimated from the masonry's area and perimeter."""
+    from masonryfw_jmm.estimate import mesh_dofs
+    from masonryfw_jmm.problem import build_problem
+
+    model = mf.checked_model(mf.open_model(case))
+    resolved = mf.resolve_options("jmm", mf.get_solver("jmm").options, {})
+    estimated, _ = mesh_dofs(model, resolved)
+    actual = build_problem(model, resolved).disc.ndof
+    assert abs(estimated / actual - 1) < 0.25, (estimated, actual)

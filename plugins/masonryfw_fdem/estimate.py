@@ -1,0 +1,50 @@
+"""The ``fdem`` solve's time and peak memory, known before it starts (``Solver.estimate``).
+
+The number of time steps to the target settlement is known from the controls (target /
+(rate x dt)); a step costs about ``STEP_SECONDS_PER_BLOCK`` a block on one thread (2-core
+AMD EPYC, docs/benchmarks.md, section "scale"), ``PARALLEL_EFFICIENCY`` of that less per added
+thread, times ``DEFORMABLE_FACTOR`` in the (serial) CST mode. A reaction plateau often stops
+the run earlier: the estimate is the longest.
+"""
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import Any
+
+import xarray as xr
+
+import masonryfw as mf
+
+from .scene import build_scene
+
+STEP_SECONDS_PER_BLOCK = 0.29e-6  # 2,432 blocks: 0.69 ms a step on one thread, 0.36 ms on two
+PARALLEL_EFFICIENCY = 0.95
+GRAVITY_SHARE = 0.05  # gravity steps, as a share of the settlement's
+DEFORMABLE_FACTOR = 6.0  # Test 12C: 14.4 s against 2.3 s (docs/benchmarks.md, fdem-deformable)
+BASE_MEMORY = 250 * 2**20
+MEMORY_PER_BLOCK = 20e3
+
+
+def threads(options: Mapping[str, Any]) -> int:
+    """The threads a run will use: the option, at most numba's (NUMBA_NUM_THREADS, else the cores)."""
+    import numba
+
+    available = numba.config.NUMBA_NUM_THREADS
+    return min(options["threads"] or available, available)
+
+
+def estimate(model: xr.Dataset, options: Mapping[str, Any]) -> mf.Estimate:
+    from .solver import make_controls
+
+    scene = build_scene(model)
+    controls = make_controls(scene, options)
+    blocks = model.sizes["block"]
+    steps = (1 + GRAVITY_SHARE) * controls.target / (controls.rate * controls.dt) if controls.rate > 0 else 0.0
+    if options["mode"] == "deformable":
+        seconds = steps * blocks * STEP_SECONDS_PER_BLOCK * DEFORMABLE_FACTOR
+    else:
+        seconds = steps * blocks * STEP_SECONDS_PER_BLOCK / (1 + PARALLEL_EFFICIENCY * (threads(options) - 1))
+    return mf.Estimate(seconds=seconds, memory=BASE_MEMORY + MEMORY_PER_BLOCK * blocks,
+                       basis=f"at most {steps:,.0f} time steps of {blocks:,} blocks, as fitted on the 2-core machine "
+                             "of docs/benchmarks.md",
+                       advice="fewer blocks (fdem's memory grows with the blocks and their contacts, not the options)")

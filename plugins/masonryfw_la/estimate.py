@@ -1,0 +1,30 @@
+"""The ``la`` solve's time and peak memory, known before it starts (``Solver.estimate``).
+
+Fits to the running-bond walls of docs/benchmarks.md, section "scale" (2026-11-25, 2-core
+AMD EPYC, quiet machine): the interior point's time grows as blocks^1.4 (10,065 blocks:
+5.9 s, 40,207 blocks: 40 s), its memory linearly (the CHOLMOD factor of ``G^T D G``); a
+non-associative sequence costs about 45 associative solves (docs/la.md, "Speed").
+"""
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import Any
+
+import xarray as xr
+
+import masonryfw as mf
+
+SECONDS_AT_10K_BLOCKS = 5.9
+TIME_EXPONENT = 1.4
+NONASSOCIATIVE_FACTOR = 45.0
+BASE_MEMORY = 160 * 2**20  # the interpreter, numpy, scipy, xarray, cvxopt
+MEMORY_PER_BLOCK = 25e3  # bytes
+
+
+def estimate(model: xr.Dataset, options: Mapping[str, Any]) -> mf.Estimate:
+    blocks = model.sizes["block"]
+    seconds = SECONDS_AT_10K_BLOCKS * (blocks / 10_000) ** TIME_EXPONENT
+    if options["flow"] == "nonassociative":
+        seconds *= NONASSOCIATIVE_FACTOR
+    return mf.Estimate(seconds=seconds, memory=BASE_MEMORY + MEMORY_PER_BLOCK * blocks,
+                       basis=f"{blocks:,} blocks, as fitted on the 2-core machine of docs/benchmarks.md")

@@ -1,0 +1,34 @@
+"""Memory limits and the refusal of a run that cannot fit (masonryfw.resources)."""
+from __future__ import annotations
+
+import pytest
+
+import masonryfw as mf
+from masonryfw.resources import available_memory, parse_bytes, require_memory
+
+
+@pytest.mark.parametrize("text, value", [("1024", 1024.0), ("4GiB", 4 * 2**30), ("512 MiB", 512 * 2**20),
+                                         ("2GB", 2e9), ("1.5e3kb", 1.5e6)])
+def test_sizes_are_read_with_their_units(text, value):
+    assert parse_bytes(text) == value
+
+
+def test_a_size_that_is_not_one_is_named():
+    with pytest.raises(mf.SolveError, match="MASONRYFW_MEMORY_LIMIT='lots' is not a size"):
+        parse_bytes("lots")
+
+
+def test_the_variable_overrides_the_system(monkeypatch):
+    monkeypatch.delenv("MASONRYFW_MEMORY_LIMIT", raising=False)
+    system = available_memory()
+    assert 0 < system
+    monkeypatch.setenv("MASONRYFW_MEMORY_LIMIT", "3GiB")
+    assert available_memory() == 3 * 2**30
+
+
+def test_a_run_over_the_limit_is_refused_with_the_advice(monkeypatch):
+    monkeypatch.setenv("MASONRYFW_MEMORY_LIMIT", "1GiB")
+    require_memory("x", mf.Estimate(seconds=1.0, memory=2**30, basis="b"))  # exactly fits
+    with pytest.raises(mf.SolveError, match=r"solver x: this run needs about 2.0 GiB .* 1.0 GiB is available "
+                                            r".*; to make it smaller: use less"):
+        require_memory("x", mf.Estimate(seconds=1.0, memory=2**31, basis="b", advice="use less"))
