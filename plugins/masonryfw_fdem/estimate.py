@@ -19,18 +19,24 @@ from .scene import build_scene
 
 STEP_SECONDS_PER_BLOCK = 0.29e-6  # 2,432 blocks: 0.69 ms a step on one thread, 0.36 ms on two
 PARALLEL_EFFICIENCY = 0.95
+# two threads add ~20 us a step of start-up (Test 12C, 72 blocks: 30 against 21 us) and save ~0.145 us a
+# block: even at ~135 blocks, clearly ahead from a few hundred (Facade 3, 480 blocks: 1.8x)
+PARALLEL_MIN_BLOCKS = 300
 GRAVITY_SHARE = 0.05  # gravity steps, as a share of the settlement's
 DEFORMABLE_FACTOR = 6.0  # Test 12C: 14.4 s against 2.3 s (docs/benchmarks.md, fdem-deformable)
 BASE_MEMORY = 250 * 2**20
 MEMORY_PER_BLOCK = 20e3
 
 
-def threads(options: Mapping[str, Any]) -> int:
-    """The threads a run will use: the option, at most numba's (NUMBA_NUM_THREADS, else the cores)."""
+def threads(options: Mapping[str, Any], blocks: int) -> int:
+    """The threads a run will use: the option, at most numba's (NUMBA_NUM_THREADS, else the cores); auto:
+    one below ``PARALLEL_MIN_BLOCKS``, where the parallel loops' start-up costs more than they share."""
     import numba
 
     available = numba.config.NUMBA_NUM_THREADS
-    return min(options["threads"] or available, available)
+    if options["threads"] is None:
+        return available if blocks >= PARALLEL_MIN_BLOCKS else 1
+    return min(options["threads"], available)
 
 
 def estimate(model: xr.Dataset, options: Mapping[str, Any]) -> mf.Estimate:
@@ -43,7 +49,7 @@ def estimate(model: xr.Dataset, options: Mapping[str, Any]) -> mf.Estimate:
     if options["mode"] == "deformable":
         seconds = steps * blocks * STEP_SECONDS_PER_BLOCK * DEFORMABLE_FACTOR
     else:
-        seconds = steps * blocks * STEP_SECONDS_PER_BLOCK / (1 + PARALLEL_EFFICIENCY * (threads(options) - 1))
+        seconds = steps * blocks * STEP_SECONDS_PER_BLOCK / (1 + PARALLEL_EFFICIENCY * (threads(options, blocks) - 1))
     return mf.Estimate(seconds=seconds, memory=BASE_MEMORY + MEMORY_PER_BLOCK * blocks,
                        basis=f"at most {steps:,.0f} time steps of {blocks:,} blocks, as fitted on the 2-core machine "
                              "of docs/benchmarks.md",

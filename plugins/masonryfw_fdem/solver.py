@@ -106,7 +106,7 @@ def solve(model: xr.Dataset, options: Mapping[str, Any], progress=mf.no_progress
     from numba.core import event
 
     compiling = event.TimingListener()
-    threads = estimate.threads(options)
+    threads = estimate.threads(options, model.sizes["block"])
     before = numba.get_num_threads()
     numba.set_num_threads(threads)
     try:
