@@ -68,7 +68,7 @@ from .plugins import (
     solve,
     solver_version,
 )
-from .progress import ProgressCallback, no_progress
+from .progress import ProgressCallback, interruptible, no_progress
 from .resources import available_memory, duration_text, size_text
 from .schema import FORMAT_VERSION, flags, load_schema, variable_attrs
 from .semantics import (

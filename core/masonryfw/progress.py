@@ -5,10 +5,40 @@ A solver receives a plain callable ``progress(fraction, message)`` with
 """
 from __future__ import annotations
 
+import threading
 from collections.abc import Callable
+from typing import TypeVar
 
 ProgressCallback = Callable[[float, str], None]
+T = TypeVar("T")
 
 
 def no_progress(fraction: float, message: str = "") -> None:
     """The progress callback that shows nothing."""
+
+
+def interruptible(call: Callable[[], T]) -> T:
+    """``call()`` in a daemon thread, the caller waiting: Ctrl-C reaches Python while the call runs.
+
+    A long call into compiled code that releases the GIL (Clarabel's solve, for one) does not
+    return to the interpreter, so a KeyboardInterrupt waits for its end (jmm-limit on a 10,000-unit
+    wall ignored Ctrl-C for 10 minutes). Here the main thread waits in short ``join``s and takes the
+    interrupt at once; the abandoned call runs on until the process exits. A call that holds the GIL
+    gains nothing but loses nothing either.
+    """
+    outcome: list = []
+
+    def run() -> None:
+        try:
+            outcome.append((True, call()))
+        except BaseException as exc:  # handed to the caller
+            outcome.append((False, exc))
+
+    worker = threading.Thread(target=run, name="masonryfw-interruptible", daemon=True)
+    worker.start()
+    while worker.is_alive():
+        worker.join(0.1)
+    ok, value = outcome[0]
+    if not ok:
+        raise value
+    return value

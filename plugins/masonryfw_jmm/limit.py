@@ -228,7 +228,7 @@ def solve_lp(cost: np.ndarray, equalities: sp.spmatrix, rhs: np.ndarray, inequal
         sp.vstack([equalities, inequalities], format="csc"), np.concatenate([rhs, bounds]),
         [clarabel.ZeroConeT(n_eq), clarabel.NonnegativeConeT(n_in)], settings,
     )
-    sol = solver.solve()
+    sol = mf.interruptible(solver.solve)
     seconds = time.perf_counter() - start
     status = str(sol.status).split(".")[-1]
     if status in ("PrimalInfeasible", "AlmostPrimalInfeasible"):

@@ -139,7 +139,7 @@ def solve_clarabel(cost, constraints, live, tolerance) -> LPSolution:
         [clarabel.ZeroConeT(1), clarabel.NonnegativeConeT(n_row)],
         settings,
     )
-    sol = solver.solve()
+    sol = mf.interruptible(solver.solve)
     status = str(sol.status).split(".")[-1]
     if status in ("PrimalInfeasible", "AlmostPrimalInfeasible"):
         raise mf.SolveError(UNBOUNDED_MESSAGE)

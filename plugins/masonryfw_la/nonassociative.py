@@ -149,7 +149,7 @@ def least_compression(lp: assembly.KinematicLP, alpha: float, tolerance: float) 
     settings.tol_gap_abs = settings.tol_gap_rel = settings.tol_feas = SELECTION_TOLERANCE
     solver = clarabel.DefaultSolver(sp.diags(weight, format="csc"), np.zeros(n_row + 1), matrix, rhs,
                                     [clarabel.ZeroConeT(n_col), clarabel.NonnegativeConeT(n_row + 1)], settings)
-    solution = solver.solve()
+    solution = mf.interruptible(solver.solve)
     status = str(solution.status).split(".")[-1]
     if status not in ("Solved", "AlmostSolved"):
         raise mf.SolveError(f"la: the least-compression contact forces at alpha = {alpha:.6g} were not found "

@@ -32,3 +32,23 @@ def test_a_run_over_the_limit_is_refused_with_the_advice(monkeypatch):
     with pytest.raises(mf.SolveError, match=r"solver x: this run needs about 2.0 GiB .* 1.0 GiB is available "
                                             r".*; to make it smaller: use less"):
         require_memory("x", mf.Estimate(seconds=1.0, memory=2**31, basis="b", advice="use less"))
+
+
+def test_an_interruptible_call_returns_its_value_and_raises_its_error():
+    assert mf.interruptible(lambda: 42) == 42
+    with pytest.raises(ZeroDivisionError):
+        mf.interruptible(lambda: 1 / 0)
+
+
+def test_ctrl_c_reaches_the_caller_during_a_long_call_that_releases_the_gil():
+    """time.sleep stands in for a solver's compiled loop that releases the GIL (Clarabel's)."""
+    import _thread
+    import threading
+    import time
+
+    timer = threading.Timer(0.3, _thread.interrupt_main)
+    timer.start()
+    clock = time.perf_counter()
+    with pytest.raises(KeyboardInterrupt):
+        mf.interruptible(lambda: time.sleep(30))
+    assert time.perf_counter() - clock < 5
