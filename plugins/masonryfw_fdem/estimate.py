@@ -19,8 +19,8 @@ from .scene import build_scene
 
 STEP_SECONDS_PER_BLOCK = 0.29e-6  # 2,432 blocks: 0.69 ms a step on one thread, 0.36 ms on two
 PARALLEL_EFFICIENCY = 0.95
-# two threads add ~20 us a step of start-up (Test 12C, 72 blocks: 30 against 21 us) and save ~0.145 us a
-# block: even at ~135 blocks, clearly ahead from a few hundred (Facade 3, 480 blocks: 1.8x)
+# two threads add ~20 us a step of start-up and save ~0.145 us a block: whole processes in alternating pairs,
+# Test 12C (72 blocks) 0.86x on two threads, Facade 3 (480 blocks) 1.59x (docs/benchmarks.md, fdem)
 PARALLEL_MIN_BLOCKS = 300
 GRAVITY_SHARE = 0.05  # gravity steps, as a share of the settlement's
 DEFORMABLE_FACTOR = 6.0  # Test 12C: 14.4 s against 2.3 s (docs/benchmarks.md, fdem-deformable)
