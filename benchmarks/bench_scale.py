@@ -126,11 +126,13 @@ def main(argv=None) -> None:
             model = Path(tmp, f"wall-{size}.nc")
             seconds, peak, code = run([sys.executable, "-m", "masonryfw", "build", str(spec), "-o", str(model)],
                                       args.limit)
-            blocks = mf.open_dataset(model).sizes["block"]
+            with mf.open_dataset(model) as built:
+                wall = mf.checked_model(built.load())
+            blocks = wall.sizes["block"]
             print(f"{size}: {blocks} blocks, built in {seconds:.1f} s", flush=True)
             for solver in solvers if size in sizes else ["la"]:
                 out = Path(tmp, f"wall-{size}.{solver}.nc")
-                expected = mf.estimate(mf.open_dataset(model), solver)
+                expected = mf.estimate(wall, solver)
                 seconds, peak, code = run([sys.executable, "-m", "masonryfw", "solve", str(model), "--plugin",
                                            solver, "-o", str(out), "--no-progress"], args.limit)
                 rows.append(f"| {size:,} | {blocks:,} | {solver} | {seconds:.1f} | {expected.seconds:.1f} | {peak:.0f} "

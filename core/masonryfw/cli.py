@@ -323,7 +323,7 @@ def solve(model: str, solver: str, output: str | None, options: dict[str, str], 
     inputs = _input_files(model)
     out = Path(output) if output else Path(f"{Path(model).stem if inputs else model}.{solver}.nc")
     mf.check_output_path(out, inputs)
-    dataset = mf.open_model(model)
+    dataset = mf.checked_model(mf.open_model(model))  # checked once, for the estimate and the solve
     expected = mf.estimate(dataset, solver, options)
     if expected is not None and expected.seconds > LONG_RUN:
         click.echo(f"{solver}: expect about {mf.duration_text(expected.seconds)} and "

@@ -21,7 +21,7 @@ _UNITS = {"": 1, "b": 1, "kb": 1e3, "mb": 1e6, "gb": 1e9, "kib": 2**10, "mib": 2
 
 def parse_bytes(text: str) -> float:
     """``"4GiB"`` -> 4294967296.0; a plain number is bytes."""
-    match = re.fullmatch(r"\s*([0-9.]+(?:e[0-9+-]+)?)\s*([a-z]*)\s*", text.lower())
+    match = re.fullmatch(r"\s*([0-9]+(?:\.[0-9]*)?(?:e[+-]?[0-9]+)?)\s*([a-z]*)\s*", text.lower())
     if not match or match.group(2) not in _UNITS:
         raise SolveError(f"{MEMORY_LIMIT_VARIABLE}={text!r} is not a size (bytes, or a number with "
                          "kB, MB, GB, KiB, MiB or GiB)")

@@ -47,13 +47,13 @@ def structured_cells(model: xr.Dataset, size: float) -> int:
     return int((across * up).sum())
 
 
-def mesh_dofs(model: xr.Dataset, options: Mapping[str, Any]) -> tuple[int, float]:
+def mesh_dofs(model: xr.Dataset, options: Mapping[str, Any], element: str = "p2") -> tuple[int, float]:
     """``(DOFs, mesh size)`` of the mesh ``options`` ask for: its cells counted on the grid of an axis-aligned
     wall, else the masonry's area over the cell area (gmsh's triangles of side ``size``: about 1.15 cells)."""
     from .problem import auto_mesh_size
 
     size = options["mesh_size"] if options["mesh_size"] is not None else auto_mesh_size(model)
-    per_cell = DOFS_PER_CELL[options.get("element", "p2")]
+    per_cell = DOFS_PER_CELL[element]
     if axis_aligned(model):
         return int(per_cell * structured_cells(model, size)), size
     blocks = masonry(model)
@@ -77,7 +77,7 @@ def advice(size: float) -> str:
 
 
 def estimate(model: xr.Dataset, options: Mapping[str, Any]) -> mf.Estimate:
-    dofs, size = mesh_dofs(model, options)
+    dofs, size = mesh_dofs(model, options, options["element"])
     seconds = NEWTON_ITERATIONS * ITERATION_SECONDS * (dofs / ITERATION_DOFS) ** TIME_EXPONENT
     return mf.Estimate(seconds=seconds, memory=BASE_MEMORY + MEMORY_PER_DOF * dofs,
                        basis=f"about {dofs:,} DOFs and {NEWTON_ITERATIONS} Newton iterations, as fitted on the 2-core "
@@ -85,7 +85,7 @@ def estimate(model: xr.Dataset, options: Mapping[str, Any]) -> mf.Estimate:
 
 
 def estimate_limit(model: xr.Dataset, options: Mapping[str, Any]) -> mf.Estimate:
-    dofs, size = mesh_dofs(model, {**options, "element": "p2"})
+    dofs, size = mesh_dofs(model, options)  # the mesh's size in P2 DOFs, the unit its constants are fitted in
     seconds = LIMIT_LP_SECONDS * (dofs / LIMIT_LP_DOFS) ** 1.4
     return mf.Estimate(seconds=seconds, memory=BASE_MEMORY + LIMIT_MEMORY_PER_DOF * dofs,
                        basis=f"about {dofs:,} DOFs, as fitted on the 2-core machine of docs/benchmarks.md",

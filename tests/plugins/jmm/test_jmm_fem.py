@@ -161,7 +161,7 @@ def test_the_estimated_dofs_are_the_meshs_to_ten_percent(case, options):
 
     model = mf.checked_model(mf.open_model(case))
     resolved = mf.resolve_options("jmm", mf.get_solver("jmm").options, options)
-    estimated, _ = mesh_dofs(model, resolved)
+    estimated, _ = mesh_dofs(model, resolved, resolved["element"])
     actual = build_problem(model, resolved).disc.ndof
     assert abs(estimated / actual - 1) < 0.1, (estimated, actual)
 
