@@ -51,7 +51,7 @@ from .hookspecs import (
     unknown_name_message,
 )
 from .interfaces import detect_interfaces
-from .io import add_history, check_output_path, content_sha256, open_dataset, save, save_figure, sha256_file
+from .io import add_history, check_output_path, content_sha256, open_dataset, save, save_figure, save_text, sha256_file
 from .linalg import cholesky_factor, has_cholmod
 from .model import checked_model, model_part, open_model
 from .plugins import (
@@ -63,12 +63,13 @@ from .plugins import (
     get_solver,
     installed_solvers,
     options_json,
+    plot_table,
     plugin_manager,
     render,
     solve,
     solver_version,
 )
-from .progress import ProgressCallback, interruptible, no_progress
+from .progress import ProgressCallback, StderrBar, interruptible, no_progress, progress_bar
 from .resources import available_memory, duration_text, size_text
 from .schema import FORMAT_VERSION, flags, load_schema, variable_attrs
 from .semantics import (
@@ -91,9 +92,11 @@ from .semantics import (
     polar_moment,
     reaction_weights,
     relative_motion,
+    rigid_fit,
     states_at,
     support_blocks,
 )
 from .spec import dump_toml
+from .summary import Row, csv_text, headline_rows, result_label, score_rows, text_table
 
 __all__ = [name for name in dir() if not name.startswith("_")]

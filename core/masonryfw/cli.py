@@ -6,6 +6,7 @@ unless ``--debug`` is given; usage errors exit with 2 (click's default).
 """
 from __future__ import annotations
 
+import itertools
 import json
 import shlex
 import signal
@@ -102,35 +103,6 @@ _OPTION = click.option(
 
 
 # ---------------------------------------------------------------- progress
-
-class _StderrBar:
-    """``progress(fraction, message)`` drawn as one line ``[####......]  40% message`` on a stream."""
-
-    width = 30
-
-    def __init__(self, stream):
-        self.stream = stream
-        self.drawn = False
-
-    def __call__(self, fraction: float, message: str = "") -> None:
-        done = min(max(float(fraction), 0.0), 1.0)
-        filled = round(done * self.width)
-        bar = "#" * filled + "." * (self.width - filled)
-        self.stream.write(f"\r[{bar}] {done:4.0%} {message[:40]:<40}")
-        self.stream.flush()
-        self.drawn = True
-
-    def close(self) -> None:
-        if self.drawn:
-            self.stream.write("\n")
-            self.stream.flush()
-
-
-def _progress_bar(wanted: bool | None) -> _StderrBar | None:
-    """A bar on stderr: with ``--progress`` always, with ``--no-progress`` never, else when stderr is a terminal."""
-    show = sys.stderr.isatty() if wanted is None else wanted
-    return _StderrBar(sys.stderr) if show else None
-
 
 # ---------------------------------------------------------------- build, check, info, datasets
 
@@ -328,7 +300,7 @@ def solve(model: str, solver: str, output: str | None, options: dict[str, str], 
     if expected is not None and expected.seconds > LONG_RUN:
         click.echo(f"{solver}: expect about {mf.duration_text(expected.seconds)} and "
                    f"{mf.size_text(expected.memory)} ({expected.basis}); Ctrl-C keeps what is computed", err=True)
-    bar = _progress_bar(progress)
+    bar = mf.progress_bar(progress)
     try:
         result = mf.solve(dataset, solver, options, progress=bar)
     except KeyboardInterrupt:
@@ -353,39 +325,82 @@ def _last_settlement(result) -> str:
 
 
 @cli.command()
-@click.argument("a")
-@click.argument("b")
+@click.argument("results", nargs=-1, required=True)
 @click.option("--comparator", help="Name of the comparator [default: the only one installed].")
-@click.option("-o", "--output", type=click.Path(dir_okay=False), help="Write the comparison dataset here.")
+@click.option("-o", "--output", type=click.Path(dir_okay=False),
+              help="Write the comparison dataset here (two results only).")
 @_OPTION
 @click.option("--json", "as_json", is_flag=True, help="Print the scalar scores as JSON.")
 def compare(
-    a: str, b: str, comparator: str | None, output: str | None, options: dict[str, str], as_json: bool
+    results: tuple[str, ...], comparator: str | None, output: str | None, options: dict[str, str], as_json: bool
 ) -> None:
-    """Compare two results A and B."""
+    """Compare two or more RESULTS of one model: their headline numbers, then every pair's scores.
+
+    The first result is the reference (a) of each pair it is in. Each score comes with what it
+    measures and its range.
+    """
+    if len(results) < 2:
+        raise click.UsageError(f"compare needs two or more results, got {len(results)}")
+    if output and len(results) != 2:
+        raise mf.MasonryError(f"-o writes the comparison of two results, got {len(results)}: compare them in pairs")
     if output:
-        mf.check_output_path(output, [a, b])
-    comparison = mf.compare(mf.open_dataset(a), mf.open_dataset(b), comparator, options)
+        mf.check_output_path(output, list(results))
+    datasets = [mf.open_dataset(r) for r in results]
+    pairs = list(itertools.combinations(range(len(results)), 2))
+    comparisons = [mf.compare(datasets[i], datasets[j], comparator, options) for i, j in pairs]
     if output:
-        mf.save(comparison, output, command=_command_line(), protect=[a, b])
-    scalars = [n for n in comparison.data_vars if comparison[n].ndim == 0]
+        mf.save(comparisons[0], output, command=_command_line(), protect=list(results))
     if as_json:
-        scores = {n: comparison[n].values.item() for n in scalars}
-        click.echo(json.dumps({"comparator": comparison.attrs["comparator"], "scores": scores}, default=str))
+        click.echo(json.dumps(_comparison_json(results, pairs, comparisons), default=str))
+        return
+    letters = [chr(ord("A") + i) if i < 26 else f"R{i + 1}" for i in range(len(results))]
+    for letter, path, ds in zip(letters, results, datasets):
+        click.echo(f"{letter}: {path} ({mf.result_label(ds)})")
+    click.echo("")
+    click.echo(mf.text_table(["", *letters], mf.headline_rows(datasets)))
+    click.echo("")
+    rows = mf.score_rows(comparisons)
+    header = [f"{comparisons[0].attrs['comparator']} score", *(f"{letters[i]}-{letters[j]}" for i, j in pairs)]
+    click.echo(mf.text_table(header, rows) if rows else "(no scalar scores)")
+    if output:
+        click.echo(f"comparison: {output}")
+
+
+def _comparison_json(results, pairs, comparisons) -> dict:
+    """``{"comparator", "scores"}`` for two results; with more, ``"pairs"`` of ``{"a", "b", "scores"}``."""
+    scores = [{str(n): c[n].values.item() for n in c.data_vars if c[n].ndim == 0} for c in comparisons]
+    out: dict[str, Any] = {"comparator": comparisons[0].attrs["comparator"]}
+    if len(results) == 2:
+        out["scores"] = scores[0]
     else:
-        click.echo(f"{comparison.attrs['comparator']}: {_scalar_summary(comparison, scalars) or '(no scalar scores)'}")
-        if output:
-            click.echo(f"comparison: {output}")
+        out["pairs"] = [{"a": results[i], "b": results[j], "scores": s} for (i, j), s in zip(pairs, scores)]
+    return out
 
 
 @cli.command()
 @click.argument("results", nargs=-1, required=True)
 @click.option("--kind", help="Plot kind (see `masonryfw plugins`) [default: the only one installed].")
-@click.option("-o", "--output", type=click.Path(dir_okay=False), required=True, help="Image file (png, svg, pdf).")
+@click.option("-o", "--output", type=click.Path(dir_okay=False), required=True,
+              help="Image file (png, svg, pdf), or a .csv file of the curves' numbers.")
+@click.option("--format", "file_format", type=click.Choice(["png", "svg", "pdf", "csv"]), default=None,
+              help="[default: from the output's suffix] csv: the numbers behind the curves (history).")
 @_OPTION
-def plot(results: tuple[str, ...], kind: str | None, output: str, options: dict[str, str]) -> None:
-    """Plot one or more RESULTS (result or model files, spec files, bundled case names) with a plotter plugin."""
+def plot(results: tuple[str, ...], kind: str | None, output: str, file_format: str | None,
+         options: dict[str, str]) -> None:
+    """Plot one or more RESULTS (result or model files, spec files, bundled case names) with a plotter plugin.
+
+    Kinds that overlay (history) or set side by side (compare) take several results.
+    """
     inputs = _input_files(*results)
+    wanted = f".{file_format}" if file_format else Path(output).suffix.lower()
+    if wanted != Path(output).suffix.lower():
+        raise mf.MasonryError(f"{output}: --format {file_format} needs a file ending in {wanted}")
+    if wanted == ".csv":
+        mf.check_output_path(output, inputs, (".csv",))
+        header, rows = mf.plot_table([_open_input(r) for r in results], kind, options)
+        mf.save_text(mf.csv_text(header, rows), output, protect=inputs, suffixes=(".csv",))
+        click.echo(f"table: {output} ({len(rows)} rows)")
+        return
     mf.check_output_path(output, inputs, mf.io.FIGURE_FORMATS)
     figure = render([_open_input(r, validate=kind != "model") for r in results], kind, options)
     mf.save_figure(figure, output, protect=inputs)

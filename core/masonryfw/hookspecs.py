@@ -285,7 +285,8 @@ class Comparator:
 class Plotter:
     """A named plot kind: ``plot(datasets, ax, options)`` draws on a matplotlib Axes.
 
-    ``datasets`` is a sequence of result (or model) datasets; most kinds use one.
+    ``datasets`` is a sequence of result (or model) datasets; most kinds use one, kinds that
+    overlay or set side by side take several.
     """
 
     name: str
@@ -293,6 +294,12 @@ class Plotter:
     plot: Callable[[Sequence[xr.Dataset], Any, Mapping[str, Any]], None]
     version: str | None = None
     options: tuple[Option, ...] = field(default_factory=tuple)
+    #: Draws several datasets side by side (the figure ``render`` makes is one panel wider per dataset);
+    #: False for a kind that draws one dataset or overlays several on one panel.
+    side_by_side: bool = False
+    #: The numbers behind the curves, ``table(datasets, options) -> (header, rows)`` (``plot --format csv``);
+    #: None for a kind that draws no curves.
+    table: Callable[[Sequence[xr.Dataset], Mapping[str, Any]], tuple[list[str], list[list]]] | None = None
 
 
 class MasonryfwSpec:

@@ -356,9 +356,17 @@ FIGURE_FORMATS = (".png", ".svg", ".pdf")
 
 
 def save_figure(figure, path: str | os.PathLike, *, protect=(), dpi: float | None = None) -> Path:
-    """Write a matplotlib ``figure`` to ``path`` (.png, .svg or .pdf) atomically; never onto ``protect``."""
+    """Write a matplotlib ``figure`` to ``path`` (.png, .svg or .pdf) atomically, cropped to what is drawn
+    (no empty margins); never onto ``protect``."""
     target = check_output_path(path, protect, FIGURE_FORMATS)
     suffix = target.suffix.lower()
     return _write_atomically(
-        target, lambda temporary: figure.savefig(temporary, format=suffix[1:], dpi=dpi or "figure"), path
+        target, lambda temporary: figure.savefig(temporary, format=suffix[1:], dpi=dpi or "figure",
+                                                 bbox_inches="tight", pad_inches=0.04), path
     )
+
+
+def save_text(text: str, path: str | os.PathLike, *, protect=(), suffixes: tuple[str, ...] = ()) -> Path:
+    """Write ``text`` (UTF-8) to ``path`` atomically; never onto ``protect``; its suffix among ``suffixes``."""
+    target = check_output_path(path, protect, suffixes)
+    return _write_atomically(target, lambda temporary: temporary.write_text(text, encoding="utf-8"), path)

@@ -528,7 +528,8 @@ def render(
     """Draw ``datasets`` with the plotter called ``kind`` (default: the only one installed).
 
     Draws into ``ax`` when given, else into a new :class:`matplotlib.figure.Figure`
-    (no pyplot, no GUI backend) one panel-width wider per extra dataset. Returns the figure.
+    (no pyplot, no GUI backend), one panel-width wider per dataset for a ``side_by_side`` kind.
+    Returns the figure.
     """
     record: Plotter = _lookup("plotter", kind).record
     resolved = resolve_options(f"plotter {record.name!r}", record.options, dict(options or {}))
@@ -536,7 +537,23 @@ def render(
     if ax is None:
         from matplotlib.figure import Figure
 
-        width = max(FIGURE_SIZE[0], PANEL_WIDTH * len(datasets))
+        width = max(FIGURE_SIZE[0], PANEL_WIDTH * len(datasets)) if record.side_by_side else FIGURE_SIZE[0]
         ax = Figure(figsize=(width, FIGURE_SIZE[1]), layout="constrained").add_subplot()
     _call_plugin("plotter", record.name, record.plot, datasets, ax, resolved)
     return ax.figure
+
+
+def plot_table(
+    datasets: Sequence[xr.Dataset], kind: str | None = None, options: Mapping[str, Any] | None = None,
+) -> tuple[list[str], list[list]]:
+    """The numbers behind the curves of the plot kind ``kind``: ``(header, rows)`` (``plot --format csv``).
+
+    Raises :class:`PluginError` for a kind that draws no curves, naming the kinds that do.
+    """
+    record: Plotter = _lookup("plotter", kind).record
+    if record.table is None:
+        with_tables = sorted(name for name, item in _by_name("plotter").items() if item.record.table is not None)
+        raise PluginError(f"the {record.name} plot draws no curves to write as CSV; kinds with curves: "
+                          f"{', '.join(with_tables) or 'none installed'}")
+    resolved = resolve_options(f"plotter {record.name!r}", record.options, dict(options or {}))
+    return _call_plugin("plotter", record.name, record.table, list(datasets), resolved)

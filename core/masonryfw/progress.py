@@ -5,6 +5,7 @@ A solver receives a plain callable ``progress(fraction, message)`` with
 """
 from __future__ import annotations
 
+import sys
 import threading
 from collections.abc import Callable
 from typing import TypeVar
@@ -42,3 +43,32 @@ def interruptible(call: Callable[[], T]) -> T:
     if not ok:
         raise value
     return value
+
+
+class StderrBar:
+    """``progress(fraction, message)`` drawn as one line ``[####......]  40% message`` on a stream."""
+
+    width = 30
+
+    def __init__(self, stream):
+        self.stream = stream
+        self.drawn = False
+
+    def __call__(self, fraction: float, message: str = "") -> None:
+        done = min(max(float(fraction), 0.0), 1.0)
+        filled = round(done * self.width)
+        bar = "#" * filled + "." * (self.width - filled)
+        self.stream.write(f"\r[{bar}] {done:4.0%} {message[:40]:<40}")
+        self.stream.flush()
+        self.drawn = True
+
+    def close(self) -> None:
+        if self.drawn:
+            self.stream.write("\n")
+            self.stream.flush()
+
+
+def progress_bar(wanted: bool | None) -> StderrBar | None:
+    """A bar on stderr: with ``--progress`` always, with ``--no-progress`` never, else when stderr is a terminal."""
+    show = sys.stderr.isatty() if wanted is None else wanted
+    return StderrBar(sys.stderr) if show else None

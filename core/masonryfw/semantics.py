@@ -168,6 +168,41 @@ def point_motion(u, centroid_x, centroid_y, px, py, owner, rotations: str = "sma
     return u[..., 0] - theta * dy, u[..., 1] + theta * dx
 
 
+def rigid_fit(block, x, y, ux, uy, weight, centroid_x, centroid_y) -> np.ndarray:
+    """The rigid motion ``(ux_c, uy_c, rz)`` (block, 3) closest to a field sampled at points.
+
+    Point ``i`` at ``(x, y)`` lies in block ``block[i]`` and moves by ``(ux, uy)``;
+    every block's motion minimises ``sum w |u - (u_c + rz x (p - c))|^2`` over its
+    points, ``c`` its centroid. This is how a continuum result (a field over a mesh)
+    gets block motions comparable with a discrete one's: with ``weight`` the
+    quadrature weights, it is the L2 projection of the field onto rigid motions,
+    and for a field that is rigid on a block it returns that motion exactly. A block
+    with no point, or whose points cannot fix a rotation (all at one place), gets NaN.
+    """
+    n = len(centroid_x)
+    block = np.asarray(block, dtype=np.int64)
+    w = np.asarray(weight, dtype=float)
+    rx = np.asarray(x, dtype=float) - np.asarray(centroid_x, dtype=float)[block]
+    ry = np.asarray(y, dtype=float) - np.asarray(centroid_y, dtype=float)[block]
+
+    def total(values):
+        return np.bincount(block, weights=w * values, minlength=n)
+
+    ones, sx, sy, srr = total(np.ones_like(rx)), total(rx), total(ry), total(rx * rx + ry * ry)
+    normal = np.zeros((n, 3, 3))  # unknowns (u_cx, u_cy, rz); residuals ux - u_cx + rz ry, uy - u_cy - rz rx
+    normal[:, 0, 0] = normal[:, 1, 1] = ones
+    normal[:, 0, 2] = normal[:, 2, 0] = -sy
+    normal[:, 1, 2] = normal[:, 2, 1] = sx
+    normal[:, 2, 2] = srr
+    ux, uy = np.asarray(ux, dtype=float), np.asarray(uy, dtype=float)
+    rhs = np.stack([total(ux), total(uy), total(rx * uy - ry * ux)], axis=1)
+    fitted = np.full((n, 3), np.nan)
+    scale = np.maximum(srr, np.finfo(float).tiny)
+    determined = (ones > 0) & (srr * ones - sx * sx - sy * sy > 1e-12 * scale * ones)
+    fitted[determined] = np.linalg.solve(normal[determined], rhs[determined][..., None])[..., 0]
+    return fitted
+
+
 def relative_motion(model: xr.Dataset, u: np.ndarray, rotations: str) -> tuple[np.ndarray, np.ndarray]:
     """Opening and slip (interface, end) of block motions ``u`` (block, 3), side 1 minus side 0."""
     sides = model.interface_blocks.values.astype(np.int64)
@@ -367,7 +402,7 @@ def _history_numbers(result: xr.Dataset) -> list[KeyNumber]:
 def key_numbers(result: xr.Dataset) -> list[KeyNumber]:
     """The numbers a user came for, whatever the solver.
 
-    Limit analysis: alpha and the reaction on the moving supports at collapse
+    Limit analysis: alpha, the dead reaction R0 and the reaction on the moving supports at collapse
     (the solver's ``moving_support_reaction``, else ``(1 - alpha) R0``). Incremental solvers: the dead reaction, the smallest
     reaction and the plateau reaction with their settlements, the widest crack and the damage
     category at the last record (:mod:`masonryfw.damage`). Both: the number of
@@ -378,6 +413,9 @@ def key_numbers(result: xr.Dataset) -> list[KeyNumber]:
         alpha = float(result.collapse_multiplier.values)
         numbers.append(KeyNumber("alpha", alpha, "1", "collapse multiplier"))
         r0 = dead_reaction(result)
+        if r0 > 0:
+            numbers.append(KeyNumber("dead_reaction", r0, "N",
+                                     "dead load on the moving supports, W L_moving / L_total (R0)"))
         if "moving_support_reaction" in result:
             numbers.append(KeyNumber("collapse_reaction", float(result.moving_support_reaction.values), "N",
                                      "reaction on the moving supports at collapse"))

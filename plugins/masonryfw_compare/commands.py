@@ -51,4 +51,26 @@ def export_command(result: str, file_format: str, output: str | None) -> None:
         click.echo(f"wrote {path}")
 
 
-COMMANDS = (gallery_command, export_command)
+@click.command("report")
+@click.argument("results", nargs=-1, required=True, type=click.Path(dir_okay=False, exists=True))
+@click.option("-o", "--output", type=click.Path(dir_okay=False), required=True, help="The HTML file to write.")
+@click.option("--progress/--no-progress", default=None,
+              help="Draw a progress bar on stderr [default: when stderr is a terminal].")
+def report_command(results: tuple[str, ...], output: str, progress: bool | None) -> None:
+    """Write one self-contained HTML report of RESULTS (one model): the wall, its spec, the key numbers,
+    every figure, the agreement of the results and their provenance."""
+    from .report import report_html  # imported here: the CLI starts without matplotlib
+
+    mf.check_output_path(output, list(results), (".html", ".htm"))
+    context = click.get_current_context()
+    bar = mf.progress_bar(progress)
+    try:
+        text = report_html(list(results), context.find_root().obj["command_line"], bar)
+    finally:
+        if bar is not None:
+            bar.close()
+    mf.save_text(text, output, protect=list(results), suffixes=(".html", ".htm"))
+    click.echo(f"report: {output} ({len(text) / 1e6:.2g} MB, {text.count('<img ')} figures)")
+
+
+COMMANDS = (gallery_command, export_command, report_command)

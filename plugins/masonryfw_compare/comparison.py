@@ -16,7 +16,6 @@ also has.
 """
 from __future__ import annotations
 
-import json
 from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
@@ -29,8 +28,6 @@ import masonryfw as mf
 from . import scores
 from .shapes import distance_to_points, distance_to_segments, segment_samples
 
-# Option names under which solvers record their numerical backend (la: "solver").
-BACKEND_OPTION_NAMES = ("solver", "backend")
 # Model variables that must be present to tell two models apart and to score them.
 GEOMETRY_VARIABLES = (
     "node_x", "node_y", "block_node_count", "block_role",
@@ -183,17 +180,6 @@ def multiplier_values(a: xr.Dataset, b: xr.Dataset) -> dict:
     }
 
 
-def solver_label(ds: xr.Dataset) -> str:
-    """``solver`` plus the backend it chose when its options name one, e.g. ``la (highs)``."""
-    name = str(ds.attrs.get("solver", ds.attrs.get("plugin", "?")))
-    try:
-        options = json.loads(ds.attrs.get("solver_options", "{}"))
-    except (TypeError, ValueError):
-        options = {}
-    detail = [str(options[k]) for k in BACKEND_OPTION_NAMES if isinstance(options, dict) and k in options]
-    return f"{name} ({', '.join(detail)})" if detail else name
-
-
 def comparison_variables(values: Mapping[str, float | int | None]) -> xr.Dataset:
     """One scalar variable per computable score (None = not computable, left out), attributes from the schema.
 
@@ -205,7 +191,7 @@ def comparison_variables(values: Mapping[str, float | int | None]) -> xr.Dataset
     for name, value in values.items():
         if value is None:
             continue
-        attrs = {"units": spec[name]["units"], "long_name": spec[name]["long_name"]}
+        attrs = {key: spec[name][key] for key in ("units", "long_name", "comment") if key in spec[name]}
         dtype = np.int64 if spec[name]["dtype"] == "int" else np.float64
         data[name] = xr.Variable((), np.asarray(value, dtype=dtype), attrs)
     return xr.Dataset(data)

@@ -23,7 +23,6 @@ import xarray as xr
 
 import masonryfw as mf
 
-from .comparison import solver_label
 from .records import DEFAULT_THRESHOLD
 
 GALLERY_DPI = 110
@@ -174,7 +173,7 @@ def solve_case(
             continue
         seconds[run.label] = time.perf_counter() - start
         echo(f"  {run.label}: {seconds[run.label]:.2f} s")
-    labels = [solver_label(r) for r in results]
+    labels = [mf.result_label(r) for r in results]
     comparisons = [
         (labels[i], labels[j], mf.compare(results[i], results[j], "crack", {"threshold": DEFAULT_THRESHOLD}))
         for i, j in compared_pairs(labels)
@@ -231,7 +230,7 @@ def agreement_table(outcomes: list[CaseOutcome]) -> str:
     columns = [c for c in SCORE_COLUMNS if not c[0].startswith("alpha")]
     rows = []
     for o, la, lb, c in _pairs(outcomes, same_method=False):
-        by_label = {solver_label(r): r for r in o.results}
+        by_label = {mf.result_label(r): r for r in o.results}
         cells = [o.title, la, lb, headline(by_label[la]) if la in by_label else "-",
                  headline(by_label[lb]) if lb in by_label else "-", *(_cell(c, name, fmt) for _, name, fmt in columns)]
         rows.append("| " + " | ".join(cells) + " |")

@@ -7,18 +7,21 @@ a :class:`masonryfw.MasonryError` naming the variable and the kind of result it 
 """
 from __future__ import annotations
 
+import json
 from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 import xarray as xr
 from matplotlib import colormaps
 from matplotlib.collections import LineCollection, PolyCollection
+from matplotlib.colors import Normalize
 from matplotlib.lines import Line2D
+from matplotlib.patches import Patch
 
 import masonryfw as mf
 
-from .comparison import solver_label
 from .shapes import deformed_nodes, deformed_points, largest_vertex_motion, padded_block_nodes
 
 # Default amplification: the largest vertex displacement drawn as this share of the model size.
@@ -26,6 +29,12 @@ DRAWN_MOTION_SHARE = 0.10
 STATE_COLOURS = {"open": "tab:red", "slide": "tab:blue", "open_slide": "tab:purple"}
 FAILURE_COLOURS = {"tensile": "tab:blue", "shear": "0.55", "tensile_shear": "navy"}
 SUPPORT_COLOUR = "0.45"
+SMALL_PIECE_COLOUR = "0.82"
+FRICTION_MAP = "plasma_r"  # dark: sliding; light: far from it
+# damage categories 0..5: green to dark red
+DAMAGE_COLOURS = ("#1a9850", "#91cf60", "#fee08b", "#fc8d59", "#d73027", "#7f0000")
+DOMINANT_SHARE = 0.02  # a macro-block holding this share of the masonry area is numbered ...
+MOST_NUMBERED = 10  # ... up to this many
 THRUST_REFERENCE_PERCENTILE = 95.0
 # tab20 entries for macro-blocks: the dark shades first, then the light ones, so that
 # neighbouring labels differ in hue; its greys (14, 15) are left to the supports.
@@ -47,17 +56,36 @@ def _single(datasets: Sequence[xr.Dataset], kind: str) -> xr.Dataset:
 
 def title_of(ds: xr.Dataset) -> str:
     """``<model title> - <solver>`` (``model`` when the dataset holds no result)."""
-    label = solver_label(ds) if "solver" in ds.attrs else "model"
+    label = mf.result_label(ds) if "solver" in ds.attrs else "model"
     return f"{ds.attrs.get('title', 'untitled')} - {label}"
 
 
+def headline_of(ds: xr.Dataset) -> str:
+    """The result's headline in a few words: alpha and the collapse reaction (limit analysis), else the
+    smallest and plateau reactions (incremental solvers); empty for a model."""
+    numbers = {n.name: n.value for n in mf.key_numbers(ds)} if "solver" in ds.attrs else {}
+    if "alpha" in numbers:
+        reaction = f", collapse reaction {numbers['collapse_reaction']:.4g} N" if "collapse_reaction" in numbers else ""
+        return f"alpha = {numbers['alpha']:.4f}{reaction}"
+    if "minimum_reaction" in numbers:
+        return (f"R0 {numbers['dead_reaction']:.4g} N, min {numbers['minimum_reaction']:.4g} N at "
+                f"{1e3 * numbers['minimum_reaction_settlement']:.3g} mm, plateau {numbers['plateau_reaction']:.4g} N")
+    return ""
+
+
 def _finish(ax, ds: xr.Dataset) -> None:
-    """Equal axes in metres, titled with the model and the solver."""
-    ax.set_aspect("equal", adjustable="datalim")
+    """Equal axes in metres fitted to the drawing, titled with the model, the solver and the headline."""
+    ax.set_aspect("equal", adjustable="box")
     ax.autoscale_view()
     ax.set_xlabel("x [m]")
     ax.set_ylabel("y [m]")
-    ax.set_title(title_of(ds), fontsize="medium")
+    headline = headline_of(ds)
+    ax.set_title(title_of(ds) + (f"\n{headline}" if headline else ""), fontsize="medium")
+
+
+def line_scale(geo: xr.Dataset) -> float:
+    """1 up to 300 blocks, then shrinking as 1/sqrt(blocks): lines stay apart on a 3,000-block wall."""
+    return float(min(1.0, np.sqrt(300.0 / max(geo.sizes["block"], 1))))
 
 
 def _block_verts(geo: xr.Dataset, x: np.ndarray, y: np.ndarray) -> np.ndarray:
@@ -69,8 +97,9 @@ def _supports(geo: xr.Dataset) -> np.ndarray:
     return mf.support_blocks(geo.block_role.values)
 
 
-def _draw_blocks(ax, geo, x, y, facecolors, *, edge="0.3", width=0.3, zorder=1) -> None:
+def _draw_blocks(ax, geo, x, y, facecolors, *, edge="0.3", width=None, zorder=1) -> None:
     """Masonry blocks filled with ``facecolors`` (per block), supports hatched grey."""
+    width = 0.3 * line_scale(geo) ** 2 if width is None else width  # edges fade out faster than the cracks
     verts = _block_verts(geo, x, y)
     support = _supports(geo)
     colours = np.asarray(facecolors, dtype=object)
@@ -103,6 +132,67 @@ def macro_block_colours(ds: xr.Dataset) -> np.ndarray:
     palette = colormaps["tab20"].colors
     return np.array([palette[MACRO_BLOCK_HUES[r % len(MACRO_BLOCK_HUES)]] for r in range(rank.max() + 1)],
                     dtype=object)[rank]
+
+
+@dataclass(frozen=True)
+class Pieces:
+    """The masonry's macro-blocks by size: ``number[block]`` is 1, 2, ... for the blocks of the
+    dominant pieces (largest first) and 0 for the small pieces and the supports."""
+
+    number: np.ndarray
+    dominant: int
+    small: int
+
+
+def dominant_pieces(ds: xr.Dataset, geo: xr.Dataset) -> Pieces:
+    """Number the macro-blocks holding at least :data:`DOMINANT_SHARE` of the masonry area (at most
+    :data:`MOST_NUMBERED`), largest first; the others are small pieces."""
+    masonry = mf.masonry_blocks(geo.block_role.values)
+    number = np.zeros(geo.sizes["block"], dtype=np.int64)
+    if "macro_block" not in ds or not masonry.any():
+        return Pieces(number, 0, 0)
+    labels, inverse = np.unique(ds.macro_block.values[masonry], return_inverse=True)
+    area = np.bincount(inverse, weights=np.abs(geo.block_area.values[masonry]))
+    order = np.argsort(-area, kind="stable")
+    big = order[area[order] >= DOMINANT_SHARE * area.sum()][:MOST_NUMBERED]
+    rank = np.zeros(labels.size, dtype=np.int64)
+    rank[big] = np.arange(1, big.size + 1)
+    number[masonry] = rank[inverse]
+    return Pieces(number, int(big.size), int(labels.size - big.size))
+
+
+def piece_colours(geo: xr.Dataset, pieces: Pieces) -> np.ndarray:
+    """Dominant pieces in tab10's colours (cycled), small pieces in one neutral grey."""
+    palette = colormaps["tab10"].colors
+    colours = np.array([SMALL_PIECE_COLOUR] * geo.sizes["block"], dtype=object)
+    for block in np.flatnonzero(pieces.number):
+        colours[block] = palette[(pieces.number[block] - 1) % len(palette)]
+    return colours
+
+
+def _number_pieces(ax, geo: xr.Dataset, pieces: Pieces, x: np.ndarray, y: np.ndarray) -> None:
+    """Write (1), (2), ... on each dominant piece, at its block nearest to the piece's area centroid (so the
+    label lies on the piece even when the piece is not convex), in the deformed configuration."""
+    owner = mf.node_block(geo.block_node_count.values)
+    count = np.bincount(owner, minlength=geo.sizes["block"])
+    bx = np.bincount(owner, weights=x, minlength=geo.sizes["block"]) / np.maximum(count, 1)
+    by = np.bincount(owner, weights=y, minlength=geo.sizes["block"]) / np.maximum(count, 1)
+    area = np.abs(geo.block_area.values)
+    for k in range(1, pieces.dominant + 1):
+        blocks = np.flatnonzero(pieces.number == k)
+        cx, cy = np.average(bx[blocks], weights=area[blocks]), np.average(by[blocks], weights=area[blocks])
+        at = blocks[np.argmin(np.hypot(bx[blocks] - cx, by[blocks] - cy))]
+        ax.text(bx[at], by[at], f"({k})", ha="center", va="center", fontsize="medium", fontweight="bold", zorder=5,
+                bbox={"boxstyle": "round,pad=0.15", "facecolor": "white", "edgecolor": "none", "alpha": 0.8})
+
+
+def _deformed_crack_faces(geo: xr.Dataset, u, amplification: float, cracked: np.ndarray) -> np.ndarray:
+    """The cracked joints as drawn on the deformed blocks: each joint once on either side's face
+    (the two faces of a crack part as the blocks move apart), shape (2 * cracked, 2, 2)."""
+    blocks = geo.interface_blocks.values[cracked].astype(np.int64)
+    px, py = geo.interface_x.values[cracked], geo.interface_y.values[cracked]
+    faces = [deformed_points(geo, u, amplification, px, py, blocks[:, [side, side]]) for side in (0, 1)]
+    return np.concatenate([_segments(fx, fy) for fx, fy in faces])
 
 
 def default_amplification(geo: xr.Dataset, displacement) -> float:
@@ -161,25 +251,31 @@ def draw_model(datasets: Sequence[xr.Dataset], ax, options: Mapping[str, Any]) -
 
 
 def draw_mechanism(datasets: Sequence[xr.Dataset], ax, options: Mapping[str, Any]) -> None:
-    """The wall in its amplified deformed configuration, blocks coloured by macro-block, cracks heavy."""
+    """The wall in its amplified deformed configuration: the dominant macro-blocks coloured and numbered
+    (1), (2), ... by size, the small pieces in one grey, the cracks drawn on the blocks' faces."""
     ds = _single(datasets, "mechanism")
-    _require(ds, ["block_displacement"], "mechanism", "block displacements (a discrete la or fdem result)")
+    _require(ds, ["block_displacement"], "mechanism", "block displacements (la, fdem, or jmm from issue 17 on)")
     geo = mf.derive_geometry(ds)
     u = mf.block_motion(ds)
     amplification = options["amplification"] or default_amplification(geo, u)
+    scale = line_scale(geo)
     _draw_outline(ax, geo)
     x, y = deformed_nodes(geo, u, amplification)
-    _draw_blocks(ax, geo, x, y, macro_block_colours(ds))
+    pieces = dominant_pieces(ds, geo)
+    _draw_blocks(ax, geo, x, y, piece_colours(geo, pieces))
+    handles = [Patch(facecolor=colormaps["tab10"].colors[0], edgecolor="0.3",
+                     label=f"({1}) .. ({pieces.dominant}) macro-blocks, largest first" if pieces.dominant > 1
+                     else "(1) the macro-block")] if pieces.dominant else []
+    if pieces.small:
+        handles.append(Patch(facecolor=SMALL_PIECE_COLOUR, edgecolor="0.3", label=f"small pieces ({pieces.small})"))
     if "crack_indicator" in ds:
         cracked = ds.crack_indicator.values > options["threshold"]
-        blocks = geo.interface_blocks.values[cracked].astype(np.int64)
-        px, py = geo.interface_x.values[cracked], geo.interface_y.values[cracked]
-        x0, y0 = deformed_points(geo, u, amplification, px, py, blocks[:, [0, 0]])
-        x1, y1 = deformed_points(geo, u, amplification, px, py, blocks[:, [1, 1]])
-        ax.add_collection(LineCollection(
-            _segments(0.5 * (x0 + x1), 0.5 * (y0 + y1)), colors="k", linewidths=2.2, zorder=3,
-        ))
-    ax.text(0.01, 0.01, f"displacements x {amplification:.3g}", transform=ax.transAxes, fontsize="small")
+        ax.add_collection(LineCollection(_deformed_crack_faces(geo, u, amplification, cracked), colors="k",
+                                         linewidths=1.6 * scale + 0.4, zorder=3, capstyle="round"))
+        handles.append(Line2D([], [], color="k", lw=2.0, label=f"cracked joints ({int(cracked.sum())})"))
+    _number_pieces(ax, geo, pieces, x, y)
+    ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize="small", frameon=False,
+              title=f"displacements x {amplification:.3g}", title_fontsize="small")
     _finish(ax, ds)
 
 
@@ -203,7 +299,7 @@ def draw_cracks(datasets: Sequence[xr.Dataset], ax, options: Mapping[str, Any]) 
         chosen = state == flag[meaning]
         ax.add_collection(LineCollection(segments[chosen], colors=colour, linewidths=2.2, zorder=3))
         handles.append(Line2D([], [], color=colour, lw=2.2, label=f"{meaning.replace('_', ' + ')} ({chosen.sum()})"))
-    ax.legend(handles=handles, loc="upper left", fontsize="small", framealpha=0.8)
+    ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize="small", frameon=False)
     _finish(ax, ds)
 
 
@@ -237,8 +333,18 @@ def thrust_segments(geo: xr.Dataset, normal, shear, scale: float):
     return px, py, magnitude, segments
 
 
+def friction_used(geo: xr.Dataset, normal, shear) -> np.ndarray:
+    """Per loaded interface (as :func:`thrust_segments` selects them): |V| / (mu N), 1 where it slides."""
+    total = normal[:, 0] + normal[:, 1]
+    loaded = total > 1e-9 * max(np.max(np.abs(total), initial=0.0), np.finfo(float).tiny)
+    mu = geo.interface_friction.values[loaded]
+    v = np.abs(shear[loaded].sum(axis=1))
+    return np.where(mu > 0, v / np.maximum(mu * total[loaded], np.finfo(float).tiny), np.inf)
+
+
 def draw_forces(datasets: Sequence[xr.Dataset], ax, options: Mapping[str, Any]) -> None:
-    """Contact forces at collapse as thrust segments through each joint's centre of pressure."""
+    """Contact forces at collapse: a segment through each joint's centre of pressure along the joint's
+    resultant, its length and width growing with the force, its colour the share of the friction used."""
     ds = _single(datasets, "forces")
     _require(
         ds, ["interface_normal_force", "interface_shear_force"], "forces",
@@ -246,14 +352,26 @@ def draw_forces(datasets: Sequence[xr.Dataset], ax, options: Mapping[str, Any]) 
     )
     geo = mf.derive_geometry(ds)
     _draw_blocks(ax, geo, geo.node_x.values, geo.node_y.values, np.array(["0.93"] * geo.sizes["block"], dtype=object))
-    px, py, magnitude, segments = thrust_segments(
-        geo, ds.interface_normal_force.values, ds.interface_shear_force.values, options["scale"]
-    )
+    normal, shear = ds.interface_normal_force.values, ds.interface_shear_force.values
+    px, py, magnitude, segments = thrust_segments(geo, normal, shear, options["scale"])
+    handles = []
     if magnitude.size:
-        width = 0.5 + 2.5 * np.minimum(magnitude / np.percentile(magnitude, THRUST_REFERENCE_PERCENTILE), 1.0)
-        ax.add_collection(LineCollection(segments, colors="tab:red", linewidths=width, zorder=3))
-        ax.scatter(px, py, s=2, c="k", zorder=4)
-        ax.text(0.01, 0.01, f"largest joint force {magnitude.max():.3g} N", transform=ax.transAxes, fontsize="small")
+        reference = float(np.percentile(magnitude, THRUST_REFERENCE_PERCENTILE))
+        width = (0.5 + 2.5 * np.minimum(magnitude / reference, 1.0)) * line_scale(geo)
+        used = np.minimum(friction_used(geo, normal, shear), 1.0)
+        lines = LineCollection(segments, cmap=FRICTION_MAP, norm=Normalize(0.0, 1.0), linewidths=width, zorder=3)
+        lines.set_array(used)
+        ax.add_collection(lines)
+        ax.scatter(px, py, s=2 * line_scale(geo), c="k", zorder=4)
+        bar = ax.figure.colorbar(lines, ax=ax, shrink=0.7, pad=0.02)
+        bar.set_label("friction used |V| / (mu N); 1 = sliding", fontsize="small")
+        handles = [
+            Line2D([], [], color="0.3", lw=3.0, label=f"joint resultant, full length = {reference:.3g} N (95th pct.)"),
+            Line2D([], [], ls="none", marker=".", color="k", label="centre of pressure"),
+            Line2D([], [], ls="none", label=f"largest {magnitude.max():.3g} N, {magnitude.size} loaded joints"),
+        ]
+    ax.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, -0.14), ncol=2, fontsize="small",
+              frameon=False)
     _finish(ax, ds)
 
 
@@ -278,34 +396,158 @@ def draw_plastic(datasets: Sequence[xr.Dataset], ax, options: Mapping[str, Any])
         chosen = failure == flag[meaning]
         ax.scatter(ds.qp_x.values[chosen], ds.qp_y.values[chosen], s=options["marker_size"], c=colour,
                    label=f"{meaning.replace('_', ' + ')} ({chosen.sum()})", zorder=3, linewidths=0)
-    ax.legend(loc="upper left", fontsize="small", framealpha=0.8, markerscale=2)
+    ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize="small", frameon=False, markerscale=2)
     _finish(ax, ds)
 
 
+def distinct_labels(datasets: Sequence[xr.Dataset]) -> list[str]:
+    """Each result's label (:func:`masonryfw.result_label`); results that share one get the solver options
+    in which they differ, e.g. ``fdem (body=deformable)``."""
+    labels = [mf.result_label(ds) for ds in datasets]
+    options = [json.loads(ds.attrs.get("solver_options", "{}") or "{}") for ds in datasets]
+    out = []
+    for i, label in enumerate(labels):
+        twins = [j for j, other in enumerate(labels) if other == label]
+        keys = sorted({k for j in twins for k in options[j]})
+        differ = [k for k in keys if len({json.dumps(options[j].get(k)) for j in twins}) > 1]
+        detail = ", ".join(f"{k}={options[i].get(k)}" for k in differ)
+        out.append(f"{label} ({detail})" if len(twins) > 1 and detail else label)
+    return out
+
+
+def _split_history(datasets: Sequence[xr.Dataset], kind: str):
+    """The incremental results (with a history) and the limit analyses (with alpha) among ``datasets``."""
+    incremental = [ds for ds in datasets if "step_settlement" in ds and "step_reaction" in ds]
+    limits = [ds for ds in datasets if "collapse_multiplier" in ds and "step_settlement" not in ds]
+    for ds in datasets:
+        if "step_settlement" not in ds and "collapse_multiplier" not in ds:
+            raise mf.MasonryError(f"{title_of(ds)} has neither step_settlement nor collapse_multiplier: "
+                                  f"the {kind} plot draws incremental (fdem, jmm) histories and la references")
+    if not incremental:
+        raise mf.MasonryError(f"the {kind} plot needs an incremental (fdem or jmm) result with step_settlement "
+                              "and step_reaction")
+    return incremental, limits
+
+
+def gravity_records(settlement: np.ndarray) -> int:
+    """Number of records before the first settlement: the gravity stage (the last of them is the dead state)."""
+    moved = np.flatnonzero(np.asarray(settlement) > 0)
+    return int(moved[0]) if moved.size else int(np.size(settlement))
+
+
+def _damage_strips(ax, incremental: Sequence[xr.Dataset]) -> list:
+    """A thin strip per result along the top of ``ax``, coloured by the damage category along the settlement."""
+    names = {v: k.replace("_", " ") for k, v in mf.flags("step_damage_category").items()}
+    seen: set[int] = set()
+    row = 0
+    for ds in incremental:
+        if "step_damage_category" not in ds or ds.step_damage_category.size < 2:
+            continue
+        s = 1e3 * ds.step_settlement.values
+        category = ds.step_damage_category.values.astype(int)
+        top = 1.0 - 0.035 * row
+        for k in range(s.size - 1):
+            if s[k + 1] > s[k]:
+                ax.axvspan(s[k], s[k + 1], ymin=top - 0.03, ymax=top, color=DAMAGE_COLOURS[category[k]], lw=0)
+        seen.update(category.tolist())
+        row += 1
+    return [Patch(color=DAMAGE_COLOURS[c], label=f"damage {c} {names[c]}") for c in sorted(seen)]
+
+
 def draw_history(datasets: Sequence[xr.Dataset], ax, options: Mapping[str, Any]) -> None:
-    """The reaction on the moving supports, or the damage (category and widest crack), against the settlement."""
-    ds = _single(datasets, "history")
-    _require(ds, ["step_settlement", "step_reaction"], "history", "an incremental (fdem or jmm) result")
-    ax.set_title(title_of(ds), fontsize="medium")
+    """The reaction on the moving supports (or the damage) against the settlement, of one or more
+    incremental results overlaid, with the dead load R0 and, for every la result given, its collapse
+    reaction (1 - alpha) R0 as reference lines; the gravity stage as the spread of reactions at zero
+    settlement; the damage category as strips along the top."""
+    incremental, limits = _split_history(datasets, "history")
+    labels = distinct_labels(incremental)
+    colours = [f"C{i % 10}" for i in range(len(incremental))]
     ax.grid(True, lw=0.3)
     ax.set_xlabel("settlement [mm]")
-    settlement = 1e3 * ds.step_settlement.values
-    if options.get("quantity", "reaction") == "reaction":
-        ax.plot(settlement, ds.step_reaction.values, marker=".", ms=3)
+    log = options["xscale"] == "log"
+    ax.set_xscale("log" if log else "linear")
+    if options["quantity"] == "damage":
+        _draw_damage(ax, incremental, labels, colours)
+    else:
+        handles = []
+        for ds, label, colour in zip(incremental, labels, colours):
+            s, r = 1e3 * ds.step_settlement.values, ds.step_reaction.values
+            first = max(gravity_records(s) - 1, 0)
+            shown = slice(first + 1 if log else first, None)
+            handles += ax.plot(s[shown], r[shown], color=colour, lw=1.2, label=label)
+            if first > 0 and not log:  # the reactions of the gravity stage, at zero settlement
+                low, high = float(r[:first + 1].min()), float(r[:first + 1].max())
+                handles.append(ax.vlines(0.0, low, high, color=colour, lw=4, alpha=0.35,
+                                         label=f"{label}: gravity stage, {first + 1} records, {low:.4g}..{high:.4g} N"))
+        r0 = mf.dead_reaction(incremental[0])
+        if r0 > 0:
+            handles.append(ax.axhline(r0, ls="--", lw=0.9, color="0.35", label=f"dead load R0 = {r0:.4g} N"))
+        for ds, style in zip(limits, (":", "-.", (0, (1, 3)), (0, (5, 2)))):
+            collapse = (1 - float(ds.collapse_multiplier.values)) * mf.dead_reaction(ds)
+            handles.append(ax.axhline(collapse, ls=style, lw=1.2, color="k",
+                                      label=f"{mf.result_label(ds)}: (1 - alpha) R0 = {collapse:.4g} N"))
+        handles += _damage_strips(ax, incremental)
         ax.set_ylabel("reaction on the moving supports [N]")
-        return
-    _require(ds, ["step_damage_category", "step_crack_width_max"], "history --option quantity=damage",
-             "a result with crack widths (fdem or jmm, issue 14 or later)")
+        ax.set_ylim(bottom=min(0.0, ax.get_ylim()[0]))
+        ax.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=2, fontsize="small",
+                  frameon=False)
+    if options["settlement_max"] is not None:
+        ax.set_xlim(right=options["settlement_max"], left=None if log else -0.02 * options["settlement_max"])
+        if options["quantity"] == "reaction":
+            _fit_y_to_shown(ax, [(1e3 * ds.step_settlement.values, ds.step_reaction.values) for ds in incremental])
+    ax.set_title(str(incremental[0].attrs.get("title", "")) if len(incremental) > 1 or limits
+                 else f"{title_of(incremental[0])}\n{headline_of(incremental[0])}", fontsize="medium")
+
+
+def _fit_y_to_shown(ax, curves: Sequence[tuple[np.ndarray, np.ndarray]]) -> None:
+    """Rescale y to the curves' points inside the x range (after a zoom on the settlement)."""
+    low, high = ax.get_xlim()
+    ys = [y[(x >= low) & (x <= high)] for x, y in curves]
+    ys = [y for y in ys if y.size]
+    if ys:
+        ax.set_ylim(min(0.0, min(float(np.min(y)) for y in ys)), 1.05 * max(float(np.max(y)) for y in ys))
+
+
+def _draw_damage(ax, incremental, labels, colours) -> None:
+    """Damage category (steps) and widest crack (dashed, right axis) of every result."""
+    for ds in incremental:
+        _require(ds, ["step_damage_category", "step_crack_width_max"], "history --option quantity=damage",
+                 "a result with crack widths (fdem or jmm, issue 14 or later)")
     names = mf.flags("step_damage_category")
-    ax.step(settlement, ds.step_damage_category.values, where="post", color="C3", label="damage category")
+    width = ax.twinx()
+    for ds, label, colour in zip(incremental, labels, colours):
+        s = 1e3 * ds.step_settlement.values
+        ax.step(s, ds.step_damage_category.values, where="post", color=colour, label=f"{label}: damage category")
+        width.plot(s, 1e3 * ds.step_crack_width_max.values, color=colour, lw=0.9, ls="--",
+                   label=f"{label}: widest crack")
     ax.set_yticks(list(names.values()), [f"{v} {k.replace('_', ' ')}" for k, v in names.items()], fontsize="small")
     ax.set_ylim(-0.3, 5.3)
     ax.set_ylabel("damage category (Burland et al. 1977)")
-    width = ax.twinx()
-    width.plot(settlement, 1e3 * ds.step_crack_width_max.values, color="0.3", lw=1.0, label="widest crack")
     width.set_ylabel("widest crack [mm]")
     lines = ax.get_lines() + width.get_lines()
-    ax.legend(lines, [line.get_label() for line in lines], loc="upper left", fontsize="small", framealpha=0.8)
+    ax.legend(lines, [line.get_label() for line in lines], loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=2,
+              fontsize="small", frameon=False)
+
+
+def history_table(datasets: Sequence[xr.Dataset], options: Mapping[str, Any]) -> tuple[list[str], list[list]]:
+    """The history plot's curves as rows: one per record of every incremental result (the la references
+    as rows with no record), in SI units."""
+    incremental, limits = _split_history(datasets, "history")
+    header = ["result", "record", "stage", "settlement_m", "reaction_N", "crack_width_max_m", "damage_category"]
+    rows: list[list] = []
+    for ds, label in zip(incremental, distinct_labels(incremental)):
+        s = ds.step_settlement.values
+        gravity = gravity_records(s)
+        width = ds.step_crack_width_max.values if "step_crack_width_max" in ds else [None] * s.size
+        damage = ds.step_damage_category.values if "step_damage_category" in ds else [None] * s.size
+        for k in range(s.size):
+            rows.append([label, k, "gravity" if k < gravity else "settlement", float(s[k]),
+                         float(ds.step_reaction.values[k]), None if width[k] is None else float(width[k]),
+                         None if damage[k] is None else int(damage[k])])
+    for ds in limits:
+        r0, alpha = mf.dead_reaction(ds), float(ds.collapse_multiplier.values)
+        rows.append([mf.result_label(ds), None, "collapse (1 - alpha) R0", None, (1 - alpha) * r0, None, None])
+    return header, rows
 
 
 def panel_kind(ds: xr.Dataset) -> str:
@@ -370,5 +612,5 @@ def draw_compare(datasets: Sequence[xr.Dataset], ax, options: Mapping[str, Any])
         else:
             draw_indicator(ds, panel, options["threshold"])
         alpha = f", alpha = {ds.collapse_multiplier.item():.4g}" if "collapse_multiplier" in ds else ""
-        panel.set_title(f"{solver_label(ds)}{alpha}\n{caption}", fontsize="medium")
+        panel.set_title(f"{mf.result_label(ds)}{alpha}\n{caption}", fontsize="medium")
     ax.figure.suptitle(str(datasets[0].attrs.get("title", "")), fontsize="large")

@@ -31,8 +31,11 @@ COMPARATOR = mf.Comparator(
 )
 
 
-def _plotter(name: str, summary: str, options: tuple = ()) -> mf.Plotter:
-    return mf.Plotter(name, summary, mf.lazy(f"masonryfw_compare.plotting:draw_{name}"), options=options)
+def _plotter(name: str, summary: str, options: tuple = (), table: bool = False,
+             side_by_side: bool = False) -> mf.Plotter:
+    return mf.Plotter(name, summary, mf.lazy(f"masonryfw_compare.plotting:draw_{name}"), options=options,
+                      table=mf.lazy(f"masonryfw_compare.plotting:{name}_table") if table else None,
+                      side_by_side=side_by_side)
 
 
 PLOTTERS = {
@@ -41,18 +44,24 @@ PLOTTERS = {
         _plotter("model", "the model as built or imported: blocks by role, interfaces by kind, block numbers",
                  (mf.Option("numbers", bool, False, "write every block's number at its centroid"),
                   mf.Option("font_size", float, 5.0, "size of the block numbers [pt]", above=0.0))),
-        _plotter("mechanism", "amplified deformed wall, macro-blocks coloured, cracks heavy",
+        _plotter("mechanism", "amplified deformed wall, alpha and the reaction in the title, the dominant "
+                 "macro-blocks numbered, cracks on the blocks' faces",
                  (AMPLIFICATION_OPTION, THRESHOLD_OPTION)),
         _plotter("cracks", "joints that open, slide or both, in colours", (THRESHOLD_OPTION,)),
         _plotter("forces", "contact forces at collapse as thrust segments",
                  (mf.Option("scale", float, 1.0, "largest segment, in median interface lengths", above=0.0),)),
         _plotter("plastic", "plastic quadrature points over the mesh (continuum results)",
                  (mf.Option("marker_size", float, 4.0, "marker area [pt^2]", above=0.0),)),
-        _plotter("history", "reaction on the moving supports (or the damage) against settlement",
+        _plotter("history", "reaction on the moving supports (or the damage) against settlement; several "
+                 "incremental results overlaid, la results as their collapse reaction (1 - alpha) R0",
                  (mf.Option("quantity", str, "reaction",
                             "reaction: on the moving supports; damage: the damage category and the widest crack",
-                            ("reaction", "damage")),)),
+                            ("reaction", "damage")),
+                  mf.Option("xscale", str, "linear", "settlement axis; log shows the first fraction of a millimetre "
+                            "(where jmm's history lives) next to fdem's centimetres", ("linear", "log")),
+                  mf.Option("settlement_max", float, None, "zoom: the settlement axis ends here [mm]", above=0.0)),
+                 table=True),
         _plotter("compare", "two or more results side by side with their scores",
-                 (AMPLIFICATION_OPTION, THRESHOLD_OPTION)),
+                 (AMPLIFICATION_OPTION, THRESHOLD_OPTION), side_by_side=True),
     )
 }

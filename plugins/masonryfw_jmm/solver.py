@@ -8,6 +8,7 @@ than ``plateau_slope`` times the first step's rate per unit of the largest displ
 over ``plateau_steps`` steps): the last converged factor is the collapse multiplier."""
 from __future__ import annotations
 
+from collections import deque
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -33,6 +34,8 @@ class History:
     residuals: list = field(default_factory=list)
     supports: list = field(default_factory=list)  # (block,) upward force of each support on the wall
     crack_width: list = field(default_factory=list)  # crack band estimate (non-dimensional, as u)
+    # (settlement, u) of the last steps, for the mechanism: as many as the plateau test looks at, plus one
+    recent: deque = field(default_factory=lambda: deque(maxlen=2))
 
     def add(self, newton: NewtonSolver, state: State, settlement: float, load_factor: float, iterations: int) -> None:
         p = newton.problem
@@ -45,6 +48,7 @@ class History:
         self.displacement.append(float(np.hypot(state.u[0::2], state.u[1::2]).max(initial=0.0)))
         self.iterations.append(iterations)
         self.plastic_points.append(int(state.active.any(axis=1).sum()))
+        self.recent.append((settlement, state.u.copy()))
 
     @property
     def steps(self) -> int:
@@ -120,7 +124,8 @@ def _start(problem: Problem, options) -> tuple[NewtonSolver, History, dict, Stat
     """The Newton solver of a run, an empty history, the run's info and the initial state."""
     kappa = options["vertex_stiffness"], options["settled_stiffness"]
     newton = NewtonSolver(problem, options["tolerance"], options["max_iterations"], regularisation=kappa)
-    return newton, History(), {"interrupted": 0, "stop_reason": ""}, State.initial(problem)
+    history = History(recent=deque(maxlen=options["plateau_steps"] + 1))
+    return newton, history, {"interrupted": 0, "stop_reason": ""}, State.initial(problem)
 
 
 def _gravity(newton: NewtonSolver, state: State, history: History, info: dict, progress) -> tuple[State, bool]:
@@ -247,6 +252,25 @@ def load_factor_variables(history: History, displacement: float) -> dict:
     }
 
 
+def mechanism(problem: Problem, model: xr.Dataset, history: History) -> np.ndarray | None:
+    """Block motions (block, 3) [m, rad] of the last steps: the displacement increment over the steps the
+    plateau test looks at, projected onto each block's rigid motions (:func:`masonryfw.rigid_fit`) at the
+    quadrature points; the supports move by their settlement increment. None before two steps."""
+    if len(history.recent) < 2:
+        return None
+    (s0, u0), (s1, u1) = history.recent[0], history.recent[-1]
+    p, disc = problem, problem.disc
+    du = (u1 - u0)[disc.edofs]  # (el, 2 nb)
+    ux = np.einsum("eqn,en->eq", disc.values, du[:, 0::2]).ravel()
+    uy = np.einsum("eqn,en->eq", disc.values, du[:, 1::2]).ravel()
+    block = np.repeat(p.mesh.block, disc.nqp)
+    fitted = mf.rigid_fit(block, *(disc.qp_xy * p.length), ux * p.displacement, uy * p.displacement,
+                          disc.weights.ravel(), model.block_centroid_x.values, model.block_centroid_y.values)
+    supports = mf.support_blocks(model.block_role.values)
+    fitted[supports] = model.settlement_direction.values[supports] * (s1 - s0) * p.displacement
+    return None if np.isnan(fitted).any() else fitted
+
+
 def result_dataset(problem: Problem, state: State, history: History, info: dict) -> xr.Dataset:
     """docs/format.md result variables (physical units) from the final converged state and the history."""
     p, disc = problem, problem.disc
@@ -298,4 +322,10 @@ def solve(model: xr.Dataset, options, progress) -> xr.Dataset:
     if info["interrupted"] and len(history.iterations) == 0:
         raise KeyboardInterrupt  # interrupted before the gravity stage converged: nothing to keep
     progress(1.0, info["stop_reason"])
-    return result_dataset(problem, state, history, info)
+    result = result_dataset(problem, state, history, info)
+    motion = mechanism(problem, model, history)
+    if motion is None:
+        return result
+    # a mechanism (an increment): linearised kinematics; the joints dilate as the continuum's flow rule says
+    flow = "associative" if options["dilatancy"] is None else "nonassociative"
+    return result.assign(mf.motion_variables(motion)).assign_attrs(rotations="small", flow_rule=flow)

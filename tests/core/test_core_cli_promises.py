@@ -286,7 +286,8 @@ def test_the_cracks_plot_draws_the_joints_above_its_threshold(la_files):
 def test_the_headline_gives_the_numbers_a_user_came_for(spec, tmp_path):
     la = run(["solve", spec.name, "--plugin", "la"], tmp_path)
     alpha = float(mf.open_dataset(tmp_path / "wall.la.nc").collapse_multiplier)
-    assert re.search(rf"la: alpha = {alpha:.6g}, collapse_reaction = [0-9.]+ N", la.stdout), la.stdout
+    assert re.search(rf"la: alpha = {alpha:.6g}, dead_reaction = [0-9.]+ N, collapse_reaction = [0-9.]+ N",
+                     la.stdout), la.stdout
     jmm = run(["solve", spec.name, "--plugin", "jmm", "--option", "max_steps=5"], tmp_path)
     line = jmm.stdout.splitlines()[-1]
     for name in ("dead_reaction", "minimum_reaction", "plateau_reaction", "plateau_settlement"):

@@ -96,3 +96,19 @@ def test_the_trough_of_the_tour_builds_under_the_tour_wall(tmp_path):
     model = mf.build(spec)
     assert mf.check(model) == []
     assert (model.block_role.values == mf.flags("block_role")["moving_support"]).sum() >= 5
+
+
+def test_the_tour_ends_with_a_report_and_its_last_step_runs_as_written(tmp_path):
+    step = README[README.index("**5. Hand it over.**"):README.index("## Where to read more")]
+    commands = [line.strip() for line in step.splitlines() if line.startswith("    masonryfw ")]
+    assert commands[-1].startswith("masonryfw report ")
+    for command in commands:
+        for part in command.split("#")[0].split(" && "):
+            words = part.split()
+            assert words[0] == "masonryfw"
+            done = subprocess.run([sys.executable, "-m", "masonryfw", *words[1:]], cwd=tmp_path, capture_output=True,
+                                  text=True, timeout=300)
+            assert done.returncode == 0, (part, done.stderr)
+    text = (tmp_path / "test-12c.html").read_text()
+    assert text.count("<img ") >= 10 and (tmp_path / "history.pdf").stat().st_size > 1000
+    assert (tmp_path / "history.csv").read_text().startswith("result,record,stage,settlement_m,reaction_N")

@@ -282,10 +282,10 @@ def test_key_numbers_of_a_history_by_hand():
     assert numbers["final_settlement"] == 0.007
 
 
-def test_key_numbers_of_a_limit_analysis_are_alpha_and_the_reaction_at_collapse():
+def test_key_numbers_of_a_limit_analysis_are_alpha_the_dead_reaction_and_the_reaction_at_collapse():
     model = mt.rectangles_model([(0.0, -0.2, 0.5, 0.0), (0.5, -0.2, 1.0, 0.0), (0.0, 0.0, 1.0, 0.5)],
                                 ["fixed_support", "moving_support", "unit"])
     result = model.assign(collapse_multiplier=((), 0.25))
     numbers = {n.name: n.value for n in mf.key_numbers(result)}
     r0 = 12e3 * 0.5 * 0.1 * 0.5  # weight times the moving support's half of the contact
-    assert numbers == pytest.approx({"alpha": 0.25, "collapse_reaction": 0.75 * r0})
+    assert numbers == pytest.approx({"alpha": 0.25, "dead_reaction": r0, "collapse_reaction": 0.75 * r0})

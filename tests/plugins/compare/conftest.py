@@ -175,3 +175,15 @@ def model():
 def results(model):
     """One result of each kind on the same model: {"la": ..., "fdem": ..., "jmm": ...}."""
     return {"la": la_result(model), "fdem": fdem_result(model), "jmm": jmm_result(model)}
+
+
+@pytest.fixture(scope="session")
+def test_12c_files(tmp_path_factory):
+    """Test 12C solved by la, fdem and jmm with their defaults, as result files: ``{solver: path}``."""
+    folder = tmp_path_factory.mktemp("test-12c")
+    model = mf.open_model("test-12c")
+    files = {}
+    for solver in ("la", "fdem", "jmm"):
+        files[solver] = folder / f"test-12c.{solver}.nc"
+        mf.save(mf.solve(model, solver), files[solver])
+    return files

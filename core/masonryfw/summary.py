@@ -1,0 +1,135 @@
+"""Headline numbers and agreement scores as short tables: what ``compare`` prints and reports show.
+
+One place turns :func:`masonryfw.key_numbers` and comparison datasets into rows of
+text, so the command line, a report and a test read the same numbers the same way.
+A row is ``(label, cells, note)``: one cell per result (or per pair of results),
+``-`` where a result has no such number, and a note saying what the row means.
+"""
+from __future__ import annotations
+
+import csv
+import io
+import json
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import xarray as xr
+
+from .schema import flags
+from .semantics import key_numbers
+
+MISSING = "-"
+#: Scores a comparison table shows first, in this order; then any other scalar score of the comparator ...
+SHOWN_SCORES = ("crack_f1", "crack_jaccard", "crack_overlap", "crack_spearman", "macro_block_ari",
+                "mechanism_cosine", "locus_distance")
+#: ... but for these details, in the comparison dataset and its JSON (the counts make one row of their own).
+DETAIL_SCORES = ("length_scale", "collapse_multiplier_a", "collapse_multiplier_b", "crack_count_a", "crack_count_b",
+                 "crack_count_both", "crack_precision", "crack_recall", "locus_distance_a_to_b",
+                 "locus_distance_b_to_a")
+
+
+@dataclass(frozen=True)
+class Row:
+    """A table row: a label, one text cell per column, what the row means, and the raw values (None = missing)."""
+
+    label: str
+    cells: tuple[str, ...]
+    note: str
+    values: tuple[float | None, ...]
+
+
+def _mm(metres: float) -> str:
+    return f"{1e3 * metres:.3g} mm"
+
+
+def _damage_name(category: float) -> str:
+    names = {value: name.replace("_", " ") for name, value in flags("step_damage_category").items()}
+    return f"{int(category)} {names.get(int(category), '')}".strip()
+
+
+#: key number -> (label, how to write it given all numbers of the result, note)
+_HEADLINES = (
+    ("alpha", "alpha", lambda n: f"{n['alpha']:.4f}",
+     "collapse multiplier (limit analysis): the share of R0 the settling supports shed at collapse"),
+    ("collapse_reaction", "collapse reaction", lambda n: f"{n['collapse_reaction']:.4g} N",
+     "reaction on the settling supports when the mechanism forms, (1 - alpha) R0"),
+    ("dead_reaction", "dead reaction R0", lambda n: f"{n['dead_reaction']:.4g} N",
+     "reaction on the settling supports under the weight alone"),
+    ("minimum_reaction", "minimum reaction", lambda n: f"{n['minimum_reaction']:.4g} N at "
+     f"{_mm(n['minimum_reaction_settlement'])}", "smallest reaction of the history, and the settlement there"),
+    ("plateau_reaction", "plateau reaction", lambda n: f"{n['plateau_reaction']:.4g} N from "
+     f"{_mm(n['plateau_settlement'])}", "the reaction once it stops changing (within 1 % of R0)"),
+    ("final_settlement", "final settlement", lambda n: _mm(n["final_settlement"]), "settlement of the last record"),
+    ("crack_width", "widest crack", lambda n: _mm(n["crack_width"]), "widest joint opening at the last record"),
+    ("damage_category", "damage category", lambda n: _damage_name(n["damage_category"]),
+     "Burland et al. (1977) by crack width: 0 negligible .. 5 very severe"),
+    ("macro_blocks", "macro-blocks", lambda n: f"{int(n['macro_blocks'])}",
+     "pieces the masonry breaks into (blocks joined by intact joints)"),
+)
+
+
+def result_label(result: xr.Dataset) -> str:
+    """``solver`` plus the backend it chose when its options name one, e.g. ``la (highs)``."""
+    name = str(result.attrs.get("solver", result.attrs.get("plugin", "?")))
+    try:
+        options = json.loads(result.attrs.get("solver_options", "{}"))
+    except (TypeError, ValueError):
+        options = {}
+    detail = [str(options[k]) for k in ("solver", "backend") if isinstance(options, dict) and k in options]
+    return f"{name} ({', '.join(detail)})" if detail else name
+
+
+def headline_rows(results: Sequence[xr.Dataset]) -> list[Row]:
+    """One row per headline number any of ``results`` has, one cell per result."""
+    numbers = [{k.name: k.value for k in key_numbers(result)} for result in results]
+    rows = []
+    for name, label, write, note in _HEADLINES:
+        if any(name in n for n in numbers):
+            rows.append(Row(label, tuple(write(n) if name in n else MISSING for n in numbers), note,
+                            tuple(n.get(name) for n in numbers)))
+    return rows
+
+
+def _score_names(comparisons: Sequence[xr.Dataset]) -> list[str]:
+    names = {str(n) for c in comparisons for n in c.data_vars if c[n].ndim == 0 and str(n) not in DETAIL_SCORES}
+    return [n for n in SHOWN_SCORES if n in names] + sorted(names - set(SHOWN_SCORES))
+
+
+def score_rows(comparisons: Sequence[xr.Dataset]) -> list[Row]:
+    """One row per score any comparison has (:data:`SHOWN_SCORES` first, no :data:`DETAIL_SCORES`, the crack
+    counts as one row), one cell per comparison."""
+    rows = []
+    if any("crack_count_a" in c for c in comparisons):
+        rows.append(Row("cracked joints a/b/both", tuple(
+            "/".join(str(int(c[n])) for n in ("crack_count_a", "crack_count_b", "crack_count_both"))
+            if "crack_count_a" in c else MISSING for c in comparisons),
+            "joints with crack_indicator above the threshold in a, in b, in both", tuple(None for _ in comparisons)))
+    for name in _score_names(comparisons):
+        present = [c for c in comparisons if name in c]
+        values = tuple(float(c[name]) if name in c else None for c in comparisons)
+        rows.append(Row(name, tuple(MISSING if v is None else f"{v:.4g}" for v in values),
+                        str(present[0][name].attrs.get("comment", present[0][name].attrs.get("long_name", ""))),
+                        values))
+    return rows
+
+
+def text_table(header: Sequence[str], rows: Sequence[Row], note: bool = True) -> str:
+    """Rows as aligned plain text, the note (what the row means) last."""
+    lines = [[str(h) for h in header]] + [[r.label, *r.cells] + ([r.note] if note else []) for r in rows]
+    if note:
+        lines[0].append("")
+    widths = [max(len(line[i]) for line in lines) for i in range(len(lines[0]) - (1 if note else 0))]
+    out = []
+    for line in lines:
+        cells = [cell.ljust(width) for cell, width in zip(line, widths)]
+        out.append("  ".join(cells + line[len(widths):]).rstrip())
+    return "\n".join(out)
+
+
+def csv_text(header: Sequence[str], rows: Sequence[Sequence]) -> str:
+    """RFC 4180 CSV; floats with every digit (repr), a missing value as an empty field."""
+    buffer = io.StringIO()
+    writer = csv.writer(buffer, lineterminator="\n")
+    writer.writerow(header)
+    writer.writerows([["" if v is None else repr(float(v)) if isinstance(v, float) else v for v in row] for row in rows])
+    return buffer.getvalue()

@@ -1,0 +1,217 @@
+"""``masonryfw report``: one self-contained HTML file about one or more results of a model.
+
+Everything is inside the file: the figures are PNGs in ``data:`` URLs, the style
+sheet is inline, there is no script and no link to the network, so it opens
+anywhere and can be attached to an assessment. The numbers are the core's
+(:func:`masonryfw.headline_rows`, :func:`masonryfw.score_rows`): each table cell
+carries its full-precision value in ``data-value`` so that a reader (or a test)
+can check it against the result files.
+"""
+from __future__ import annotations
+
+import base64
+import datetime
+import hashlib
+import html
+import io
+import itertools
+import platform
+from collections.abc import Callable, Sequence
+from importlib import metadata
+from pathlib import Path
+
+import xarray as xr
+
+import masonryfw as mf
+
+from .comparison import ensure_same_model
+
+FIGURE_DPI = 130
+#: Libraries whose versions the provenance lists.
+LIBRARIES = ("numpy", "scipy", "xarray", "netCDF4", "matplotlib", "numba", "scikit-fem", "clarabel")
+
+STYLE = """
+body { font-family: system-ui, -apple-system, "Segoe UI", Roboto, sans-serif; margin: 2em auto; max-width: 70em;
+       padding: 0 1em; color: #222; line-height: 1.4; }
+h1 { font-size: 1.6em; margin-bottom: 0.2em; } h2 { border-bottom: 1px solid #ccc; margin-top: 1.6em; }
+table { border-collapse: collapse; margin: 0.6em 0; font-size: 0.92em; }
+th, td { border: 1px solid #ccc; padding: 0.25em 0.6em; text-align: left; vertical-align: top; }
+th { background: #f3f3f3; } td.note { color: #555; font-size: 0.9em; }
+figure { margin: 1em 0; } figure img { max-width: 100%; height: auto; border: 1px solid #eee; }
+figcaption { color: #555; font-size: 0.9em; } pre { background: #f7f7f7; padding: 0.6em; overflow-x: auto;
+font-size: 0.85em; } .meta { color: #555; }
+"""
+
+
+def _png(figure) -> str:
+    """A matplotlib figure as a ``data:`` URL of a PNG cropped to what is drawn."""
+    buffer = io.BytesIO()
+    figure.savefig(buffer, format="png", dpi=FIGURE_DPI, bbox_inches="tight", pad_inches=0.04)
+    return "data:image/png;base64," + base64.b64encode(buffer.getvalue()).decode("ascii")
+
+
+def _figure(datasets: Sequence[xr.Dataset], kind: str, caption: str, options: dict | None = None) -> str:
+    src = _png(mf.render(list(datasets), kind, options or {}))
+    return (f'<figure data-kind="{kind}"><img src="{src}" alt="{html.escape(caption)}">'
+            f"<figcaption>{html.escape(caption)}</figcaption></figure>")
+
+
+def _value_attribute(value: float | None) -> str:
+    return "" if value is None else f' data-value="{value!r}"'
+
+
+def _table(header: Sequence[str], rows: Sequence[mf.Row], table_id: str, columns: Sequence[str]) -> str:
+    """An HTML table of :class:`masonryfw.Row`; each cell says its row key, column and full value."""
+    head = "".join(f"<th>{html.escape(h)}</th>" for h in header) + "<th>what it means</th>"
+    body = []
+    for row in rows:
+        cells = "".join(
+            f'<td data-row="{html.escape(row.label)}" data-column="{html.escape(column)}"{_value_attribute(value)}>'
+            f"{html.escape(cell)}</td>"
+            for cell, value, column in zip(row.cells, row.values, columns)
+        )
+        body.append(f"<tr><th>{html.escape(row.label)}</th>{cells}<td class=\"note\">{html.escape(row.note)}</td></tr>")
+    return f'<table id="{table_id}"><tr>{head}</tr>{"".join(body)}</table>'
+
+
+def _model_of(result: xr.Dataset) -> xr.Dataset:
+    """The model variables of a result, titled as the model (drawn as a model, not as a result)."""
+    names = [n for n in result.data_vars if n in mf.load_schema("model")["variables"]]
+    return xr.Dataset({n: result[n] for n in names}, attrs={"title": result.attrs.get("title", "")})
+
+
+def _model_section(first: xr.Dataset) -> str:
+    geo = mf.derive_geometry(first)
+    roles = first.block_role.values
+    masonry = mf.masonry_blocks(roles)
+    xmin, xmax, ymin, ymax = mf.block_bounds(geo.node_x, geo.node_y, geo.block_node_count)
+    size = f"{xmax[masonry].max() - xmin[masonry].min():.4g} m x {ymax[masonry].max() - ymin[masonry].min():.4g} m"
+    facts = (f"{int(masonry.sum())} masonry blocks, {int(mf.support_blocks(roles).sum())} supports, "
+             f"{first.sizes.get('interface', 0)} interfaces; the masonry spans {size}.")
+    parts = ["<h2>The wall</h2>", f"<p>{html.escape(facts)}</p>",
+             _figure([_model_of(first)], "model",
+                     "The model: blocks by role (supports hatched, a settling one with an arrow), joints by kind.")]
+    if first.attrs.get("source_drawing"):
+        parts.append(f"<p>Drawing: <code>{html.escape(str(first.attrs['source_drawing']))}</code>, sha256 "
+                     f"<code>{html.escape(str(first.attrs.get('source_drawing_sha256', '?')))}</code></p>")
+    if first.attrs.get("source_spec"):
+        parts.append("<details open><summary>Source spec</summary><pre>"
+                     f"{html.escape(str(first.attrs['source_spec']), quote=False)}</pre></details>")
+    return "\n".join(parts)
+
+
+def _result_figures(ds: xr.Dataset, label: str) -> list[str]:
+    """The figures a single result supports, each with a caption saying how to read it."""
+    figures = []
+    if "block_displacement" in ds:
+        how = ("the displacement increment of the last steps, fitted per block" if "qp_failure" in ds
+               else "amplified")
+        figures.append(_figure([ds], "mechanism", f"{label}: the mechanism ({how}); the dominant macro-blocks "
+                               "numbered by size, cracked joints heavy on the blocks' faces."))
+    if "interface_opening" in ds:
+        figures.append(_figure([ds], "cracks", f"{label}: joints that open, slide or both."))
+    if "interface_normal_force" in ds:
+        figures.append(_figure([ds], "forces", f"{label}: joint resultants at collapse; colour: the share of "
+                               "the friction used."))
+    if "qp_failure" in ds:
+        figures.append(_figure([ds], "plastic", f"{label}: plastic quadrature points of the continuum."))
+    return figures
+
+
+def _history_section(datasets: Sequence[xr.Dataset]) -> list[str]:
+    incremental = [ds for ds in datasets if "step_settlement" in ds]
+    if not incremental:
+        return []
+    parts = ["<h2>Reaction against settlement</h2>",
+             _figure(datasets, "history", "Reaction on the settling supports of every incremental result, with the "
+                     "dead load R0 and the limit analyses' collapse reaction (1 - alpha) R0; strips along the top: "
+                     "the damage category."),
+             _figure(datasets, "history", "The same on a logarithmic settlement axis (the first fractions of a "
+                     "millimetre).", {"xscale": "log"})]
+    if all("step_damage_category" in ds for ds in incremental):
+        parts.append(_figure(incremental, "history", "Damage category and widest crack against settlement.",
+                             {"quantity": "damage"}))
+    return parts
+
+
+def _agreement_section(datasets: Sequence[xr.Dataset], letters: Sequence[str]) -> list[str]:
+    if len(datasets) < 2:
+        return []
+    pairs = list(itertools.combinations(range(len(datasets)), 2))
+    comparisons = [mf.compare(datasets[i], datasets[j], "crack") for i, j in pairs]
+    columns = [f"{letters[i]}-{letters[j]}" for i, j in pairs]
+    return ["<h2>Agreement</h2>",
+            "<p>Every pair scored by the <code>crack</code> comparator (the first of a pair is its reference): "
+            "do the two results crack the same joints, break into the same pieces, move the same way?</p>",
+            _table(["score", *columns], mf.score_rows(comparisons), "agreement", columns),
+            _figure(datasets, "compare", "The results side by side, each later one with its scores against the "
+                    "first.")]
+
+
+def _versions() -> dict[str, str]:
+    versions = {"masonryfw": mf.__version__, "python": platform.python_version()}
+    for name in LIBRARIES:
+        try:
+            versions[name] = metadata.version(name)
+        except metadata.PackageNotFoundError:
+            continue
+    return versions
+
+
+def _provenance_section(paths: Sequence[str], datasets: Sequence[xr.Dataset], letters: Sequence[str],
+                        command: str) -> list[str]:
+    rows = []
+    for letter, path, ds in zip(letters, paths, datasets):
+        digest = hashlib.sha256(Path(path).read_bytes()).hexdigest()
+        facts = {
+            "file": path, "file sha256": digest, "solver": ds.attrs.get("solver", "?"),
+            "solver version": ds.attrs.get("solver_version", "?"), "core version": ds.attrs.get("core_version", "?"),
+            "options": ds.attrs.get("solver_options", "{}"), "model sha256": ds.attrs.get("model_sha256", "?"),
+            "wall time": f"{float(ds.attrs.get('wall_time_s', 'nan')):.3g} s",
+            "stop reason": ds.attrs.get("stop_reason", ""), "history": ds.attrs.get("history", ""),
+        }
+        cells = "".join(f"<tr><th>{html.escape(k)}</th><td><code>{html.escape(str(v))}</code></td></tr>"
+                        for k, v in facts.items() if v != "")
+        rows.append(f'<h3>{letter}: {html.escape(mf.result_label(ds))}</h3><table class="provenance">{cells}</table>')
+    versions = "".join(f"<tr><th>{html.escape(k)}</th><td>{html.escape(v)}</td></tr>" for k, v in _versions().items())
+    return ["<h2>Provenance</h2>", *rows, "<h3>This report</h3>",
+            f"<p>Made by <code>{html.escape(command)}</code> on "
+            f"{datetime.datetime.now(datetime.timezone.utc):%Y-%m-%d %H:%M} UTC with:</p>",
+            f"<table>{versions}</table>"]
+
+
+def report_html(paths: Sequence[str], command: str, progress: Callable[[float, str], None] | None = None) -> str:
+    """The report of the results at ``paths`` (one model) as one HTML document."""
+    step = progress or (lambda fraction, message: None)
+    datasets = [mf.open_dataset(p) for p in paths]
+    for path, ds in zip(paths, datasets):
+        if ds.attrs.get("masonryfw_format") != "result":
+            raise mf.MasonryError(f"{path}: not a result file (masonryfw_format = "
+                                  f"{ds.attrs.get('masonryfw_format')!r}); the report reads results")
+    for ds in datasets[1:]:
+        ensure_same_model(datasets[0], ds)
+    letters = [chr(ord("A") + i) for i in range(len(datasets))]
+    labels = [f"{letter}: {mf.result_label(ds)}" for letter, ds in zip(letters, datasets)]
+    title = str(datasets[0].attrs.get("title", "untitled"))
+    step(0.05, "the wall")
+    parts = [f"<h1>{html.escape(title)}</h1>",
+             '<p class="meta">' + " &middot; ".join(
+                 f"{html.escape(label)} (<code>{html.escape(path)}</code>)" for label, path in zip(labels, paths))
+             + "</p>",
+             _model_section(datasets[0]),
+             "<h2>Key numbers</h2>",
+             _table(["", *letters], mf.headline_rows(datasets), "key-numbers", letters)]
+    step(0.2, "figures")
+    parts += _history_section(datasets)
+    for i, (label, ds) in enumerate(zip(labels, datasets)):
+        step(0.2 + 0.5 * i / len(datasets), f"figures of {label}")
+        parts += [f"<h2>{html.escape(label)}</h2>", *_result_figures(ds, label)]
+    step(0.75, "agreement")
+    parts += _agreement_section(datasets, letters)
+    parts += _provenance_section(paths, datasets, letters, command)
+    step(1.0, "done")
+    body = "\n".join(parts)
+    return (f'<!DOCTYPE html>\n<html lang="en"><head><meta charset="utf-8">'
+            f'<meta name="viewport" content="width=device-width, initial-scale=1">'
+            f"<title>{html.escape(title)} - masonryfw report</title><style>{STYLE}</style></head>"
+            f"<body>\n{body}\n</body></html>\n")

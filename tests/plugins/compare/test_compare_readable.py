@@ -1,0 +1,133 @@
+"""Results a person can read: the compare table, the history overlay and its CSV, the numbered mechanism.
+
+On Test 12C solved by la, fdem and jmm. The references are independent of the drawing code: the
+closed-form dead load R0 = 792 N x 0.6 / 1.1 = 432 N (datasets/README.md), the result files' own
+variables, and the comparator's scores.
+"""
+from __future__ import annotations
+
+import csv
+import json
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+import masonryfw as mf
+from masonryfw.cli import cli
+from masonryfw_compare.plotting import DOMINANT_SHARE, gravity_records
+
+R0 = 792.0 * 0.6 / 1.1
+
+
+def invoke(*args):
+    return CliRunner().invoke(cli, [str(a) for a in args])
+
+
+@pytest.fixture(scope="module")
+def opened(test_12c_files):
+    return {solver: mf.open_dataset(path) for solver, path in test_12c_files.items()}
+
+
+def test_compare_prints_both_headlines_and_each_score_with_what_it_measures(test_12c_files, opened):
+    run = invoke("compare", test_12c_files["la"], test_12c_files["fdem"])
+    assert run.exit_code == 0, run.output
+    lines = run.stdout.splitlines()
+    assert lines[0] == f"A: {test_12c_files['la']} (la (ipm))" and lines[1] == f"B: {test_12c_files['fdem']} (fdem)"
+    alpha = float(opened["la"].collapse_multiplier)
+    row = next(line for line in lines if line.startswith("alpha "))
+    assert row.split()[1:3] == [f"{alpha:.4f}", "-"]
+    row = next(line for line in lines if line.startswith("collapse reaction"))
+    assert f"{(1 - alpha) * R0:.4g} N" in row
+    fdem = opened["fdem"]
+    settling = fdem.step_reaction.values[gravity_records(fdem.step_settlement.values) - 1:]
+    row = next(line for line in lines if line.startswith("minimum reaction"))
+    assert f"{settling.min():.4g} N at" in row
+    scores = mf.compare(opened["la"], fdem, "crack")
+    for name in ("crack_f1", "macro_block_ari", "mechanism_cosine", "locus_distance"):
+        row = next(line for line in lines if line.startswith(name + " "))
+        assert row.split()[1] == f"{float(scores[name]):.4g}"
+        assert scores[name].attrs["comment"] in row  # what it measures and its range
+    assert "1 = the same mechanism, 0 = unrelated, -1 = opposite" in run.stdout
+
+
+def test_compare_of_three_results_scores_every_pair(test_12c_files, opened):
+    paths = [test_12c_files[s] for s in ("la", "fdem", "jmm")]
+    run = invoke("compare", *paths)
+    assert run.exit_code == 0, run.output
+    header = next(line for line in run.stdout.splitlines() if line.startswith("crack score"))
+    assert header.split()[2:] == ["A-B", "A-C", "B-C"]
+    scores = json.loads(invoke("compare", *paths, "--json").stdout)
+    assert [(p["a"], p["b"]) for p in scores["pairs"]] == [(str(paths[0]), str(paths[1])), (str(paths[0]), str(paths[2])),
+                                                         (str(paths[1]), str(paths[2]))]
+    expected = mf.compare(opened["fdem"], opened["jmm"], "crack")
+    assert scores["pairs"][2]["scores"]["mechanism_cosine"] == float(expected.mechanism_cosine)
+    refused = invoke("compare", *paths, "-o", "three.nc")
+    assert refused.exit_code == 1 and "-o writes the comparison of two results, got 3" in refused.stderr
+    assert invoke("compare", paths[0]).exit_code == 2
+
+
+def test_a_continuum_result_is_scored_by_its_mechanism_too(opened):
+    scores = mf.compare(opened["la"], opened["jmm"], "crack")
+    assert {"mechanism_cosine", "macro_block_ari"} <= set(scores.data_vars)
+    masonry = mf.masonry_blocks(opened["jmm"].block_role.values)
+    assert np.isfinite(mf.block_motion(opened["jmm"])[masonry]).all()
+
+
+def test_history_csv_holds_the_curves_numbers_and_la_s_collapse_reaction(test_12c_files, opened, tmp_path):
+    out = tmp_path / "history.csv"
+    run = invoke("plot", test_12c_files["fdem"], test_12c_files["jmm"], test_12c_files["la"], "--kind", "history",
+                 "-o", out)
+    assert run.exit_code == 0, run.output
+    with out.open() as handle:
+        rows = list(csv.DictReader(handle))
+    for solver in ("fdem", "jmm"):
+        mine = [r for r in rows if r["result"] == solver]
+        ds = opened[solver]
+        np.testing.assert_array_equal([float(r["settlement_m"]) for r in mine], ds.step_settlement.values)
+        np.testing.assert_array_equal([float(r["reaction_N"]) for r in mine], ds.step_reaction.values)
+        np.testing.assert_array_equal([int(r["damage_category"]) for r in mine], ds.step_damage_category.values)
+        assert [r["stage"] for r in mine].count("gravity") == gravity_records(ds.step_settlement.values)
+    (la_row,) = [r for r in rows if r["result"] == "la (ipm)"]
+    assert float(la_row["reaction_N"]) == pytest.approx((1 - float(opened["la"].collapse_multiplier)) * R0, rel=1e-12)
+    refused = invoke("plot", test_12c_files["la"], "--kind", "mechanism", "-o", tmp_path / "m.csv")
+    assert refused.exit_code == 1 and "the mechanism plot draws no curves to write as CSV; kinds with curves: history" \
+        in refused.stderr
+    mismatch = invoke("plot", test_12c_files["fdem"], "--kind", "history", "--format", "svg", "-o", tmp_path / "h.png")
+    assert mismatch.exit_code == 1 and "--format svg needs a file ending in .svg" in mismatch.stderr
+
+
+def test_the_history_overlays_results_with_the_dead_load_and_la_s_collapse_reaction(opened, tmp_path):
+    figure = mf.render([opened["fdem"], opened["jmm"], opened["la"]], "history", {"xscale": "log"})
+    ax = figure.axes[0]
+    assert ax.get_xscale() == "log"
+    labels = [text.get_text() for text in ax.get_legend().get_texts()]
+    assert labels[:2] == ["fdem", "jmm"]
+    alpha = float(opened["la"].collapse_multiplier)
+    levels = {round(float(line.get_ydata()[0]), 9) for line in ax.get_lines() if len(set(line.get_ydata())) == 1}
+    assert round(R0, 9) in levels and round((1 - alpha) * R0, 9) in levels
+    for suffix in (".png", ".svg", ".pdf"):
+        assert mf.save_figure(figure, tmp_path / f"h{suffix}").stat().st_size > 1000
+    zoomed = mf.render([opened["fdem"], opened["jmm"]], "history", {"settlement_max": 0.01}).axes[0]
+    assert zoomed.get_xlim()[1] == 0.01
+    jmm_reactions = opened["jmm"].step_reaction.values
+    assert zoomed.get_ylim()[1] >= jmm_reactions.max()
+
+
+def test_the_mechanism_numbers_the_pieces_holding_two_percent_of_the_masonry(opened):
+    ds = opened["la"]
+    masonry = mf.masonry_blocks(ds.block_role.values)
+    labels, inverse = np.unique(ds.macro_block.values[masonry], return_inverse=True)
+    area = np.bincount(inverse, weights=np.abs(ds.block_area.values[masonry]))
+    dominant = int((area >= DOMINANT_SHARE * area.sum()).sum())
+    ax = mf.render([ds], "mechanism").axes[0]
+    numbers = sorted(t.get_text() for t in ax.texts)
+    assert numbers == sorted(f"({k})" for k in range(1, dominant + 1))
+    legend = [t.get_text() for t in ax.get_legend().get_texts()]
+    assert f"small pieces ({labels.size - dominant})" in legend
+    cracked = int((ds.crack_indicator.values > 0.1).sum())
+    assert f"cracked joints ({cracked})" in legend
+    faces = [c for c in ax.collections if c.get_linewidths()[0] > 1.0]
+    assert len(faces[0].get_segments()) == 2 * cracked  # each crack on both blocks' faces
+    assert ax.get_title().endswith(f"alpha = {float(ds.collapse_multiplier):.4f}, collapse reaction "
+                                   f"{(1 - float(ds.collapse_multiplier)) * R0:.4g} N")
