@@ -306,7 +306,10 @@ of a pair.
   about the centroid), i.e. rotations are scaled by each block's radius of gyration
   sqrt(J/A); the cosine ignores the overall size, so a normalised LA mechanism and a
   physical displacement compare directly. 1 = the same mechanism, 0 = unrelated,
-  negative = opposite.
+  negative = opposite. A continuum result (jmm) has block motions too: the displacement
+  increment of its last steps projected onto each block's rigid motions
+  (`masonryfw.rigid_fit`), from which its macro-blocks and cracks are derived as for the
+  discrete methods.
 - **locus d**: symmetric mean distance between the failure loci (cracked joints,
   or plastic points of a continuum result), over the model size (bounding-box
   diagonal); 0 = the same place. It needs no shared discretisation, so it scores a

@@ -1,8 +1,9 @@
 """Plot kinds: the drawing functions behind the ``Plotter`` records of :mod:`.records`.
 
 Every kind draws on one matplotlib Axes with equal axes, metres on both axes and
-a title made of the model's ``title`` and the solver; ``history`` plots reaction
-against settlement instead. A kind that needs a variable the result lacks raises
+a title made of the model's ``title``, the solver and the result's headline (alpha and
+the collapse reaction, or the dead, smallest and plateau reactions); ``history`` plots
+reaction against settlement instead, of several results at once. A kind that needs a variable the result lacks raises
 a :class:`masonryfw.MasonryError` naming the variable and the kind of result it needs.
 """
 from __future__ import annotations
@@ -36,9 +37,6 @@ DAMAGE_COLOURS = ("#1a9850", "#91cf60", "#fee08b", "#fc8d59", "#d73027", "#7f000
 DOMINANT_SHARE = 0.02  # a macro-block holding this share of the masonry area is numbered ...
 MOST_NUMBERED = 10  # ... up to this many
 THRUST_REFERENCE_PERCENTILE = 95.0
-# tab20 entries for macro-blocks: the dark shades first, then the light ones, so that
-# neighbouring labels differ in hue; its greys (14, 15) are left to the supports.
-MACRO_BLOCK_HUES = tuple(i for i in (*range(0, 20, 2), *range(1, 20, 2)) if i not in (14, 15))
 
 
 def _require(ds: xr.Dataset, names: Sequence[str], kind: str, needs: str) -> None:
@@ -122,16 +120,6 @@ def _draw_outline(ax, geo) -> None:
 def _segments(x: np.ndarray, y: np.ndarray) -> np.ndarray:
     """(n, 2 ends) coordinates to a LineCollection's (n, 2, 2) array."""
     return np.stack([x, y], axis=-1)
-
-
-def macro_block_colours(ds: xr.Dataset) -> np.ndarray:
-    """One colour per block from its macro-block label (tab20 cycled); light grey without labels."""
-    if "macro_block" not in ds:
-        return np.array(["0.85"] * ds.sizes["block"], dtype=object)
-    _, rank = np.unique(ds.macro_block.values, return_inverse=True)
-    palette = colormaps["tab20"].colors
-    return np.array([palette[MACRO_BLOCK_HUES[r % len(MACRO_BLOCK_HUES)]] for r in range(rank.max() + 1)],
-                    dtype=object)[rank]
 
 
 @dataclass(frozen=True)
@@ -362,12 +350,12 @@ def draw_forces(datasets: Sequence[xr.Dataset], ax, options: Mapping[str, Any]) 
         lines = LineCollection(segments, cmap=FRICTION_MAP, norm=Normalize(0.0, 1.0), linewidths=width, zorder=3)
         lines.set_array(used)
         ax.add_collection(lines)
-        ax.scatter(px, py, s=2 * line_scale(geo), c="k", zorder=4)
-        bar = ax.figure.colorbar(lines, ax=ax, shrink=0.7, pad=0.02)
+        ax.scatter(px, py, s=1.5 * line_scale(geo) ** 2, c="0.35", zorder=4, linewidths=0)
+        bar = ax.figure.colorbar(lines, cax=ax.inset_axes((1.03, 0.1, 0.03, 0.8)))  # follows the equal-aspect box
         bar.set_label("friction used |V| / (mu N); 1 = sliding", fontsize="small")
         handles = [
             Line2D([], [], color="0.3", lw=3.0, label=f"joint resultant, full length = {reference:.3g} N (95th pct.)"),
-            Line2D([], [], ls="none", marker=".", color="k", label="centre of pressure"),
+            Line2D([], [], ls="none", marker=".", color="0.35", label="centre of pressure"),
             Line2D([], [], ls="none", label=f"largest {magnitude.max():.3g} N, {magnitude.size} loaded joints"),
         ]
     ax.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, -0.14), ncol=2, fontsize="small",
@@ -415,18 +403,63 @@ def distinct_labels(datasets: Sequence[xr.Dataset]) -> list[str]:
     return out
 
 
+def _is_sweep(ds: xr.Dataset) -> bool:
+    return ds.attrs.get("masonryfw_format") == "sweep"
+
+
 def _split_history(datasets: Sequence[xr.Dataset], kind: str):
-    """The incremental results (with a history) and the limit analyses (with alpha) among ``datasets``."""
+    """The incremental results (with a history), the limit analyses (with alpha) and the sweeps of an
+    incremental solver (with each point's smallest reaction) among ``datasets``."""
+    sweeps = [ds for ds in datasets if _is_sweep(ds)]
     incremental = [ds for ds in datasets if "step_settlement" in ds and "step_reaction" in ds]
     limits = [ds for ds in datasets if "collapse_multiplier" in ds and "step_settlement" not in ds]
     for ds in datasets:
-        if "step_settlement" not in ds and "collapse_multiplier" not in ds:
+        if _is_sweep(ds) and not {"minimum_reaction", "minimum_reaction_settlement"} <= set(ds.data_vars):
+            raise mf.MasonryError(f"{ds.attrs.get('title', 'a sweep')} has no minimum_reaction_settlement: the {kind} "
+                                  f"plot draws the points of sweeps of an incremental solver (fdem, jmm), not "
+                                  f"{ds.attrs.get('solver', '?')}'s")
+        if not _is_sweep(ds) and "step_settlement" not in ds and "collapse_multiplier" not in ds:
             raise mf.MasonryError(f"{title_of(ds)} has neither step_settlement nor collapse_multiplier: "
-                                  f"the {kind} plot draws incremental (fdem, jmm) histories and la references")
-    if not incremental:
+                                  f"the {kind} plot draws incremental (fdem, jmm) histories, sweeps of them "
+                                  "and la references")
+    if not incremental and not sweeps:
         raise mf.MasonryError(f"the {kind} plot needs an incremental (fdem or jmm) result with step_settlement "
-                              "and step_reaction")
-    return incremental, limits
+                              "and step_reaction, or a sweep of one")
+    return incremental, limits, sweeps
+
+
+def sweep_points(sweep: xr.Dataset) -> list[tuple[str, float, float, float, float]]:
+    """Per solved point of a sweep: ``(point, smallest reaction's settlement, smallest reaction, plateau's
+    settlement, plateau reaction)``, the point as ``key=value, ...``; NaN where a number is missing."""
+    meanings = dict(zip(sweep.status.attrs["flag_meanings"].split(), np.atleast_1d(sweep.status.attrs["flag_values"])))
+    ok = sweep.status.values == meanings["ok"]
+    names = ("minimum_reaction_settlement", "minimum_reaction", "plateau_settlement", "plateau_reaction")
+    values = [sweep[n].values if n in sweep else np.full(ok.shape, np.nan) for n in names]
+    out = []
+    for index in zip(*np.nonzero(ok)):
+        where = ", ".join(f"{sweep[c].attrs.get('sweep_key', c)}={sweep[c].values[index[sweep.status.dims.index(d)]]}"
+                          for d in sweep.status.dims for c in sweep.coords if sweep[c].dims == (d,))
+        out.append((where, *(float(v[index]) for v in values)))
+    return out
+
+
+def _draw_sweeps(ax, sweeps: Sequence[xr.Dataset], first_colour: int) -> list:
+    """Each sweep point's smallest reaction (filled) and plateau (hollow) at their settlements."""
+    handles = []
+    for k, sweep in enumerate(sweeps):
+        colour = f"C{(first_colour + k) % 10}"
+        points = sweep_points(sweep)
+        keys = sweep.attrs.get("sweep_keys", "")
+        x, y = 1e3 * np.array([p[1] for p in points]), np.array([p[2] for p in points])
+        handles.append(ax.scatter(x, y, marker="o", s=22, color=colour, zorder=4,
+                                  label=f"sweep of {keys}: smallest reaction ({len(points)} points)"))
+        handles.append(ax.scatter(1e3 * np.array([p[3] for p in points]), [p[4] for p in points], marker="s", s=22,
+                                  facecolors="none", edgecolors=colour, zorder=4, label=f"sweep of {keys}: plateau"))
+        if len(points) <= 12:
+            for (where, *_), xi, yi in zip(points, x, y):
+                ax.annotate(where.split("=", 1)[-1] if "," not in where else where, (xi, yi), fontsize="x-small",
+                            xytext=(3, 3), textcoords="offset points", color=colour)
+    return handles
 
 
 def gravity_records(settlement: np.ndarray) -> int:
@@ -459,7 +492,7 @@ def draw_history(datasets: Sequence[xr.Dataset], ax, options: Mapping[str, Any])
     incremental results overlaid, with the dead load R0 and, for every la result given, its collapse
     reaction (1 - alpha) R0 as reference lines; the gravity stage as the spread of reactions at zero
     settlement; the damage category as strips along the top."""
-    incremental, limits = _split_history(datasets, "history")
+    incremental, limits, sweeps = _split_history(datasets, "history")
     labels = distinct_labels(incremental)
     colours = [f"C{i % 10}" for i in range(len(incremental))]
     ax.grid(True, lw=0.3)
@@ -467,6 +500,8 @@ def draw_history(datasets: Sequence[xr.Dataset], ax, options: Mapping[str, Any])
     log = options["xscale"] == "log"
     ax.set_xscale("log" if log else "linear")
     if options["quantity"] == "damage":
+        if sweeps or not incremental:
+            raise mf.MasonryError("history --option quantity=damage draws incremental results, not sweeps")
         _draw_damage(ax, incremental, labels, colours)
     else:
         handles = []
@@ -479,7 +514,9 @@ def draw_history(datasets: Sequence[xr.Dataset], ax, options: Mapping[str, Any])
                 low, high = float(r[:first + 1].min()), float(r[:first + 1].max())
                 handles.append(ax.vlines(0.0, low, high, color=colour, lw=4, alpha=0.35,
                                          label=f"{label}: gravity stage, {first + 1} records, {low:.4g}..{high:.4g} N"))
-        r0 = mf.dead_reaction(incremental[0])
+        handles += _draw_sweeps(ax, sweeps, len(incremental))
+        references = [*incremental, *limits]
+        r0 = mf.dead_reaction(references[0]) if references else 0.0
         if r0 > 0:
             handles.append(ax.axhline(r0, ls="--", lw=0.9, color="0.35", label=f"dead load R0 = {r0:.4g} N"))
         for ds, style in zip(limits, (":", "-.", (0, (1, 3)), (0, (5, 2)))):
@@ -495,8 +532,10 @@ def draw_history(datasets: Sequence[xr.Dataset], ax, options: Mapping[str, Any])
         ax.set_xlim(right=options["settlement_max"], left=None if log else -0.02 * options["settlement_max"])
         if options["quantity"] == "reaction":
             _fit_y_to_shown(ax, [(1e3 * ds.step_settlement.values, ds.step_reaction.values) for ds in incremental])
-    ax.set_title(str(incremental[0].attrs.get("title", "")) if len(incremental) > 1 or limits
-                 else f"{title_of(incremental[0])}\n{headline_of(incremental[0])}", fontsize="medium")
+    if len(incremental) == 1 and not limits and not sweeps:
+        ax.set_title(f"{title_of(incremental[0])}\n{headline_of(incremental[0])}", fontsize="medium")
+    else:
+        ax.set_title(str(datasets[0].attrs.get("title", "")), fontsize="medium")
 
 
 def _fit_y_to_shown(ax, curves: Sequence[tuple[np.ndarray, np.ndarray]]) -> None:
@@ -532,7 +571,7 @@ def _draw_damage(ax, incremental, labels, colours) -> None:
 def history_table(datasets: Sequence[xr.Dataset], options: Mapping[str, Any]) -> tuple[list[str], list[list]]:
     """The history plot's curves as rows: one per record of every incremental result (the la references
     as rows with no record), in SI units."""
-    incremental, limits = _split_history(datasets, "history")
+    incremental, limits, sweeps = _split_history(datasets, "history")
     header = ["result", "record", "stage", "settlement_m", "reaction_N", "crack_width_max_m", "damage_category"]
     rows: list[list] = []
     for ds, label in zip(incremental, distinct_labels(incremental)):
@@ -547,6 +586,10 @@ def history_table(datasets: Sequence[xr.Dataset], options: Mapping[str, Any]) ->
     for ds in limits:
         r0, alpha = mf.dead_reaction(ds), float(ds.collapse_multiplier.values)
         rows.append([mf.result_label(ds), None, "collapse (1 - alpha) R0", None, (1 - alpha) * r0, None, None])
+    for sweep in sweeps:
+        for k, (where, s_min, r_min, s_plateau, r_plateau) in enumerate(sweep_points(sweep)):
+            rows.append([f"sweep {where}", k, "smallest reaction", s_min, r_min, None, None])
+            rows.append([f"sweep {where}", k, "plateau", s_plateau, r_plateau, None, None])
     return header, rows
 
 
@@ -597,20 +640,27 @@ def panel_axes(ax, count: int) -> list:
 
 
 def draw_compare(datasets: Sequence[xr.Dataset], ax, options: Mapping[str, Any]) -> None:
-    """Results side by side; each later panel's title carries its scores against the first."""
+    """Results side by side, the first titled with the wall; each later panel's title carries its scores
+    against the first. The panels keep their drawings and drop their legends (the single-result kinds
+    explain them); a mechanism's amplification goes under its panel."""
     if len(datasets) < 2:
         raise mf.MasonryError(f"the compare plot needs two or more results of one model, got {len(datasets)}")
     kinds = [panel_kind(ds) for ds in datasets]
     captions = ["reference"] + [
         score_caption(mf.compare(datasets[0], ds, "crack", {"threshold": options["threshold"]})) for ds in datasets[1:]
     ]
-    for panel, ds, kind, caption in zip(panel_axes(ax, len(datasets)), datasets, kinds, captions):
+    wall = str(datasets[0].attrs.get("title", ""))
+    for k, (panel, ds, kind, caption) in enumerate(zip(panel_axes(ax, len(datasets)), datasets, kinds, captions)):
         if kind == "mechanism":
             draw_mechanism([ds], panel, options)
+            amplification = panel.get_legend().get_title().get_text()
+            panel.set_xlabel(f"x [m]; {amplification}")
         elif kind == "plastic":
             draw_plastic([ds], panel, {"marker_size": 4.0})
         else:
             draw_indicator(ds, panel, options["threshold"])
+        if panel.get_legend() is not None:
+            panel.get_legend().remove()
         alpha = f", alpha = {ds.collapse_multiplier.item():.4g}" if "collapse_multiplier" in ds else ""
-        panel.set_title(f"{mf.result_label(ds)}{alpha}\n{caption}", fontsize="medium")
-    ax.figure.suptitle(str(datasets[0].attrs.get("title", "")), fontsize="large")
+        heading = f"{wall}\n" if k == 0 and wall else ""
+        panel.set_title(f"{heading}{mf.result_label(ds)}{alpha}\n{caption}", fontsize="medium")

@@ -64,7 +64,7 @@ def test_compare_draws_side_by_side_panels_with_scores_in_the_titles(results, tm
     figure, _ = plot([results["la"], results["fdem"], results["jmm"]], "compare")
     titles = [ax.get_title() for ax in figure.axes if ax.get_visible() and ax.axison]
     assert titles == [
-        "la (highs), alpha = 0.3\nreference",
+        "Grid wall\nla (highs), alpha = 0.3\nreference",
         "fdem\nF1 1.00, ARI 1.00, cos 1.00, d 0.00",
         "jmm\nF1 1.00, d 0.08",
     ]

@@ -11,6 +11,7 @@ import json
 
 import numpy as np
 import pytest
+import xarray as xr
 from click.testing import CliRunner
 
 import masonryfw as mf
@@ -131,3 +132,34 @@ def test_the_mechanism_numbers_the_pieces_holding_two_percent_of_the_masonry(ope
     assert len(faces[0].get_segments()) == 2 * cracked  # each crack on both blocks' faces
     assert ax.get_title().endswith(f"alpha = {float(ds.collapse_multiplier):.4f}, collapse reaction "
                                    f"{(1 - float(ds.collapse_multiplier)) * R0:.4g} N")
+
+
+def test_a_sweep_s_points_go_on_the_history_at_their_settlements(opened):
+    """A hand-made sweep of two friction angles (one point failed): its solved points' smallest
+    reactions and plateaus, drawn and tabulated where the sweep's own numbers put them."""
+    status = {"flag_values": np.array([0, 1], np.int8), "flag_meanings": "ok failed"}
+    sweep = xr.Dataset(
+        {"status": ("friction", np.array([0, 1, 0], np.int8), status),
+         "minimum_reaction": ("friction", [100.0, np.nan, 90.0]),
+         "minimum_reaction_settlement": ("friction", [0.001, np.nan, 0.002]),
+         "plateau_reaction": ("friction", [110.0, np.nan, 95.0]),
+         "plateau_settlement": ("friction", [0.008, np.nan, 0.009])},
+        coords={"friction": ("friction", [20.0, 25.0, 30.0], {"sweep_key": "material.friction_angle"})},
+        attrs={"masonryfw_format": "sweep", "title": "sweep of Test 12C", "solver": "fdem",
+               "sweep_keys": "material.friction_angle"},
+    )
+    ax = mf.render([opened["fdem"], sweep], "history").axes[0]
+    smallest, plateau = [c for c in ax.collections if c.get_label().startswith("sweep of")]
+    np.testing.assert_allclose(smallest.get_offsets(), [[1.0, 100.0], [2.0, 90.0]])
+    np.testing.assert_allclose(plateau.get_offsets(), [[8.0, 110.0], [9.0, 95.0]])
+    assert smallest.get_label() == "sweep of material.friction_angle: smallest reaction (2 points)"
+    header, rows = mf.plot_table([sweep], "history")
+    assert [r[:5] for r in rows if r[0].startswith("sweep")] == [
+        ["sweep material.friction_angle=20.0", 0, "smallest reaction", 0.001, 100.0],
+        ["sweep material.friction_angle=20.0", 0, "plateau", 0.008, 110.0],
+        ["sweep material.friction_angle=30.0", 1, "smallest reaction", 0.002, 90.0],
+        ["sweep material.friction_angle=30.0", 1, "plateau", 0.009, 95.0],
+    ]
+    la_sweep = sweep.drop_vars(["minimum_reaction", "minimum_reaction_settlement"]).assign_attrs(solver="la")
+    with pytest.raises(mf.MasonryError, match="draws the points of sweeps of an incremental solver"):
+        mf.render([la_sweep], "history")
