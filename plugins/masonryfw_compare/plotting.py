@@ -33,6 +33,7 @@ SUPPORT_COLOUR = "0.45"
 SMALL_PIECE_COLOUR = "0.82"
 FRICTION_MAP = "plasma_r"  # dark: sliding; light: far from it
 # damage categories 0..5: green to dark red
+STRIP_SHARE = 0.035  # of the axes' height: one damage strip
 DAMAGE_COLOURS = ("#1a9850", "#91cf60", "#fee08b", "#fc8d59", "#d73027", "#7f0000")
 DOMINANT_SHARE = 0.02  # a macro-block holding this share of the masonry area is numbered ...
 MOST_NUMBERED = 10  # ... up to this many
@@ -468,8 +469,9 @@ def gravity_records(settlement: np.ndarray) -> int:
     return int(moved[0]) if moved.size else int(np.size(settlement))
 
 
-def _damage_strips(ax, incremental: Sequence[xr.Dataset]) -> list:
-    """A thin strip per result along the top of ``ax``, coloured by the damage category along the settlement."""
+def _damage_strips(ax, incremental: Sequence[xr.Dataset]) -> tuple[list, int]:
+    """A thin strip per result along the top of ``ax``, coloured by the damage category along the settlement;
+    returns the legend's handles and the number of strips."""
     names = {v: k.replace("_", " ") for k, v in mf.flags("step_damage_category").items()}
     seen: set[int] = set()
     row = 0
@@ -478,13 +480,20 @@ def _damage_strips(ax, incremental: Sequence[xr.Dataset]) -> list:
             continue
         s = 1e3 * ds.step_settlement.values
         category = ds.step_damage_category.values.astype(int)
-        top = 1.0 - 0.035 * row
+        top = 1.0 - STRIP_SHARE * row
         for k in range(s.size - 1):
             if s[k + 1] > s[k]:
-                ax.axvspan(s[k], s[k + 1], ymin=top - 0.03, ymax=top, color=DAMAGE_COLOURS[category[k]], lw=0)
+                ax.axvspan(s[k], s[k + 1], ymin=top - 0.85 * STRIP_SHARE, ymax=top, color=DAMAGE_COLOURS[category[k]], lw=0)
         seen.update(category.tolist())
         row += 1
-    return [Patch(color=DAMAGE_COLOURS[c], label=f"damage {c} {names[c]}") for c in sorted(seen)]
+    return [Patch(color=DAMAGE_COLOURS[c], label=f"damage {c} {names[c]}") for c in sorted(seen)], row
+
+
+def _room_for_strips(ax, rows: int) -> None:
+    """Raise the top of ``ax`` so that ``rows`` damage strips sit above the curves, not on them."""
+    if rows:
+        low, high = ax.get_ylim()
+        ax.set_ylim(low, low + (high - low) / (1.0 - STRIP_SHARE * rows - 0.01))
 
 
 def draw_history(datasets: Sequence[xr.Dataset], ax, options: Mapping[str, Any]) -> None:
@@ -523,15 +532,17 @@ def draw_history(datasets: Sequence[xr.Dataset], ax, options: Mapping[str, Any])
             collapse = (1 - float(ds.collapse_multiplier.values)) * mf.dead_reaction(ds)
             handles.append(ax.axhline(collapse, ls=style, lw=1.2, color="k",
                                       label=f"{mf.result_label(ds)}: (1 - alpha) R0 = {collapse:.4g} N"))
-        handles += _damage_strips(ax, incremental)
+        strips, rows = _damage_strips(ax, incremental)
         ax.set_ylabel("reaction on the moving supports [N]")
         ax.set_ylim(bottom=min(0.0, ax.get_ylim()[0]))
-        ax.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=2, fontsize="small",
-                  frameon=False)
+        ax.legend(handles=handles + strips, loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=2,
+                  fontsize="small", frameon=False)
     if options["settlement_max"] is not None:
         ax.set_xlim(right=options["settlement_max"], left=None if log else -0.02 * options["settlement_max"])
-        if options["quantity"] == "reaction":
+    if options["quantity"] == "reaction":
+        if options["settlement_max"] is not None:
             _fit_y_to_shown(ax, [(1e3 * ds.step_settlement.values, ds.step_reaction.values) for ds in incremental])
+        _room_for_strips(ax, rows)
     if len(incremental) == 1 and not limits and not sweeps:
         ax.set_title(f"{title_of(incremental[0])}\n{headline_of(incremental[0])}", fontsize="medium")
     else:
