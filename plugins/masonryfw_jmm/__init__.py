@@ -3,8 +3,11 @@
 Registration only (scikit-fem is imported when a solve starts); the method lives in
 :mod:`.material` (the JMM return mapping), :mod:`.mesh`, :mod:`.fem`, :mod:`.problem`,
 :mod:`.newton`, :mod:`.solver` (incremental settlement) and :mod:`.limit` (the static
-limit LP on the same mesh). Their plastic points (``qp_failure``) become
-``crack_indicator`` in the core, like every continuum result's.
+limit LP on the same mesh). Both return a mechanism as block motions (the plateau's
+displacement increment, the LP's dual velocities, fitted per block by
+``masonryfw.rigid_fit``), from which the core derives ``crack_indicator`` and the
+macro-blocks as for the discrete solvers; their plastic points (``qp_failure``) stay for
+the plastic picture.
 """
 from __future__ import annotations
 

@@ -206,6 +206,7 @@ class StaticField:
 class LPSolution:
     x: np.ndarray
     strength_duals: np.ndarray
+    equality_duals: np.ndarray
     objective: float
     status: str
     iterations: int
@@ -240,7 +241,8 @@ def solve_lp(cost: np.ndarray, equalities: sp.spmatrix, rhs: np.ndarray, inequal
     if status not in ("Solved", "AlmostSolved"):
         raise mf.SolveError(f"jmm limit: Clarabel stopped with status {status} after {sol.iterations} iterations")
     x = np.asarray(sol.x)
-    return LPSolution(x, np.asarray(sol.z)[n_eq:], float(cost @ x), status, int(sol.iterations), seconds)
+    z = np.asarray(sol.z)
+    return LPSolution(x, z[n_eq:], z[:n_eq], float(cost @ x), status, int(sol.iterations), seconds)
 
 
 def plastic_rows(duals: np.ndarray, volume: np.ndarray) -> np.ndarray:
@@ -398,6 +400,26 @@ def collapse_points(field: StaticField, stress: np.ndarray) -> tuple[np.ndarray,
     return xy.transpose(0, 2, 1).reshape(2, -1), at_points.reshape(-1, 3)
 
 
+def limit_mechanism(domain: Domain, lp: LimitLP, sol: LPSolution, model: xr.Dataset) -> np.ndarray | None:
+    """The collapse mechanism as block motions (block, 3): per metre of settlement (as la's), or per unit
+    rate of the live load's multiplier.
+
+    The static LP's kinematic side: the duals of the equilibrium rows ``V (div s + b) = 0`` are the
+    triangles' velocities, scaled so that the moving support settles at unit rate (the cost is its
+    reaction; checked: the fastest point moves at 1.000). They are projected onto each block's rigid
+    motions at the triangles' centroids, weighted by volume (:func:`masonryfw.rigid_fit`); the
+    supports move along their ``settlement_direction`` (0 when fixed). None where a block gets no
+    motion (no triangle)."""
+    field, H = lp.field, domain.length
+    velocity = sol.equality_duals[:2 * field.n_el].reshape(field.n_el, 2)
+    cx, cy = (field.points[c, field.triangles].mean(axis=0) * H for c in (0, 1))
+    fitted = mf.rigid_fit(domain.mesh.block, cx, cy, velocity[:, 0], velocity[:, 1], field.area * field.thickness,
+                          model.block_centroid_x.values, model.block_centroid_y.values)
+    supports = mf.support_blocks(model.block_role.values)
+    fitted[supports] = model.settlement_direction.values[supports] if lp.dead_reaction is not None else 0.0
+    return None if np.isnan(fitted).any() else fitted
+
+
 def limit_dataset(domain: Domain, lp: LimitLP, sol: LPSolution, names: tuple[str, ...],
                   assembly: float) -> xr.Dataset:
     """The result variables (physical units) of the limit LP (docs/format.md)."""
@@ -457,4 +479,8 @@ def solve(model: xr.Dataset, options, progress) -> xr.Dataset:
     sol = solve_lp(lp.cost, lp.equalities, lp.rhs, lp.inequalities, lp.bounds)
     result = limit_dataset(domain, lp, sol, names, assembly)
     progress(1.0, f"limit LP {sol.status}: alpha = {float(result.collapse_multiplier):.4f}")
-    return result
+    motion = limit_mechanism(domain, lp, sol, model)
+    if motion is None:
+        return result
+    # a mechanism (a velocity field) of the associated continuum: its joints dilate with mu
+    return result.assign(mf.motion_variables(motion)).assign_attrs(rotations="small", flow_rule="associative")

@@ -70,3 +70,38 @@ def test_a_jmm_result_has_a_mechanism_the_comparisons_score(model):
     assert {"mechanism_cosine", "macro_block_ari"} <= set(scores.data_vars)
     assert -1.0 <= float(scores.mechanism_cosine) <= 1.0
 
+
+
+def test_the_limit_lp_s_mechanism_is_the_incremental_plateau_s(model):
+    """Two formulations of one continuum: the static LP's dual velocities (jmm-limit) and the displacement
+    increment at the reaction plateau (jmm) move the blocks the same way."""
+    incremental = mf.solve(model, "jmm", {"mesh_size": 0.025, "first_increment": 0.2})
+    assert incremental.attrs["stop_reason"] == "reaction plateau"
+    limit = mf.solve(model, "jmm-limit", {"mesh_size": 0.025})
+    scores = mf.compare(limit, incremental, "crack")
+    assert float(scores.mechanism_cosine) > 0.98
+    assert float(scores.macro_block_ari) > 0.9
+    # per metre of settlement, like la's: the moving support at unit rate, the masonry on it about as fast
+    u = mf.block_motion(limit)
+    moving = limit.block_role.values == mf.flags("block_role")["moving_support"]
+    np.testing.assert_allclose(u[moving, :2], [[0.0, -1.0]])
+    assert 0.9 < np.abs(u[mf.masonry_blocks(limit.block_role.values), :2]).max() < 1.0 + 1e-6
+
+
+def test_the_limit_mechanism_of_test_12c_is_the_closed_form_wedge():
+    """With c = 0 the optimum is the rigid wedge over the moving support bounded by the line from its
+    edge (x = 0.5 m) inclined at phi to the vertical, sliding down with it (docs/jmm.md, "A closed
+    form it meets": alpha 0.19999): the blocks wholly inside it move by (0, -1, 0) per metre of
+    settlement, those wholly outside stay."""
+    result = mf.solve(mf.open_model("test-12c"), "jmm-limit")
+    u = mf.block_motion(result)
+    owner = mf.node_block(result.block_node_count.values)
+    beyond = result.node_x.values - (0.5 + np.maximum(result.node_y.values, 0.0) * np.tan(np.radians(21.8)))
+    blocks = np.arange(result.sizes["block"])
+    inside = np.array([(beyond[owner == b] >= -1e-9).all() for b in blocks])
+    outside = np.array([(beyond[owner == b] <= 1e-9).all() for b in blocks])
+    masonry = mf.masonry_blocks(result.block_role.values)
+    assert (inside & masonry).sum() == 26 and (outside & masonry).sum() == 34
+    np.testing.assert_allclose(u[inside & masonry], np.tile([0.0, -1.0, 0.0], ((inside & masonry).sum(), 1)),
+                               atol=1e-3)
+    np.testing.assert_allclose(u[outside & masonry], 0.0, atol=1e-3)
