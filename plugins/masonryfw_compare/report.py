@@ -100,14 +100,21 @@ def _model_section(first: xr.Dataset) -> str:
     return "\n".join(parts)
 
 
+def _mechanism_source(ds: xr.Dataset) -> str:
+    """What a result's block motions are, in a few words (docs/format.md, block_displacement)."""
+    if "qp_failure" not in ds:
+        return "the final displacement" if "step_settlement" in ds else "the collapse mechanism"
+    if "step_settlement" in ds or "step_load_factor" in ds:
+        return "the continuum's displacement increment over its last steps, fitted per block"
+    return "the continuum's collapse velocities from its limit LP, fitted per block"
+
+
 def _result_figures(ds: xr.Dataset, label: str) -> list[str]:
     """The figures a single result supports, each with a caption saying how to read it."""
     figures = []
     if "block_displacement" in ds:
-        how = ("the displacement increment of the last steps, fitted per block" if "qp_failure" in ds
-               else "amplified")
-        figures.append(_figure([ds], "mechanism", f"{label}: the mechanism ({how}); the dominant macro-blocks "
-                               "numbered by size, cracked joints heavy on the blocks' faces."))
+        figures.append(_figure([ds], "mechanism", f"{label}: the mechanism ({_mechanism_source(ds)}, amplified); the "
+                               "dominant macro-blocks numbered by size, cracked joints heavy on the blocks' faces."))
     if "interface_opening" in ds:
         figures.append(_figure([ds], "cracks", f"{label}: joints that open, slide or both."))
     if "interface_normal_force" in ds:
