@@ -243,7 +243,7 @@ def draw_mechanism(datasets: Sequence[xr.Dataset], ax, options: Mapping[str, Any
     """The wall in its amplified deformed configuration: the dominant macro-blocks coloured and numbered
     (1), (2), ... by size, the small pieces in one grey, the cracks drawn on the blocks' faces."""
     ds = _single(datasets, "mechanism")
-    _require(ds, ["block_displacement"], "mechanism", "block displacements (la, fdem, or jmm from issue 17 on)")
+    _require(ds, ["block_displacement"], "mechanism", "block displacements (la, fdem, jmm or jmm-limit)")
     geo = mf.derive_geometry(ds)
     u = mf.block_motion(ds)
     amplification = options["amplification"] or default_amplification(geo, u)
@@ -253,7 +253,7 @@ def draw_mechanism(datasets: Sequence[xr.Dataset], ax, options: Mapping[str, Any
     pieces = dominant_pieces(ds, geo)
     _draw_blocks(ax, geo, x, y, piece_colours(geo, pieces))
     handles = [Patch(facecolor=colormaps["tab10"].colors[0], edgecolor="0.3",
-                     label=f"({1}) .. ({pieces.dominant}) macro-blocks, largest first" if pieces.dominant > 1
+                     label=f"(1) .. ({pieces.dominant}) macro-blocks, largest first" if pieces.dominant > 1
                      else "(1) the macro-block")] if pieces.dominant else []
     if pieces.small:
         handles.append(Patch(facecolor=SMALL_PIECE_COLOUR, edgecolor="0.3", label=f"small pieces ({pieces.small})"))
@@ -292,6 +292,12 @@ def draw_cracks(datasets: Sequence[xr.Dataset], ax, options: Mapping[str, Any]) 
     _finish(ax, ds)
 
 
+def loaded_joints(normal: np.ndarray) -> np.ndarray:
+    """Interfaces whose resultant normal force is more than round-off (1e-9 of the largest)."""
+    total = normal[:, 0] + normal[:, 1]
+    return total > 1e-9 * max(np.max(np.abs(total), initial=0.0), np.finfo(float).tiny)
+
+
 def thrust_segments(geo: xr.Dataset, normal, shear, scale: float):
     """Per loaded interface: point of application, resultant force on side 1, and its drawn segment.
 
@@ -305,7 +311,7 @@ def thrust_segments(geo: xr.Dataset, normal, shear, scale: float):
     """
     n0, n1 = normal[:, 0], normal[:, 1]
     total = n0 + n1
-    loaded = total > 1e-9 * max(np.max(np.abs(total), initial=0.0), np.finfo(float).tiny)
+    loaded = loaded_joints(normal)
     w = n1[loaded] / total[loaded]
     ix, iy = geo.interface_x.values[loaded], geo.interface_y.values[loaded]
     px, py = ix[:, 0] + w * (ix[:, 1] - ix[:, 0]), iy[:, 0] + w * (iy[:, 1] - iy[:, 0])
@@ -323,9 +329,9 @@ def thrust_segments(geo: xr.Dataset, normal, shear, scale: float):
 
 
 def friction_used(geo: xr.Dataset, normal, shear) -> np.ndarray:
-    """Per loaded interface (as :func:`thrust_segments` selects them): |V| / (mu N), 1 where it slides."""
+    """Per loaded interface (:func:`loaded_joints`): |V| / (mu N), 1 where it slides."""
     total = normal[:, 0] + normal[:, 1]
-    loaded = total > 1e-9 * max(np.max(np.abs(total), initial=0.0), np.finfo(float).tiny)
+    loaded = loaded_joints(normal)
     mu = geo.interface_friction.values[loaded]
     v = np.abs(shear[loaded].sum(axis=1))
     return np.where(mu > 0, v / np.maximum(mu * total[loaded], np.finfo(float).tiny), np.inf)
