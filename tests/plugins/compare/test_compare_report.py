@@ -132,3 +132,19 @@ def test_a_report_refuses_models_and_results_of_different_walls(test_12c_files, 
     assert run.exit_code == 1 and "not a result file" in run.stderr
     run = CliRunner().invoke(cli, ["report", str(test_12c_files["la"]), "-o", str(test_12c_files["la"])])
     assert run.exit_code == 1
+
+
+def test_ctrl_c_during_a_report_writes_nothing_and_exits_130(test_12c_files, tmp_path, monkeypatch, capsys):
+    import masonryfw_compare.report as report_module
+    from masonryfw.cli import main
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(report_module, "report_html", interrupted)
+    out = tmp_path / "r.html"
+    with pytest.raises(SystemExit) as stop:
+        main(["report", str(test_12c_files["la"]), "-o", str(out)])
+    assert stop.value.code == 130
+    assert "interrupted: nothing written" in capsys.readouterr().err
+    assert not out.exists() and list(tmp_path.iterdir()) == []
