@@ -68,15 +68,34 @@ _HEADLINES = (
 )
 
 
+def result_options(result: xr.Dataset) -> dict:
+    """The solver options a result records (``solver_options``, JSON); empty when absent or unreadable."""
+    try:
+        options = json.loads(result.attrs.get("solver_options", "{}") or "{}")
+    except (TypeError, ValueError):
+        return {}
+    return options if isinstance(options, dict) else {}
+
+
 def result_label(result: xr.Dataset) -> str:
     """``solver`` plus the backend it chose when its options name one, e.g. ``la (highs)``."""
     name = str(result.attrs.get("solver", result.attrs.get("plugin", "?")))
-    try:
-        options = json.loads(result.attrs.get("solver_options", "{}"))
-    except (TypeError, ValueError):
-        options = {}
-    detail = [str(options[k]) for k in ("solver", "backend") if isinstance(options, dict) and k in options]
+    options = result_options(result)
+    detail = [str(options[k]) for k in ("solver", "backend") if k in options]
     return f"{name} ({', '.join(detail)})" if detail else name
+
+
+def headline_text(result: xr.Dataset) -> str:
+    """A result's headline in a few words (a figure's title): alpha and the collapse reaction (limit
+    analysis), else R0 and the smallest and plateau reactions (incremental solvers); empty for a model."""
+    numbers = {n.name: n.value for n in key_numbers(result)} if "solver" in result.attrs else {}
+    if "alpha" in numbers:
+        reaction = f", collapse reaction {numbers['collapse_reaction']:.4g} N" if "collapse_reaction" in numbers else ""
+        return f"alpha = {numbers['alpha']:.4f}{reaction}"
+    if "minimum_reaction" in numbers:
+        return (f"R0 {numbers['dead_reaction']:.4g} N, min {numbers['minimum_reaction']:.4g} N at "
+                f"{_mm(numbers['minimum_reaction_settlement'])}, plateau {numbers['plateau_reaction']:.4g} N")
+    return ""
 
 
 def headline_rows(results: Sequence[xr.Dataset]) -> list[Row]:

@@ -17,6 +17,7 @@ import matplotlib
 matplotlib.use("Agg")
 
 import masonryfw as mf  # noqa: E402
+from masonryfw_compare.plotting import drawable_kinds  # noqa: E402
 from masonryfw_compare.report import report_html  # noqa: E402
 
 DOCS = Path(__file__).resolve().parents[1]
@@ -24,20 +25,6 @@ IMAGES = DOCS / "img" / "report"
 REPORTS = DOCS / "report"
 SOLVERS = ("la", "fdem", "jmm")
 DPI = 110
-
-
-def single_kinds(result) -> list[str]:
-    """The one-result kinds a result supports."""
-    kinds = []
-    if "block_displacement" in result:
-        kinds.append("mechanism")
-    if "interface_opening" in result:
-        kinds.append("cracks")
-    if "interface_normal_force" in result:
-        kinds.append("forces")
-    if "qp_failure" in result:
-        kinds.append("plastic")
-    return kinds
 
 
 def case_figures(case: str, folder: Path) -> None:
@@ -54,7 +41,7 @@ def case_figures(case: str, folder: Path) -> None:
         print(f"{case} {solver}: {time.perf_counter() - start:.1f} s", flush=True)
     mf.save_figure(mf.render([model], "model"), IMAGES / f"{case}-model.png", dpi=DPI)
     for solver, result in zip(SOLVERS, results):
-        for kind in single_kinds(result):
+        for kind in drawable_kinds(result):
             mf.save_figure(mf.render([result], kind), IMAGES / f"{case}-{kind}-{solver}.png", dpi=DPI)
     incremental = [r for r in results if "step_settlement" in r]
     mf.save_figure(mf.render(results, "history"), IMAGES / f"{case}-history.png", dpi=DPI)

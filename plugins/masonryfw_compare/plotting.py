@@ -8,7 +8,6 @@ a :class:`masonryfw.MasonryError` naming the variable and the kind of result it 
 """
 from __future__ import annotations
 
-import json
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -59,26 +58,13 @@ def title_of(ds: xr.Dataset) -> str:
     return f"{ds.attrs.get('title', 'untitled')} - {label}"
 
 
-def headline_of(ds: xr.Dataset) -> str:
-    """The result's headline in a few words: alpha and the collapse reaction (limit analysis), else the
-    smallest and plateau reactions (incremental solvers); empty for a model."""
-    numbers = {n.name: n.value for n in mf.key_numbers(ds)} if "solver" in ds.attrs else {}
-    if "alpha" in numbers:
-        reaction = f", collapse reaction {numbers['collapse_reaction']:.4g} N" if "collapse_reaction" in numbers else ""
-        return f"alpha = {numbers['alpha']:.4f}{reaction}"
-    if "minimum_reaction" in numbers:
-        return (f"R0 {numbers['dead_reaction']:.4g} N, min {numbers['minimum_reaction']:.4g} N at "
-                f"{1e3 * numbers['minimum_reaction_settlement']:.3g} mm, plateau {numbers['plateau_reaction']:.4g} N")
-    return ""
-
-
 def _finish(ax, ds: xr.Dataset) -> None:
     """Equal axes in metres fitted to the drawing, titled with the model, the solver and the headline."""
     ax.set_aspect("equal", adjustable="box")
     ax.autoscale_view()
     ax.set_xlabel("x [m]")
     ax.set_ylabel("y [m]")
-    headline = headline_of(ds)
+    headline = mf.headline_text(ds)
     ax.set_title(title_of(ds) + (f"\n{headline}" if headline else ""), fontsize="medium")
 
 
@@ -397,14 +383,14 @@ def draw_plastic(datasets: Sequence[xr.Dataset], ax, options: Mapping[str, Any])
 
 def distinct_labels(datasets: Sequence[xr.Dataset]) -> list[str]:
     """Each result's label (:func:`masonryfw.result_label`); results that share one get the solver options
-    in which they differ, e.g. ``fdem (body=deformable)``."""
+    in which they differ, e.g. ``fdem (mode=deformable)``."""
     labels = [mf.result_label(ds) for ds in datasets]
-    options = [json.loads(ds.attrs.get("solver_options", "{}") or "{}") for ds in datasets]
+    options = [mf.result_options(ds) for ds in datasets]
     out = []
     for i, label in enumerate(labels):
         twins = [j for j, other in enumerate(labels) if other == label]
         keys = sorted({k for j in twins for k in options[j]})
-        differ = [k for k in keys if len({json.dumps(options[j].get(k)) for j in twins}) > 1]
+        differ = [k for k in keys if len({repr(options[j].get(k)) for j in twins}) > 1]
         detail = ", ".join(f"{k}={options[i].get(k)}" for k in differ)
         out.append(f"{label} ({detail})" if len(twins) > 1 and detail else label)
     return out
@@ -438,7 +424,11 @@ def _split_history(datasets: Sequence[xr.Dataset], kind: str):
 def sweep_points(sweep: xr.Dataset) -> list[tuple[str, float, float, float, float]]:
     """Per solved point of a sweep: ``(point, smallest reaction's settlement, smallest reaction, plateau's
     settlement, plateau reaction)``, the point as ``key=value, ...``; NaN where a number is missing."""
-    meanings = dict(zip(sweep.status.attrs["flag_meanings"].split(), np.atleast_1d(sweep.status.attrs["flag_values"])))
+    attrs = sweep.status.attrs if "status" in sweep else {}
+    meanings = dict(zip(str(attrs.get("flag_meanings", "")).split(), np.atleast_1d(attrs.get("flag_values", []))))
+    if "ok" not in meanings:
+        raise mf.MasonryError(f"{sweep.attrs.get('title', 'the sweep')}: its status variable has no 'ok' flag "
+                              "(flag_meanings): not a sweep written by masonryfw sweep")
     ok = sweep.status.values == meanings["ok"]
     names = ("minimum_reaction_settlement", "minimum_reaction", "plateau_settlement", "plateau_reaction")
     values = [sweep[n].values if n in sweep else np.full(ok.shape, np.nan) for n in names]
@@ -550,7 +540,7 @@ def draw_history(datasets: Sequence[xr.Dataset], ax, options: Mapping[str, Any])
             _fit_y_to_shown(ax, [(1e3 * ds.step_settlement.values, ds.step_reaction.values) for ds in incremental])
         _room_for_strips(ax, rows)
     if len(incremental) == 1 and not limits and not sweeps:
-        ax.set_title(f"{title_of(incremental[0])}\n{headline_of(incremental[0])}", fontsize="medium")
+        ax.set_title(f"{title_of(incremental[0])}\n{mf.headline_text(incremental[0])}", fontsize="medium")
     else:
         ax.set_title(str(datasets[0].attrs.get("title", "")), fontsize="medium")
 
@@ -608,6 +598,16 @@ def history_table(datasets: Sequence[xr.Dataset], options: Mapping[str, Any]) ->
             rows.append([f"sweep {where}", k, "smallest reaction", s_min, r_min, None, None])
             rows.append([f"sweep {where}", k, "plateau", s_plateau, r_plateau, None, None])
     return header, rows
+
+
+#: The one-result kinds and the variable each needs (the first the drawing reads).
+SINGLE_RESULT_KINDS = {"mechanism": "block_displacement", "cracks": "interface_opening",
+                       "forces": "interface_normal_force", "plastic": "qp_failure"}
+
+
+def drawable_kinds(ds: xr.Dataset) -> list[str]:
+    """The one-result kinds ``ds`` can be drawn as, in the order of :data:`SINGLE_RESULT_KINDS`."""
+    return [kind for kind, needs in SINGLE_RESULT_KINDS.items() if needs in ds]
 
 
 def panel_kind(ds: xr.Dataset) -> str:

@@ -11,20 +11,19 @@ from __future__ import annotations
 
 import base64
 import datetime
-import hashlib
 import html
 import io
 import itertools
 import platform
 from collections.abc import Callable, Sequence
 from importlib import metadata
-from pathlib import Path
 
 import xarray as xr
 
 import masonryfw as mf
 
 from .comparison import ensure_same_model
+from .plotting import drawable_kinds
 
 FIGURE_DPI = 130
 #: Libraries whose versions the provenance lists.
@@ -111,24 +110,21 @@ def _mechanism_source(ds: xr.Dataset) -> str:
 
 def _result_figures(ds: xr.Dataset, label: str) -> list[str]:
     """The figures a single result supports, each with a caption saying how to read it."""
-    figures = []
-    if "block_displacement" in ds:
-        figures.append(_figure([ds], "mechanism", f"{label}: the mechanism ({_mechanism_source(ds)}, amplified); the "
-                               "dominant macro-blocks numbered by size, cracked joints heavy on the blocks' faces."))
-    if "interface_opening" in ds:
-        figures.append(_figure([ds], "cracks", f"{label}: joints that open, slide or both."))
-    if "interface_normal_force" in ds:
-        figures.append(_figure([ds], "forces", f"{label}: joint resultants at collapse; colour: the share of "
-                               "the friction used."))
-    if "qp_failure" in ds:
-        figures.append(_figure([ds], "plastic", f"{label}: plastic quadrature points of the continuum."))
-    return figures
+    captions = {
+        "mechanism": f"the mechanism ({_mechanism_source(ds)}, amplified); the dominant macro-blocks numbered by "
+                     "size, cracked joints heavy on the blocks' faces.",
+        "cracks": "joints that open, slide or both.",
+        "forces": "joint resultants at collapse; colour: the share of the friction used.",
+        "plastic": "plastic quadrature points of the continuum.",
+    }
+    return [_figure([ds], kind, f"{label}: {captions[kind]}") for kind in drawable_kinds(ds)]
 
 
 def _history_section(datasets: Sequence[xr.Dataset]) -> list[str]:
     incremental = [ds for ds in datasets if "step_settlement" in ds]
     if not incremental:
         return []
+    datasets = [ds for ds in datasets if "step_settlement" in ds or "collapse_multiplier" in ds]  # what it draws
     parts = ["<h2>Reaction against settlement</h2>",
              _figure(datasets, "history", "Reaction on the settling supports of every incremental result, with the "
                      "dead load R0 and the limit analyses' collapse reaction (1 - alpha) R0; strips along the top: "
@@ -169,7 +165,7 @@ def _provenance_section(paths: Sequence[str], datasets: Sequence[xr.Dataset], le
                         command: str) -> list[str]:
     rows = []
     for letter, path, ds in zip(letters, paths, datasets):
-        digest = hashlib.sha256(Path(path).read_bytes()).hexdigest()
+        digest = mf.sha256_file(path)
         facts = {
             "file": path, "file sha256": digest, "solver": ds.attrs.get("solver", "?"),
             "solver version": ds.attrs.get("solver_version", "?"), "core version": ds.attrs.get("core_version", "?"),

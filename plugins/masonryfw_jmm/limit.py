@@ -53,7 +53,7 @@ import masonryfw as mf
 
 from .fabric import stress_rotation
 from .material import failure_mode
-from .output import mesh_variables, point_variables, variable
+from .output import block_mechanism, mesh_variables, point_variables, variable, with_mechanism
 from .problem import Domain, live_body_force, support_facets, wall_domain
 
 ROLE = mf.flags("block_role")
@@ -413,11 +413,8 @@ def limit_mechanism(domain: Domain, lp: LimitLP, sol: LPSolution, model: xr.Data
     field, H = lp.field, domain.length
     velocity = sol.equality_duals[:2 * field.n_el].reshape(field.n_el, 2)
     cx, cy = (field.points[c, field.triangles].mean(axis=0) * H for c in (0, 1))
-    fitted = mf.rigid_fit(domain.mesh.block, cx, cy, velocity[:, 0], velocity[:, 1], field.area * field.thickness,
-                          model.block_centroid_x.values, model.block_centroid_y.values)
-    supports = mf.support_blocks(model.block_role.values)
-    fitted[supports] = model.settlement_direction.values[supports] if lp.dead_reaction is not None else 0.0
-    return None if np.isnan(fitted).any() else fitted
+    return block_mechanism(model, domain.mesh.block, cx, cy, velocity[:, 0], velocity[:, 1],
+                           field.area * field.thickness, 1.0 if lp.dead_reaction is not None else 0.0)
 
 
 def limit_dataset(domain: Domain, lp: LimitLP, sol: LPSolution, names: tuple[str, ...],
@@ -479,8 +476,4 @@ def solve(model: xr.Dataset, options, progress) -> xr.Dataset:
     sol = solve_lp(lp.cost, lp.equalities, lp.rhs, lp.inequalities, lp.bounds)
     result = limit_dataset(domain, lp, sol, names, assembly)
     progress(1.0, f"limit LP {sol.status}: alpha = {float(result.collapse_multiplier):.4f}")
-    motion = limit_mechanism(domain, lp, sol, model)
-    if motion is None:
-        return result
-    # a mechanism (a velocity field) of the associated continuum: its joints dilate with mu
-    return result.assign(mf.motion_variables(motion)).assign_attrs(rotations="small", flow_rule="associative")
+    return with_mechanism(result, limit_mechanism(domain, lp, sol, model), "associative")  # an associated LP

@@ -35,3 +35,22 @@ def point_variables(xy: np.ndarray, failure: np.ndarray, stress: np.ndarray, whe
         "qp_stress_yy": variable("qp", stress[:, 1], "Pa", f"stress sigma_yy {when} (tension positive)"),
         "qp_stress_xy": variable("qp", stress[:, 2], "Pa", f"shear stress sigma_xy {when}"),
     }
+
+
+def block_mechanism(model: xr.Dataset, block, x, y, ux, uy, weight, settlement: float) -> np.ndarray | None:
+    """A continuum's field ``(ux, uy)`` at weighted points ``(x, y)`` of blocks ``block`` [m] as block motions
+    (block, 3): projected onto each block's rigid motions (:func:`masonryfw.rigid_fit`), the supports moving
+    by ``settlement`` along their ``settlement_direction`` (fixed ones stay). None when a block gets no
+    motion (no point in it)."""
+    fitted = mf.rigid_fit(block, x, y, ux, uy, weight, model.block_centroid_x.values, model.block_centroid_y.values)
+    supports = mf.support_blocks(model.block_role.values)
+    fitted[supports] = model.settlement_direction.values[supports] * settlement
+    return None if np.isnan(fitted).any() else fitted
+
+
+def with_mechanism(result: xr.Dataset, motion: np.ndarray | None, flow_rule: str) -> xr.Dataset:
+    """``result`` with ``motion`` (a mechanism: linearised kinematics) as its block motions, if there is one;
+    ``flow_rule`` says how its joints dilate (docs/format.md)."""
+    if motion is None:
+        return result
+    return result.assign(mf.motion_variables(motion)).assign_attrs(rotations="small", flow_rule=flow_rule)

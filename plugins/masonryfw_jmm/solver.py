@@ -17,7 +17,7 @@ import xarray as xr
 import masonryfw as mf
 
 from .newton import NewtonSolver, State
-from .output import mesh_variables, point_variables, variable
+from .output import block_mechanism, mesh_variables, point_variables, variable, with_mechanism
 from .problem import Problem, build_problem
 
 MIN_INCREMENT = 1e-4  # of the elastic unloading settlement: below it a failing step stops the run
@@ -263,12 +263,8 @@ def mechanism(problem: Problem, model: xr.Dataset, history: History) -> np.ndarr
     du = (u1 - u0)[disc.edofs]  # (el, 2 nb)
     ux = np.einsum("eqn,en->eq", disc.values, du[:, 0::2]).ravel()
     uy = np.einsum("eqn,en->eq", disc.values, du[:, 1::2]).ravel()
-    block = np.repeat(p.mesh.block, disc.nqp)
-    fitted = mf.rigid_fit(block, *(disc.qp_xy * p.length), ux * p.displacement, uy * p.displacement,
-                          disc.weights.ravel(), model.block_centroid_x.values, model.block_centroid_y.values)
-    supports = mf.support_blocks(model.block_role.values)
-    fitted[supports] = model.settlement_direction.values[supports] * (s1 - s0) * p.displacement
-    return None if np.isnan(fitted).any() else fitted
+    return block_mechanism(model, np.repeat(p.mesh.block, disc.nqp), *(disc.qp_xy * p.length),
+                           ux * p.displacement, uy * p.displacement, disc.weights.ravel(), (s1 - s0) * p.displacement)
 
 
 def result_dataset(problem: Problem, state: State, history: History, info: dict) -> xr.Dataset:
@@ -322,10 +318,5 @@ def solve(model: xr.Dataset, options, progress) -> xr.Dataset:
     if info["interrupted"] and len(history.iterations) == 0:
         raise KeyboardInterrupt  # interrupted before the gravity stage converged: nothing to keep
     progress(1.0, info["stop_reason"])
-    result = result_dataset(problem, state, history, info)
-    motion = mechanism(problem, model, history)
-    if motion is None:
-        return result
-    # a mechanism (an increment): linearised kinematics; the joints dilate as the continuum's flow rule says
-    flow = "associative" if options["dilatancy"] is None else "nonassociative"
-    return result.assign(mf.motion_variables(motion)).assign_attrs(rotations="small", flow_rule=flow)
+    flow = "associative" if options["dilatancy"] is None else "nonassociative"  # the continuum's flow rule
+    return with_mechanism(result_dataset(problem, state, history, info), mechanism(problem, model, history), flow)

@@ -166,6 +166,8 @@ def test_a_sweep_s_points_go_on_the_history_at_their_settlements(opened):
         ["sweep material.friction_angle=30.0", 1, "smallest reaction", 0.002, 90.0],
         ["sweep material.friction_angle=30.0", 1, "plateau", 0.009, 95.0],
     ]
+    with pytest.raises(mf.MasonryError, match="its status variable has no 'ok' flag"):
+        mf.render([sweep.drop_vars("status")], "history")
     la_sweep = sweep.drop_vars(["minimum_reaction", "minimum_reaction_settlement"]).assign_attrs(solver="la")
     with pytest.raises(mf.MasonryError, match="draws the points of sweeps of an incremental solver"):
         mf.render([la_sweep], "history")

@@ -65,10 +65,8 @@ def test_a_jmm_result_has_a_mechanism_the_comparisons_score(model):
     over_moving = masonry & (result.block_centroid_x.values > 0.2)
     over_fixed = masonry & (result.block_centroid_x.values < 0.2)
     assert u[over_moving, 1].mean() < 0.5 * u[over_fixed, 1].mean() - 0.2 * recent
-    la = mf.solve(model, "la")
-    scores = mf.compare(la, result, "crack")
+    scores = mf.compare(mf.solve(model, "la"), result, "crack")
     assert {"mechanism_cosine", "macro_block_ari"} <= set(scores.data_vars)
-    assert -1.0 <= float(scores.mechanism_cosine) <= 1.0
 
 
 
