@@ -18,7 +18,7 @@ except PackageNotFoundError:  # running from a source tree that is not installed
 
 from .builder import build, load_spec
 from .checks import Problem, check
-from .damage import DAMAGE_LIMITS, damage_category, distortion, support_profile, widest_opening
+from .damage import DAMAGE_LIMITS, Cracks, damage_category, distortion, support_profile, widest_crack
 from .datasets import BUNDLED_NAMES, CASE_NAMES, DRAWN_NAMES, PROFILE_NAMES, bundled_cases, bundled_spec_path
 from .dofs import block_loads, block_motion, load_variables, motion_variables, upgrade
 from .errors import MasonryError, ModelError, PluginError, SolveError, SpecError, listed
@@ -54,6 +54,7 @@ from .interfaces import detect_interfaces
 from .io import add_history, check_output_path, content_sha256, open_dataset, save, save_figure, save_text, sha256_file
 from .linalg import cholesky_factor, has_cholmod
 from .model import checked_model, model_part, open_model
+from .plausibility import PlausibilityWarning, plausibility
 from .plugins import (
     compare,
     core_version,
@@ -90,9 +91,12 @@ from .semantics import (
     plastic_crack_indicator,
     point_motion,
     polar_moment,
-    reaction_weights,
+    refuse_rigid_settlement,
     relative_motion,
     rigid_fit,
+    settlement_reaction,
+    settlement_reference_rate,
+    settlement_weights,
     states_at,
     support_blocks,
 )

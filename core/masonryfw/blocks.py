@@ -17,11 +17,12 @@ and loads are made; the parametric builder, the import of drawings and
   loading: the weight acts horizontally as live load on every unit and lintel,
   and every support is held;
 - a moving support translates vertically (``block_fixed`` 1 0 1, direction
-  0 -1 0), translates along a given direction (a greenfield trough's
-  segments: ``block_fixed`` 0 0 1) or rotates about a pivot (free, direction
-  of the small rotation that moves its centroid down, as a unit vector); its
-  direction is then scaled by its ``rate``: all moving supports move as
-  ``u_s = t * settlement_direction_s`` with one settlement parameter ``t``.
+  0 -1 0), rotates about a pivot (free, direction of the small rotation that
+  moves its centroid down, as a unit vector), either scaled by its ``rate``, or
+  is a segment of a continuous ground (free: its top edge follows the ground's
+  motion given at the edge's two ends, :func:`ground_direction`): all moving
+  supports move as ``u_s = t * settlement_direction_s`` with one settlement
+  parameter ``t``.
 """
 from __future__ import annotations
 
@@ -56,12 +57,22 @@ class Material:
 
 
 @dataclass(frozen=True)
-class Support:
-    """How one support block moves: ``kind`` fixed or moving; ``motion`` translation or rotation (about ``pivot``).
+class GroundEdge:
+    """The top edge of a support segment on a continuous ground, and the ground's motion at its two ends per
+    unit settlement parameter: downward rate and horizontal motion (x positive)."""
 
-    A moving support moves ``rate`` times as fast as the settlement parameter;
-    ``translation`` (x, y) replaces the vertical unit translation (0, -1) before
-    the rate scales it (a greenfield trough's horizontal component).
+    x: tuple[float, float]
+    y: float
+    down: tuple[float, float]
+    horizontal: tuple[float, float]
+
+
+@dataclass(frozen=True)
+class Support:
+    """How one support block moves: ``kind`` fixed or moving; ``motion`` translation, rotation (about
+    ``pivot``) or ground (its top edge follows ``ground``).
+
+    A translating or rotating support moves ``rate`` times as fast as the settlement parameter.
     """
 
     name: str
@@ -69,7 +80,7 @@ class Support:
     motion: str = "none"
     pivot: tuple[float, float] | None = None
     rate: float = 1.0
-    translation: tuple[float, float] | None = None
+    ground: GroundEdge | None = None
 
 
 def rotation_direction(centre, pivot) -> np.ndarray:
@@ -78,6 +89,18 @@ def rotation_direction(centre, pivot) -> np.ndarray:
     omega = -math.copysign(1.0, dx)
     direction = np.array([-omega * dy, omega * dx, omega])
     return direction / np.linalg.norm(direction)
+
+
+def ground_direction(edge: GroundEdge, centre) -> np.ndarray:
+    """Dof-space motion (ux, uy, rz) at ``centre`` per unit settlement of the rigid block whose top edge
+    follows the ground: vertical motion linear between the ends' (so neighbouring segments meet at their
+    common end), horizontal motion of the edge the mean of its ends' (a rigid edge cannot stretch), small
+    rotation ``(down_a - down_b) / (x_b - x_a)``."""
+    (xa, xb), (da, db) = edge.x, edge.down
+    theta = (da - db) / (xb - xa)
+    uy = -da + theta * (centre[0] - xa)
+    ux = 0.5 * (edge.horizontal[0] + edge.horizontal[1]) + theta * (edge.y - centre[1])
+    return np.array([ux, uy, theta])
 
 
 def support_kinematics(supports, centres, loading: str):
@@ -96,9 +119,9 @@ def support_kinematics(supports, centres, loading: str):
         if support.motion == "rotation":
             fixed[i] = 0
             direction[i] = support.rate * rotation_direction(centres[i], support.pivot)
-        elif support.translation is not None:
-            fixed[i] = (0, 0, 1)
-            direction[i] = (support.rate * support.translation[0], support.rate * support.translation[1], 0.0)
+        elif support.motion == "ground":
+            fixed[i] = 0
+            direction[i] = ground_direction(support.ground, centres[i])
         else:
             fixed[i] = (1, 0, 1)
             direction[i] = (0.0, -support.rate, 0.0)

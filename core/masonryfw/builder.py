@@ -44,6 +44,7 @@ from . import blocks
 from .errors import SpecError
 from .imported import build_drawn, is_drawn, parse_drawn_spec, resolved_drawing
 from .model import checked_model
+from .plausibility import warn_implausible
 from .profiles import profile_segments, read_profile
 from .schema import flags
 from .spec import (
@@ -107,7 +108,7 @@ class Support:
     motion: str
     pivot: tuple[float, float] | None
     rate: float = 1.0
-    translation: tuple[float, float] | None = None
+    ground: blocks.GroundEdge | None = None
 
 
 @dataclass(frozen=True)
@@ -189,15 +190,16 @@ def parse_spec(spec: dict) -> Wall:
 
 
 def _profile_supports(top: SpecTable, wall: Wall) -> tuple[Support, ...]:
-    """The support segments of the ``[settlement]`` profile under the wall's bottom course."""
-    profile = read_profile(top, wall.width)
+    """The support segments of the ``[settlement]`` profile under the wall's bottom course (a continuous
+    ground: :mod:`masonryfw.profiles`)."""
+    profile = read_profile(top, wall.width, wall.unit_length)
     x0, x1, y0, _, _ = masonry_blocks(wall)
     bottom = y0 <= wall.tol
     segments = profile_segments(profile, wall.width, np.c_[x0[bottom], x1[bottom]])
     return tuple(
-        Support(f"segment {k} [{s.start:.6g}, {s.end:.6g}] m", "moving" if s.moving else "fixed", s.start, s.end,
-                "translation" if s.moving else "none", None, s.rate,
-                (s.horizontal / s.rate, -1.0) if s.moving and s.horizontal else None)
+        Support(f"segment {k} [{s.start:.6g}, {s.end:.6g}] m", "moving", s.start, s.end, "ground", None,
+                ground=blocks.GroundEdge((s.start, s.end), 0.0, s.down, s.horizontal))
+        if s.moving else Support(f"segment {k} [{s.start:.6g}, {s.end:.6g}] m", "fixed", s.start, s.end, "none", None)
         for k, s in enumerate(segments)
     )
 
@@ -412,11 +414,17 @@ def build(spec, *, validate: bool = True) -> xr.Dataset:
     supports in spec order; interfaces, kinds and loads as every model gets them
     (:mod:`masonryfw.blocks`). Raises :class:`SpecError` naming the key at fault.
     The model is returned checked (:func:`masonryfw.checked_model`), unless
-    ``validate`` is False.
+    ``validate`` is False. Values outside the range of real masonry give a
+    :class:`masonryfw.PlausibilityWarning` each (:mod:`masonryfw.plausibility`).
     """
     spec_dict, text, base_dir = read_spec(spec)
-    if is_drawn(spec_dict):
-        return build_drawn(spec_dict, text, base_dir, validate)
+    model = build_drawn(spec_dict, text, base_dir, validate) if is_drawn(spec_dict) \
+        else _build_parametric(spec_dict, text, validate)
+    warn_implausible(model)
+    return model
+
+
+def _build_parametric(spec_dict: dict, text: str, validate: bool) -> xr.Dataset:
     wall = parse_spec(spec_dict)
     mx0, mx1, my0, my1, m_role = masonry_blocks(wall)
     s_x0 = np.array([s.start for s in wall.supports])
@@ -425,7 +433,7 @@ def build(spec, *, validate: bool = True) -> xr.Dataset:
     y0 = np.concatenate((my0, np.full(s_x0.size, -wall.unit_height)))
     y1 = np.concatenate((my1, np.zeros(s_x0.size)))
     role = np.concatenate((m_role, np.full(s_x0.size, flags("block_role")["fixed_support"], dtype=np.int8)))
-    supports = [blocks.Support(_support_label(s.name), s.kind, s.motion, s.pivot, s.rate, s.translation)
+    supports = [blocks.Support(_support_label(s.name), s.kind, s.motion, s.pivot, s.rate, s.ground)
                 for s in wall.supports]
     material = wall.material
     attrs = {"title": wall.title, "source_spec": text}

@@ -135,15 +135,23 @@ def _input_files(*names: str) -> list[Path]:
 
 @cli.command(name="check")
 @click.argument("file")
-def check_command(file: str) -> None:
-    """Check FILE (model, result or comparison) and print every problem found."""
+@click.option("--strict", is_flag=True, help="Count implausible values (warnings) as problems: exit 1.")
+def check_command(file: str, strict: bool) -> None:
+    """Check FILE (model, result or comparison) and print every problem found, then every value outside
+    the range of real masonry (a warning; a problem with --strict)."""
     ds = mf.open_dataset(file)
     problems = mf.check(ds)
+    implausible = mf.plausibility(ds) if "block_role" in ds and not problems else []
     for problem in problems:
         click.echo(f"  - {problem}")
-    if problems:
-        click.echo(f"error: {file}: {len(problems)} problem(s)", err=True)
+    for message in implausible:
+        click.echo(f"  - {'' if strict else 'warning: '}{message}")
+    if problems or (strict and implausible):
+        counted = len(problems) + (len(implausible) if strict else 0)
+        click.echo(f"error: {file}: {counted} problem(s)", err=True)
         click.get_current_context().exit(1)
+    if implausible:
+        click.echo(f"{file}: {len(implausible)} implausible value(s) (warnings; --strict makes them errors)", err=True)
     if ds.attrs.get("masonryfw_format") == "comparison":
         click.echo(f"OK: comparison by {ds.attrs.get('comparator', '?')} of {ds.attrs.get('title', '')}")
     else:

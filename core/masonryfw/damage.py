@@ -1,11 +1,13 @@
 """What a settlement does to a wall, one definition for every solver: crack widths, damage
 categories and the distortion of the imposed settlement profile.
 
-- **crack width** of a state: the widest opening of a masonry joint (an interface
-  with a masonry side: the joints between blocks and the wall's bed on its
-  supports, as for ``crack_indicator``), from the block motions
-  (:func:`masonryfw.relative_motion`). Solvers report it per recorded step as
-  ``step_crack_width_max``;
+- **crack width** of a state: the widest opening of a joint *within the masonry*
+  (both sides masonry blocks), from the block motions
+  (:func:`masonryfw.relative_motion`). The joint between the wall and the ground
+  is no crack in the masonry: its widest opening is the **base gap**, reported
+  apart. Solvers report per recorded step ``step_crack_width_max``, the joint it
+  is at (``step_crack_interface``) and ``step_base_gap_max``
+  (:func:`widest_crack`);
 - **damage category** (``step_damage_category``, derived by the core): Burland et
   al. (1977) and Boscardin & Cording (1989), by the crack width, upper limits
   inclusive: 0 negligible (<= 0.1 mm), 1 very slight (<= 1 mm), 2 slight
@@ -23,11 +25,13 @@ categories and the distortion of the imposed settlement profile.
 """
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 import xarray as xr
 
 from .schema import variable_attrs
-from .semantics import masonry_joints, relative_motion, support_blocks
+from .semantics import masonry_blocks, relative_motion, support_blocks
 
 #: Upper crack widths [m] of damage categories 0 to 4 (category 5 beyond the last).
 DAMAGE_LIMITS = (1.0e-4, 1.0e-3, 5.0e-3, 15.0e-3, 25.0e-3)
@@ -40,11 +44,25 @@ def damage_category(width) -> np.ndarray:
     return np.searchsorted(np.array(DAMAGE_LIMITS), np.asarray(width, dtype=float), side="left").astype(np.int8)
 
 
-def widest_opening(model: xr.Dataset, u: np.ndarray, rotations: str = "finite") -> float:
-    """Widest masonry-joint opening [m] under block motions ``u`` (block, 3)."""
+@dataclass(frozen=True)
+class Cracks:
+    """The widest openings of one state of a wall (module docstring)."""
+
+    width: float  # widest opening of a joint between two masonry blocks [m]
+    interface: int  # that joint, -1 when none opens
+    base_gap: float  # widest opening of a joint between the wall and a support [m]
+
+
+def widest_crack(model: xr.Dataset, u: np.ndarray, rotations: str = "finite") -> Cracks:
+    """The widest crack in the masonry and the widest base gap under block motions ``u`` (block, 3)."""
     opening, _ = relative_motion(model, u, rotations)
-    masonry = masonry_joints(model.block_role.values, model.interface_blocks.values)
-    return float(np.maximum(opening[masonry], 0.0).max(initial=0.0))
+    opening = np.maximum(opening, 0.0).max(axis=1, initial=0.0)
+    masonry = masonry_blocks(model.block_role.values)[model.interface_blocks.values.astype(np.int64)]
+    inside, base = masonry.all(axis=1), masonry.any(axis=1) & ~masonry.all(axis=1)
+    crack = np.where(inside, opening, 0.0)
+    widest = int(np.argmax(crack)) if crack.size else -1
+    width = float(crack[widest]) if widest >= 0 else 0.0
+    return Cracks(width, widest if width > 0 else -1, float(opening[base].max(initial=0.0)))
 
 
 def support_profile(model: xr.Dataset) -> tuple[np.ndarray, np.ndarray]:

@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import csv
 import json
+import logging
 from collections import Counter
 from dataclasses import dataclass
 from pathlib import Path
@@ -42,6 +43,8 @@ DRAWING_UNITS = {"m": 1.0, "cm": 0.01, "mm": 0.001}
 INSUNITS = {4: "mm", 5: "cm", 6: "m"}
 #: Snap tolerance, relative to the drawing's bounding-box diagonal.
 RELATIVE_SNAP = 1e-6
+#: The first bytes of a binary DXF file.
+BINARY_DXF = b"AutoCAD Binary DXF"
 SUFFIXES = {".dxf": "dxf", ".csv": "csv", ".geojson": "geojson", ".json": "geojson"}
 
 
@@ -67,6 +70,7 @@ class _Ring:
     y: np.ndarray
     layer: str
     source: str
+    closed: bool = True  # False: a polyline not flagged closed, closed only if it ends where it starts (snapped)
 
 
 def read_drawing(path: str | Path, drawing_unit: str | None = None, chord_tolerance: float | None = None,
@@ -98,7 +102,7 @@ def read_drawing(path: str | Path, drawing_unit: str | None = None, chord_tolera
         raise SpecError(f"drawing {str(path)!r}: no closed polyline or polygon in it"
                         + (f" (left out: {_counted(ignored)})" if ignored else ""))
     scale = DRAWING_UNITS[unit]
-    rings = [_Ring(r.x * scale, r.y * scale, r.layer, r.source) for r in rings]
+    rings = [_Ring(r.x * scale, r.y * scale, r.layer, r.source, r.closed) for r in rings]
     snap = None if snap_tolerance is None else snap_tolerance * scale
     return clean(rings, snap, ignored)
 
@@ -113,10 +117,16 @@ def _read_dxf(path: Path, drawing_unit: str | None, chord_tolerance: float | Non
     import ezdxf  # here, not at the top: only a drawing needs it
     from ezdxf import recover
 
-    try:
-        doc, _ = recover.readfile(str(path))
-    except (OSError, ezdxf.DXFStructureError) as exc:
-        raise SpecError(f"drawing {str(path)!r}: not a readable DXF file ({exc})") from None
+    binary = path.open("rb").read(len(BINARY_DXF)) == BINARY_DXF
+    ezdxf_log = logging.getLogger("ezdxf")
+    level = ezdxf_log.level
+    ezdxf_log.setLevel(logging.CRITICAL)  # its repairs would print lines of the file; a failure is ours to say
+    try:  # recover repairs damaged text files; a binary DXF (DXB-like, "AutoCAD Binary DXF") reads as it is
+        doc = ezdxf.readfile(str(path)) if binary else recover.readfile(str(path))[0]
+    except (OSError, ezdxf.DXFError, UnicodeDecodeError) as exc:
+        raise SpecError(f"drawing {str(path)!r}: not a readable DXF file ({type(exc).__name__})") from None
+    finally:
+        ezdxf_log.setLevel(level)
     unit = drawing_unit
     if unit is None:
         code = int(doc.header.get("$INSUNITS", 0))
@@ -164,11 +174,7 @@ def _polyline_ring(entity, path: Path, chord_tolerance: float | None) -> _Ring:
     if points.shape[0] and np.ptp(points[:, 2]) > 0:
         raise SpecError(f"{where}: its vertices are not in one plane parallel to the drawing (z varies)")
     x, y = points[:, 0], points[:, 1]
-    closed = bool(entity.closed) or (x.size > 2 and x[0] == x[-1] and y[0] == y[-1])
-    if not closed:
-        raise SpecError(f"{where}: open (it starts at ({x[0]:.6g}, {y[0]:.6g}) and ends at "
-                        f"({x[-1]:.6g}, {y[-1]:.6g}) in drawing units); close it")
-    return _Ring(x, y, layer, source)
+    return _Ring(x, y, layer, source, bool(entity.closed))
 
 
 def _number(text: str, where: str, column: str) -> float:
@@ -243,9 +249,11 @@ def clean(rings: list[_Ring], snap: float | None = None, ignored: dict[str, int]
     snap = RELATIVE_SNAP * size if snap is None else snap
     if not snap > 0:
         raise SpecError(f"geometry.snap_tolerance: must be > 0, got {snap!r}")
+    raw_x, raw_y = x, y
     x, y = snapped(x, y, snap)
     counts = np.array([r.x.size for r in rings])
     starts = block_offsets(counts)
+    _refuse_open(rings, starts, x, y, raw_x, raw_y, snap)
     cleaned_x, cleaned_y, cleaned_counts = [], [], []
     for i, ring in enumerate(rings):
         rx, ry = _simplified(x[starts[i]:starts[i + 1]], y[starts[i]:starts[i + 1]], snap, ring)
@@ -258,6 +266,32 @@ def clean(rings: list[_Ring], snap: float | None = None, ignored: dict[str, int]
     node_x, node_y = _counter_clockwise(node_x, node_y, counts, rings, snap)
     return Drawing(node_x, node_y, counts, tuple(r.layer for r in rings), tuple(r.source for r in rings),
                    dict(ignored or {}))
+
+
+def _refuse_open(rings, starts, x, y, raw_x, raw_y, snap: float) -> None:
+    """A SpecError naming the first ring not flagged closed that never comes back to its first vertex (after
+    snapping: a polyline that ends a hair from its start is closed; one that goes on past it is cut later)
+    with the gap and the ends written with as many digits as it takes to tell them apart."""
+    for i, ring in enumerate(rings):
+        first, last = starts[i], starts[i + 1] - 1
+        back = (x[first + 2:last + 1] == x[first]) & (y[first + 2:last + 1] == y[first])
+        if ring.closed or back.any():
+            continue
+        gap = float(np.hypot(raw_x[last] - raw_x[first], raw_y[last] - raw_y[first]))
+        start, end = _told_apart((raw_x[first], raw_y[first]), (raw_x[last], raw_y[last]))
+        raise SpecError(f"{ring.source} on layer {ring.layer}: open: it starts at {start} m and ends at {end} m, "
+                        f"{gap:.3g} m apart, more than the snap tolerance {snap:.3g} m; close it (or raise "
+                        "geometry.snap_tolerance)")
+
+
+def _told_apart(a, b) -> tuple[str, str]:
+    """Two points written with the fewest significant digits (at least 6) that show how they differ."""
+    for digits in range(6, 18):
+        left = f"({a[0]:.{digits}g}, {a[1]:.{digits}g})"
+        right = f"({b[0]:.{digits}g}, {b[1]:.{digits}g})"
+        if left != right:
+            return left, right
+    return left, right
 
 
 def snapped(x: np.ndarray, y: np.ndarray, tol: float) -> tuple[np.ndarray, np.ndarray]:

@@ -12,11 +12,19 @@ per unit of the settlement parameter ``t`` (for a trough, ``t`` is ``S_max``):
 - ``table``: measured rates ``points = [[x, r], ...]``, linearly interpolated,
   constant beyond the first and last points.
 
-The base ``[0, wall width]`` is cut into ``round(width / segment)`` equal
-segments (at least one). A segment is evaluated at ``x_mid``, the midpoint of
-its contact with the masonry (a door leaves part of the base bare; a segment
-with no masonry on it gets no support block); it stays fixed when its rate is at
-most ``cutoff`` (default 0.01), and adjacent fixed segments merge into one.
+**The ground is continuous.** The base ``[0, wall width]`` is cut into
+``round(width / segment)`` equal segments (at least one); ``segment`` defaults to
+a quarter of the unit length (``DEFAULT_SEGMENT_UNITS``: where the widest crack has
+converged to within 10 %, docs/settlements.md). The ground's motion is known at the segment ends (the
+*nodes*): the profile's rate there, or 0 where that rate is at most ``cutoff``
+(default 0.01), so the cut-off ground joins the rest without a step. Every
+segment moves as a rigid block whose top edge follows the straight line between
+its two nodes: it translates and rotates (small rotations), and two
+neighbouring segments meet at their common node at every settlement; the
+imposed ground is the piecewise-linear interpolation of the profile (error
+``O(segment^2)`` times its curvature). A segment whose two nodes both stay
+still is fixed, and adjacent fixed segments merge; a segment with no masonry on
+it (under a door) gets no block.
 """
 from __future__ import annotations
 
@@ -32,6 +40,8 @@ PROFILES = ("gaussian", "linear", "table")
 SETTLEMENT_KEYS = ("profile", "center", "width", "start", "end", "points", "segment", "cutoff", "depth")
 #: A segment whose rate is at most this stays fixed unless ``cutoff`` says otherwise.
 DEFAULT_CUTOFF = 0.01
+#: The default segment length in unit lengths (the convergence study of docs/settlements.md).
+DEFAULT_SEGMENT_UNITS = 0.25
 _ONLY = {"center": ("gaussian",), "width": ("gaussian",), "depth": ("gaussian",),
          "start": ("linear",), "end": ("linear",), "points": ("table",)}
 
@@ -70,28 +80,29 @@ class Profile:
 
 @dataclass(frozen=True)
 class Segment:
-    """One support block under the wall: its range, and its motion per unit settlement parameter."""
+    """One support block under the wall: its range and the ground's motion at its two ends (the nodes), per
+    unit settlement parameter: downward rate and horizontal motion (x positive), 0 where the ground is still."""
 
     start: float
     end: float
-    x_mid: float  # midpoint of the masonry resting on it
-    rate: float  # vertical, 0 when fixed
-    horizontal: float
+    down: tuple[float, float]
+    horizontal: tuple[float, float]
 
     @property
     def moving(self) -> bool:
-        return self.rate > 0
+        return max(self.down) > 0
 
 
-def read_profile(top: SpecTable, wall_width: float) -> Profile:
-    """The ``[settlement]`` table of a spec (``top``: the whole spec, with its length scale)."""
+def read_profile(top: SpecTable, wall_width: float, unit_length: float) -> Profile:
+    """The ``[settlement]`` table of a spec (``top``: the whole spec, with its length scale); ``segment``
+    defaults to :data:`DEFAULT_SEGMENT_UNITS` unit lengths."""
     table = top.sub("settlement", SETTLEMENT_KEYS)
     kind = table.choice("profile", PROFILES)
     for key, kinds in _ONLY.items():
         if table.has(key) and kind not in kinds:
             raise SpecError(f"spec key {table.key(key)!r} only applies to profile = "
                             f"{' or '.join(map(repr, kinds))}")
-    segment = table.number("segment", length=True, positive=True)
+    segment = table.number("segment", DEFAULT_SEGMENT_UNITS * unit_length / top.scale, length=True, positive=True)
     cutoff = table.number("cutoff", DEFAULT_CUTOFF, minimum=0.0)
     if kind == "gaussian":
         return Profile(kind, segment, cutoff, center=table.number("center", length=True),
@@ -126,16 +137,19 @@ def _table_points(table: SpecTable) -> tuple[tuple[float, float], ...]:
     return tuple(zip(x.tolist(), rate.tolist()))
 
 
-def contact_midpoints(edges: np.ndarray, base: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Per segment ``[edges[k], edges[k+1]]``: the length and midpoint of its overlap with the ``base``
-    intervals ``(n, 2)`` (the masonry's bottom edges); midpoint nan where nothing rests on it."""
-    a, b = edges[:-1, None], edges[1:, None]
-    lo, hi = np.maximum(a, base[:, 0]), np.minimum(b, base[:, 1])
-    piece = np.maximum(hi - lo, 0.0)
-    length = piece.sum(axis=1)
-    moment = (piece * 0.5 * (lo + hi)).sum(axis=1)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        return length, np.where(length > 0, moment / length, np.nan)
+def contact_lengths(edges: np.ndarray, base: np.ndarray) -> np.ndarray:
+    """Per segment ``[edges[k], edges[k+1]]``: the length of its overlap with the ``base`` intervals ``(n, 2)``
+    (the masonry's bottom edges)."""
+    lo = np.maximum(edges[:-1, None], base[:, 0])
+    hi = np.minimum(edges[1:, None], base[:, 1])
+    return np.maximum(hi - lo, 0.0).sum(axis=1)
+
+
+def node_motion(profile: Profile, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``(down, horizontal)`` rates of the ground at the nodes ``x``: the profile's, 0 at or below the cutoff."""
+    down = profile.rate(x)
+    still = down <= profile.cutoff
+    return np.where(still, 0.0, down), np.where(still, 0.0, profile.horizontal(x))
 
 
 def profile_segments(profile: Profile, width: float, base: np.ndarray) -> list[Segment]:
@@ -143,22 +157,19 @@ def profile_segments(profile: Profile, width: float, base: np.ndarray) -> list[S
     intervals (module docstring): moving segments one by one, adjacent fixed ones merged."""
     count = max(1, round(width / profile.segment))
     edges = np.linspace(0.0, width, count + 1)
-    length, mid = contact_midpoints(edges, base)
-    tol = 1e-9 * width
+    down, horizontal = node_motion(profile, edges)
+    bare = contact_lengths(edges, base) <= 1e-9 * width
     segments: list[Segment] = []
-    for k in np.flatnonzero(length > tol):
-        rate = float(profile.rate(mid[k]))
-        if rate <= profile.cutoff:
-            last = segments[-1] if segments else None
-            if last is not None and not last.moving and abs(last.end - edges[k]) <= tol:
-                joined = (last.end - last.start) + (edges[k + 1] - edges[k])
-                segments[-1] = Segment(last.start, float(edges[k + 1]), last.start + 0.5 * joined, 0.0, 0.0)
-            else:
-                segments.append(Segment(float(edges[k]), float(edges[k + 1]), float(mid[k]), 0.0, 0.0))
-            continue
-        segments.append(Segment(float(edges[k]), float(edges[k + 1]), float(mid[k]), rate,
-                                float(profile.horizontal(mid[k]))))
+    for k in np.flatnonzero(~bare):
+        segment = Segment(float(edges[k]), float(edges[k + 1]), (float(down[k]), float(down[k + 1])),
+                          (float(horizontal[k]), float(horizontal[k + 1])))
+        last = segments[-1] if segments else None
+        if not segment.moving and last is not None and not last.moving and last.end == segment.start:
+            segment = Segment(last.start, segment.end, (0.0, 0.0), (0.0, 0.0))
+            segments.pop()
+        segments.append(segment)
     if not any(s.moving for s in segments):
-        raise SpecError(f"spec table 'settlement': every segment's rate is at most the cutoff {profile.cutoff:g}: "
-                        "nothing settles under the wall (move the profile under it or lower the cutoff)")
+        raise SpecError(f"spec table 'settlement': the ground settles at most {profile.cutoff:g} (the cutoff) times "
+                        "S_max under every segment: nothing settles under the wall (move the profile under it "
+                        "or lower the cutoff)")
     return segments

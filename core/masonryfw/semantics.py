@@ -36,7 +36,8 @@ import numpy as np
 import xarray as xr
 
 from .dofs import block_loads
-from .geometry import block_offsets, model_scale, node_block
+from .errors import ModelError
+from .geometry import block_offsets, model_scale, node_block, polygon_area_centroid
 from .schema import flags, variable_attrs
 
 #: A joint moving at most this share of the largest masonry-joint motion is intact.
@@ -234,15 +235,18 @@ def crack_indicator(motion: np.ndarray, masonry: np.ndarray, share: float = INTA
     return np.where(masonry & (motion > share * largest), np.minimum(motion / largest, 1.0), 0.0)
 
 
-def nearest_interface(model: xr.Dataset, x: np.ndarray, y: np.ndarray, spacing: float) -> np.ndarray:
-    """Index of the interface nearest to each point ``(x, y)``, to within ``spacing / 2``.
+def nearest_interface(model: xr.Dataset, x: np.ndarray, y: np.ndarray, spacing: float,
+                      among: np.ndarray | None = None) -> np.ndarray:
+    """Index of the interface nearest to each point ``(x, y)``, to within ``spacing / 2``; ``among`` (bool per
+    interface) limits the search to those interfaces.
 
     A KD-tree of points sampled along every interface ``spacing`` apart, so no
     point-to-segment loop over all pairs.
     """
     from scipy.spatial import cKDTree  # here, not at the top: it adds 0.1 s to every CLI start
 
-    ix, iy = model.interface_x.values, model.interface_y.values
+    index = np.arange(model.sizes["interface"]) if among is None else np.flatnonzero(among)
+    ix, iy = model.interface_x.values[index], model.interface_y.values[index]
     length = np.hypot(ix[:, 1] - ix[:, 0], iy[:, 1] - iy[:, 0])
     samples = np.maximum(np.ceil(length / spacing).astype(int), 1) + 1
     owner = np.repeat(np.arange(length.size), samples)
@@ -251,7 +255,7 @@ def nearest_interface(model: xr.Dataset, x: np.ndarray, y: np.ndarray, spacing: 
     sx = ix[owner, 0] + fraction * (ix[owner, 1] - ix[owner, 0])
     sy = iy[owner, 0] + fraction * (iy[owner, 1] - iy[owner, 0])
     _, nearest = cKDTree(np.c_[sx, sy]).query(np.c_[x, y])
-    return owner[nearest]
+    return index[owner[nearest]]
 
 
 def plastic_crack_indicator(model: xr.Dataset, x: np.ndarray, y: np.ndarray, plastic: np.ndarray) -> np.ndarray:
@@ -345,28 +349,69 @@ class KeyNumber:
         return f"{self.name} = {self.value:.6g}{unit}"
 
 
-def reaction_weights(role: np.ndarray, direction: np.ndarray) -> np.ndarray:
-    """Per block, the weight of its vertical reaction in the settlement reaction: a moving support's
-    downward rate over the fastest one's (1 for all when they settle at one rate), 0 for other blocks.
+def settlement_reference_rate(model: xr.Dataset) -> float:
+    """The rate the settlement reaction is measured against: the fastest downward motion of any point of a
+    moving support per unit settlement parameter (the point of a trough's S_max, when a support reaches it;
+    over the supports' vertices, as a rigid block's vertical motion is linear in x). Without any downward
+    motion, the largest motion; 0 without a moving support."""
+    role = np.asarray(model.block_role.values)
+    moving = role == _ROLE["moving_support"]
+    d = np.asarray(model.settlement_direction.values, dtype=float)
+    if not moving.any():
+        return 0.0
+    counts = np.asarray(model.block_node_count.values)
+    x = np.asarray(model.node_x.values, dtype=float)
+    _, cx, _ = polygon_area_centroid(x, np.asarray(model.node_y.values, dtype=float), counts)
+    owner = node_block(counts)
+    on = moving[owner]
+    down = -(d[owner, 1] + d[owner, 2] * (x - cx[owner]))[on]
+    fastest = float(down.max())
+    return fastest if fastest > 0 else float(np.linalg.norm(d[moving], axis=1).max())
 
-    With one settlement parameter t, equilibrium fixes only the reactions' work on t, the sum of
-    the supports' reactions weighted by their rates: that is what drops by alpha in la (its plain
-    sum is not unique when the rates differ). Vertical components only: exact for supports that
-    translate vertically, and the plain sum for a single support of any motion.
+
+def settlement_weights(model: xr.Dataset) -> np.ndarray:
+    """``(block, 3)``: every moving support's ``settlement_direction`` over the reference rate
+    (:func:`settlement_reference_rate`), 0 for other blocks: the weights of :func:`settlement_reaction`."""
+    moving = np.asarray(model.block_role.values) == _ROLE["moving_support"]
+    weights = np.where(moving[:, None], np.asarray(model.settlement_direction.values, dtype=float), 0.0)
+    reference = settlement_reference_rate(model)
+    return weights / reference if reference > 0 else weights
+
+
+def settlement_reaction(model: xr.Dataset, wrench: np.ndarray) -> np.ndarray:
+    """The **settlement reaction** [N] of support wrenches ``wrench`` ``(..., block, 3)``: the force (x, y)
+    and moment (about each block's centroid) the *wall exerts on* each support.
+
+    The force conjugate to the settlement parameter t: the work the supports' reactions do on the wall
+    per unit of t, with the sign flipped, over the reference rate (:func:`settlement_weights`). With one
+    moving support translating down it is that support's upward vertical reaction; with several at their
+    own rates, rotating or moving sideways (a trough's segments), it is the one quantity equilibrium fixes
+    (la's alpha is a share of it: ``(1 - alpha) R0`` at collapse), and it stays defined when the whole
+    base settles (a rigid-body settlement leaves it at R0; a trough makes it drop).
     """
-    moving = np.asarray(role) == _ROLE["moving_support"]
-    down = np.where(moving, -np.asarray(direction, dtype=float)[:, 1], 0.0)
-    fastest = float(down.max(initial=0.0))
-    if moving.sum() <= 1 or not fastest > 0:
-        return moving.astype(float)
-    return down / fastest
+    return np.einsum("...bd,bd->...", np.asarray(wrench, dtype=float), settlement_weights(model))
+
+
+def refuse_rigid_settlement(model: xr.Dataset, solver: str) -> None:
+    """A :class:`ModelError` when every support moves and all by the same translation: the whole wall
+    then follows the ground as one rigid body, nothing in it deforms and the settlement reaction stays R0."""
+    role = np.asarray(model.block_role.values)
+    ground = support_blocks(role)
+    moving = role == _ROLE["moving_support"]
+    direction = np.asarray(model.settlement_direction.values, dtype=float)[ground]
+    if moving.any() and moving.sum() == ground.sum() and np.all(direction[:, 2] == 0) \
+            and np.allclose(direction, direction[0], rtol=0.0, atol=1e-12 * np.abs(direction).max()):
+        raise ModelError(f"{solver}: every support moves by the same translation "
+                         f"{' '.join(f'{d:.6g}' for d in direction[0])} per unit settlement: the wall follows the "
+                         "ground as one rigid body and nothing in it deforms; keep part of the base fixed or let "
+                         "the supports settle at different rates (a [settlement] profile)")
 
 
 def dead_reaction(model: xr.Dataset) -> float:
-    """Upward dead load on the moving supports [N], weighted by their rates (:func:`reaction_weights`):
-    the paper's settlement reaction R0 (0 without one)."""
-    weights = reaction_weights(model.block_role.values, model.settlement_direction.values)
-    return float((weights * block_loads(model, "dead")[:, 1]).sum())
+    """The settlement reaction of the model's dead loads on the moving supports [N] (R0, the paper's
+    convention: each moving support carries ``W L_s / L_total`` up): :func:`settlement_reaction` of the
+    force the wall would exert on them (their dead load, down), a sum weighted by the supports' rates."""
+    return float(settlement_reaction(model, -block_loads(model, "dead")))
 
 
 def plateau_start(settlement: np.ndarray, reaction: np.ndarray, band: float) -> int:
@@ -383,30 +428,63 @@ def _history_numbers(result: xr.Dataset) -> list[KeyNumber]:
     loaded = np.flatnonzero(settlement <= 0)
     first = int(loaded[-1]) if loaded.size else 0
     r0 = float(reaction[first])
-    numbers = [KeyNumber("dead_reaction", r0, "N", "reaction on the moving supports before they settle")]
+    numbers = [KeyNumber("dead_reaction", r0, "N", "settlement reaction before the supports settle (R0)")]
     s, r = settlement[first:], reaction[first:]
     if s.size < 2:
         return numbers
     low = int(np.argmin(r))
     start = plateau_start(s, r, PLATEAU_SHARE * abs(r0))
     return numbers + [
-        KeyNumber("minimum_reaction", float(r[low]), "N", "smallest reaction on the moving supports"),
+        KeyNumber("minimum_reaction", float(r[low]), "N", "smallest settlement reaction"),
         KeyNumber("minimum_reaction_settlement", float(s[low]), "m", "settlement at the smallest reaction"),
         KeyNumber("plateau_reaction", float(r[start:].mean()), "N",
-                  f"mean reaction from the plateau on (within {PLATEAU_SHARE:.0%} of R0 of the final value)"),
+                  f"mean settlement reaction from the plateau on (within {PLATEAU_SHARE:.0%} of R0 of the final value)"),
         KeyNumber("plateau_settlement", float(s[start]), "m", "settlement where the plateau starts"),
         KeyNumber("final_settlement", float(s[-1]), "m", "settlement of the last record"),
     ]
 
 
+def _crack_numbers(result: xr.Dataset) -> list[KeyNumber]:
+    """The widest crack over the run, where and when it is, the damage category it gives; the last
+    record's crack and category; the widest base gap."""
+    width = np.asarray(result.step_crack_width_max.values, dtype=float)
+    if width.size == 0:
+        return []
+    widest = int(np.argmax(width))
+    numbers = [KeyNumber("crack_width", float(width[widest]), "m", "widest crack in the masonry over the run")]
+    if "step_settlement" in result:
+        numbers.append(KeyNumber("crack_settlement", float(result.step_settlement.values[widest]), "m",
+                                 "settlement at the record of the widest crack"))
+    interface = int(result.step_crack_interface.values[widest]) if "step_crack_interface" in result else -1
+    if interface >= 0:
+        numbers += [
+            KeyNumber("crack_interface", float(interface), "1", "the joint of the widest crack"),
+            KeyNumber("crack_x", float(result.interface_x.values[interface].mean()), "m", "x of that joint's midpoint"),
+            KeyNumber("crack_y", float(result.interface_y.values[interface].mean()), "m", "y of that joint's midpoint"),
+        ]
+    if "step_damage_category" in result:
+        category = np.asarray(result.step_damage_category.values)
+        numbers += [
+            KeyNumber("damage_category", float(category.max()), "1",
+                      "largest damage category over the run (0 negligible .. 5 very severe)"),
+            KeyNumber("damage_category_final", float(category[-1]), "1", "damage category at the last record"),
+        ]
+    numbers.append(KeyNumber("crack_width_final", float(width[-1]), "m", "widest crack at the last record"))
+    if "step_base_gap_max" in result and result.step_base_gap_max.size:
+        numbers.append(KeyNumber("base_gap", float(np.max(result.step_base_gap_max.values)), "m",
+                                 "widest gap between the wall and the ground over the run (not a crack in the masonry)"))
+    return numbers
+
+
 def key_numbers(result: xr.Dataset) -> list[KeyNumber]:
     """The numbers a user came for, whatever the solver.
 
-    Limit analysis: alpha, the dead reaction R0 and the reaction on the moving supports at collapse
-    (the solver's ``moving_support_reaction``, else ``(1 - alpha) R0``). Incremental solvers: the dead reaction, the smallest
-    reaction and the plateau reaction with their settlements, the widest crack and the damage
-    category at the last record (:mod:`masonryfw.damage`). Both: the number of
-    masonry macro-blocks when the result has them.
+    Limit analysis: alpha, the dead reaction R0 and the settlement reaction at collapse (the solver's
+    ``moving_support_reaction``, else ``(1 - alpha) R0``). Incremental solvers: the dead reaction, the
+    smallest and the plateau settlement reaction with their settlements; the widest crack over the run
+    with its joint, place and settlement, the largest damage category, and the last record's
+    (:mod:`masonryfw.damage`). Both: the number of masonry macro-blocks when the result has them. R0 and
+    the reactions are settlement reactions (:func:`settlement_reaction`), one definition for every solver.
     """
     numbers: list[KeyNumber] = []
     if "collapse_multiplier" in result:
@@ -415,21 +493,17 @@ def key_numbers(result: xr.Dataset) -> list[KeyNumber]:
         r0 = dead_reaction(result)
         if r0 > 0:
             numbers.append(KeyNumber("dead_reaction", r0, "N",
-                                     "dead load on the moving supports, W L_moving / L_total (R0)"))
+                                     "settlement reaction of the dead loads W L_s / L_total on the moving supports (R0)"))
         if "moving_support_reaction" in result:
             numbers.append(KeyNumber("collapse_reaction", float(result.moving_support_reaction.values), "N",
-                                     "reaction on the moving supports at collapse"))
+                                     "settlement reaction at collapse"))
         elif r0 > 0:
             numbers.append(KeyNumber("collapse_reaction", (1.0 - alpha) * r0, "N",
-                                     "reaction on the moving supports at collapse, (1 - alpha) R0"))
+                                     "settlement reaction at collapse, (1 - alpha) R0"))
     if "step_reaction" in result and "step_settlement" in result:
         numbers += _history_numbers(result)
-    if "step_crack_width_max" in result and result.step_crack_width_max.size:
-        numbers.append(KeyNumber("crack_width", float(result.step_crack_width_max.values[-1]), "m",
-                                 "widest crack at the last record"))
-    if "step_damage_category" in result and result.step_damage_category.size:
-        numbers.append(KeyNumber("damage_category", float(result.step_damage_category.values[-1]), "1",
-                                 "damage category at the last record (0 negligible .. 5 very severe)"))
+    if "step_crack_width_max" in result:
+        numbers += _crack_numbers(result)
     if "macro_block" in result:
         masonry = masonry_blocks(result.block_role.values)
         count = np.unique(result.macro_block.values[masonry]).size

@@ -42,6 +42,17 @@ def _mm(metres: float) -> str:
     return f"{1e3 * metres:.3g} mm"
 
 
+def _crack_text(numbers: dict) -> str:
+    """``0.272 mm (joint 41 at x 3.1 m, y 0.125 m; S = 15 mm)``: the widest crack, where and when."""
+    where = []
+    if "crack_interface" in numbers:
+        where.append(f"joint {int(numbers['crack_interface'])} at x {numbers['crack_x']:.3g} m, "
+                     f"y {numbers['crack_y']:.3g} m")
+    if "crack_settlement" in numbers:
+        where.append(f"settlement {_mm(numbers['crack_settlement'])}")
+    return _mm(numbers["crack_width"]) + (f" ({'; '.join(where)})" if where else "")
+
+
 def _damage_name(category: float) -> str:
     names = {value: name.replace("_", " ") for name, value in flags("step_damage_category").items()}
     return f"{int(category)} {names.get(int(category), '')}".strip()
@@ -60,9 +71,12 @@ _HEADLINES = (
     ("plateau_reaction", "plateau reaction", lambda n: f"{n['plateau_reaction']:.4g} N from "
      f"{_mm(n['plateau_settlement'])}", "the reaction once it stops changing (within 1 % of R0)"),
     ("final_settlement", "final settlement", lambda n: _mm(n["final_settlement"]), "settlement of the last record"),
-    ("crack_width", "widest crack", lambda n: _mm(n["crack_width"]), "widest joint opening at the last record"),
+    ("crack_width", "widest crack", lambda n: _crack_text(n),
+     "widest opening of a joint in the masonry over the run: the joint, its midpoint, the settlement"),
     ("damage_category", "damage category", lambda n: _damage_name(n["damage_category"]),
-     "Burland et al. (1977) by crack width: 0 negligible .. 5 very severe"),
+     "largest over the run, Burland et al. (1977) by crack width: 0 negligible .. 5 very severe"),
+    ("base_gap", "base gap", lambda n: _mm(n["base_gap"]),
+     "widest gap between the wall and the ground over the run (not a crack in the masonry)"),
     ("macro_blocks", "macro-blocks", lambda n: f"{int(n['macro_blocks'])}",
      "pieces the masonry breaks into (blocks joined by intact joints)"),
 )

@@ -8,8 +8,10 @@ a :class:`masonryfw.MasonryError` naming the variable and the kind of result it 
 """
 from __future__ import annotations
 
+from collections import Counter
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -383,15 +385,33 @@ def draw_plastic(datasets: Sequence[xr.Dataset], ax, options: Mapping[str, Any])
 
 def distinct_labels(datasets: Sequence[xr.Dataset]) -> list[str]:
     """Each result's label (:func:`masonryfw.result_label`); results that share one get the solver options
-    in which they differ, e.g. ``fdem (mode=deformable)``."""
+    in which they differ, e.g. ``fdem (mode=deformable)``, else their titles, else their file names, else
+    their place in the list: no two results share a label."""
     labels = [mf.result_label(ds) for ds in datasets]
-    options = [mf.result_options(ds) for ds in datasets]
+    details = [
+        lambda ds: mf.result_options(ds),
+        lambda ds: {"": ds.attrs.get("title", "")},
+        lambda ds: {"": Path(str(ds.encoding.get("source", ""))).name},
+    ]
+    for detail in details:
+        labels = _told_apart(labels, [detail(ds) for ds in datasets])
+    counts = Counter(labels)
+    seen: Counter = Counter()
+    out = []
+    for label in labels:
+        seen[label] += 1
+        out.append(f"{label} #{seen[label]}" if counts[label] > 1 else label)
+    return out
+
+
+def _told_apart(labels: list[str], facts: list[dict]) -> list[str]:
+    """Labels that several results share get the facts (key -> value) in which those results differ."""
     out = []
     for i, label in enumerate(labels):
         twins = [j for j, other in enumerate(labels) if other == label]
-        keys = sorted({k for j in twins for k in options[j]})
-        differ = [k for k in keys if len({repr(options[j].get(k)) for j in twins}) > 1]
-        detail = ", ".join(f"{k}={options[i].get(k)}" for k in differ)
+        keys = sorted({k for j in twins for k in facts[j]})
+        differ = [k for k in keys if len({repr(facts[j].get(k)) for j in twins}) > 1]
+        detail = ", ".join(f"{k}={facts[i].get(k)}" if k else str(facts[i].get(k)) for k in differ)
         out.append(f"{label} ({detail})" if len(twins) > 1 and detail else label)
     return out
 
@@ -492,6 +512,13 @@ def _room_for_strips(ax, rows: int) -> None:
         ax.set_ylim(low, low + (high - low) / (1.0 - STRIP_SHARE * rows - 0.01))
 
 
+def _profiled(results: Sequence[xr.Dataset]) -> bool:
+    """Whether any result settles several supports (a profile): its reaction is then the settlement reaction
+    (``mf.settlement_reaction``: each support weighted by its motion), not one support's."""
+    moving = mf.flags("block_role")["moving_support"]
+    return any(int((ds.block_role.values == moving).sum()) > 1 for ds in results if "block_role" in ds)
+
+
 def draw_history(datasets: Sequence[xr.Dataset], ax, options: Mapping[str, Any]) -> None:
     """The reaction on the moving supports (or the damage) against the settlement, of one or more
     incremental results overlaid, with the dead load R0 and, for every la result given, its collapse
@@ -523,13 +550,13 @@ def draw_history(datasets: Sequence[xr.Dataset], ax, options: Mapping[str, Any])
         references = [*incremental, *limits]
         r0 = mf.dead_reaction(references[0]) if references else 0.0
         if r0 > 0:
-            handles.append(ax.axhline(r0, ls="--", lw=0.9, color="0.35", label=f"dead load R0 = {r0:.4g} N"))
+            handles.append(ax.axhline(r0, ls="--", lw=0.9, color="0.35", label=f"dead reaction R0 = {r0:.4g} N"))
         for ds, style in zip(limits, (":", "-.", (0, (1, 3)), (0, (5, 2)))):
             collapse = (1 - float(ds.collapse_multiplier.values)) * mf.dead_reaction(ds)
             handles.append(ax.axhline(collapse, ls=style, lw=1.2, color="k",
                                       label=f"{mf.result_label(ds)}: (1 - alpha) R0 = {collapse:.4g} N"))
         strips, rows = _damage_strips(ax, incremental)
-        ax.set_ylabel("reaction on the moving supports [N]")
+        ax.set_ylabel("settlement reaction [N]" if _profiled(references) else "reaction on the moving support [N]")
         ax.set_ylim(bottom=min(0.0, ax.get_ylim()[0]))
         ax.legend(handles=handles + strips, loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=2,
                   fontsize="small", frameon=False)
@@ -555,24 +582,32 @@ def _fit_y_to_shown(ax, curves: Sequence[tuple[np.ndarray, np.ndarray]]) -> None
 
 
 def _draw_damage(ax, incremental, labels, colours) -> None:
-    """Damage category (steps) and widest crack (dashed, right axis) of every result."""
+    """The widest crack of every result against the settlement on one crack-width axis whose damage
+    categories are bands (their limits from ``mf.DAMAGE_LIMITS``, named at the right): the category a curve
+    is in is the band it crosses, with no second axis to misread. Linear up to 0.1 mm (category 0, where a
+    crack may be 0), logarithmic above."""
     for ds in incremental:
         _require(ds, ["step_damage_category", "step_crack_width_max"], "history --option quantity=damage",
-                 "a result with crack widths (fdem or jmm, issue 14 or later)")
-    names = mf.flags("step_damage_category")
-    width = ax.twinx()
+                 "a result with crack widths (fdem or jmm)")
+    names = {v: k.replace("_", " ") for k, v in mf.flags("step_damage_category").items()}
+    limits_mm = [0.0, *(1e3 * v for v in mf.DAMAGE_LIMITS)]
+    widest = max(float(np.max(ds.step_crack_width_max.values, initial=0.0)) for ds in incremental) * 1e3
+    top = max(2.0 * limits_mm[-1], 1.5 * widest)
+    ax.set_yscale("symlog", linthresh=limits_mm[1], linscale=0.6)
+    for category, low in enumerate(limits_mm):
+        high = limits_mm[category + 1] if category + 1 < len(limits_mm) else top
+        ax.axhspan(low, high, color=DAMAGE_COLOURS[category], alpha=0.13, lw=0, zorder=0)
+        ax.text(1.01, np.sqrt(max(low, 1e-2) * high) if category else 0.5 * high, f"{category} {names[category]}",
+                transform=ax.get_yaxis_transform(), va="center", ha="left", fontsize="small", color="0.2")
     for ds, label, colour in zip(incremental, labels, colours):
         s = 1e3 * ds.step_settlement.values
-        ax.step(s, ds.step_damage_category.values, where="post", color=colour, label=f"{label}: damage category")
-        width.plot(s, 1e3 * ds.step_crack_width_max.values, color=colour, lw=0.9, ls="--",
-                   label=f"{label}: widest crack")
-    ax.set_yticks(list(names.values()), [f"{v} {k.replace('_', ' ')}" for k, v in names.items()], fontsize="small")
-    ax.set_ylim(-0.3, 5.3)
-    ax.set_ylabel("damage category (Burland et al. 1977)")
-    width.set_ylabel("widest crack [mm]")
-    lines = ax.get_lines() + width.get_lines()
-    ax.legend(lines, [line.get_label() for line in lines], loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=2,
-              fontsize="small", frameon=False)
+        ax.plot(s, 1e3 * ds.step_crack_width_max.values, color=colour, lw=1.3, label=label)
+    ax.set_ylim(0.0, top)
+    ax.set_yticks(limits_mm, [f"{v:g}" for v in limits_mm])
+    ax.minorticks_off()
+    ax.set_ylabel("widest crack in the masonry [mm]")
+    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=2, fontsize="small", frameon=False,
+              title="damage category: the band the curve is in (Burland et al. 1977)", title_fontsize="small")
 
 
 def history_table(datasets: Sequence[xr.Dataset], options: Mapping[str, Any]) -> tuple[list[str], list[list]]:

@@ -33,9 +33,15 @@ import masonryfw as mf
 from .kernels import (
     DISSIPATED_DAMPING,
     DISSIPATED_FRICTION,
+    KINETIC,
+    OUT_SCALARS,
+    REBUILD,
     RELEASED,
     SETTLEMENT,
+    STEPS,
+    STORED,
     TIME,
+    UNBALANCED,
     WORK_GRAVITY,
     WORK_SUPPORT,
     face_geometry,
@@ -387,7 +393,7 @@ def driven_motion(settlement, rate, x0, y0, node_block, driven_nodes, pos0, dire
 
 @jit
 def advance(n_steps, dt, x, y, vel, x0, y0, x_detect, y_detect, offs, node_block, triangles, grad_x, grad_y,
-            area0, young, poisson, active_tri, mass, inv_mass, driven, moving, pos0, direction, faces, props,
+            area0, young, poisson, active_tri, mass, inv_mass, driven, pos0, direction, faces, props,
             kn, kt, min_half, contact_damping, shear, bonded, normal, energy, load, load_ramp, added_load,
             added_start, added_time, damping, rate, ramp_time, start_time, target, half_buffer, acc, out):
     """Up to ``n_steps`` central-difference steps of the nodes (see :func:`.kernels.advance` for the
@@ -456,25 +462,26 @@ def advance(n_steps, dt, x, y, vel, x0, y0, x_detect, y_detect, offs, node_block
     strain = cst_element_forces(x, y, elements, constants, force)
     springs = node_contact_forces(x, y, vel, offs, faces, props, kn, kt, min_half, contact_damping, inv_mass,
                                   dt, shear, bonded, normal, energy, force, acc, False)
-    reaction = 0.0
     kinetic = 0.0
     unbalanced = 0.0
-    out[6:] = 0.0
+    out[OUT_SCALARS:] = 0.0
     for k in range(n_node):
-        if driven[k]:
-            out[6 + node_block[k]] -= force[k, 1]
-        if moving[node_block[k]]:
-            reaction -= force[k, 1]
+        if driven[k]:  # the wall's force on the support block, and its moment about the block's centroid
+            b = node_block[k]
+            cx = pos0[b, 0] + acc[SETTLEMENT] * direction[b, 0]
+            cy = pos0[b, 1] + acc[SETTLEMENT] * direction[b, 1]
+            out[OUT_SCALARS + 3 * b] += force[k, 0]
+            out[OUT_SCALARS + 3 * b + 1] += force[k, 1]
+            out[OUT_SCALARS + 3 * b + 2] += (x[k] - cx) * force[k, 1] - (y[k] - cy) * force[k, 0]
         if not driven[k]:
             kinetic += 0.5 * mass[k] * (vel[k, 0] * vel[k, 0] + vel[k, 1] * vel[k, 1])
             unbalanced += (abs(force[k, 0] + load[k, 0] + added_load[k, 0])
                            + abs(force[k, 1] + load[k, 1] + added_load[k, 1]))
-    out[0] = steps
-    out[1] = rebuild
-    out[2] = reaction
-    out[3] = kinetic
-    out[4] = strain + springs
-    out[5] = unbalanced / load_norm if load_norm > 0.0 else 0.0
+    out[STEPS] = steps
+    out[REBUILD] = rebuild
+    out[KINETIC] = kinetic
+    out[STORED] = strain + springs
+    out[UNBALANCED] = unbalanced / load_norm if load_norm > 0.0 else 0.0
 
 
 def rigid_fit(mesh: Mesh, x: np.ndarray, y: np.ndarray, n_block: int) -> np.ndarray:

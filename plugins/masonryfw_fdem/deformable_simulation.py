@@ -70,8 +70,8 @@ class DeformableState(State):
         m = self.mesh
         deformable.advance(n_steps, controls.dt, self.x, self.y, self.node_vel, m.x0, m.y0, self.x_detect,
                            self.y_detect, scene.offs, m.node_block, m.triangles, m.grad_x, m.grad_y, m.area0,
-                           m.young, m.poisson, m.active_tri, m.mass, m.inv_mass, m.driven, scene.moving,
-                           scene.pos0, scene.direction, self.faces, self.props, controls.kn, controls.kt,
+                           m.young, m.poisson, m.active_tri, m.mass, m.inv_mass, m.driven, scene.pos0,
+                           scene.direction, self.faces, self.props, controls.kn, controls.kt,
                            controls.min_half, controls.contact_damping, self.shear, self.bonded, self.normal,
                            self.energy, self.node_load, controls.load_ramp, self.node_added, self.added_start,
                            self.added_time, controls.damping, rate, controls.ramp_time, self.settlement_start, target,

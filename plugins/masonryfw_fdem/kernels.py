@@ -32,6 +32,10 @@ from numba import njit, prange
 # Indices into the scalar state vector ``acc`` (accumulators carried between chunks).
 TIME, SETTLEMENT, WORK_GRAVITY, WORK_SUPPORT, DISSIPATED_DAMPING, DISSIPATED_FRICTION, RELEASED = range(7)
 N_ACC = 7
+# Indices into a chunk's report ``out``: these scalars, then per block the force (x, y) and moment the wall
+# exerts on it if it is a support (0 for the others), OUT_SCALARS + 3 * block + component.
+STEPS, REBUILD, KINETIC, STORED, UNBALANCED = range(5)
+OUT_SCALARS = 5
 
 # error_model="numpy": float division by zero gives inf/nan instead of a checked branch (3x faster)
 jit = njit(cache=True, error_model="numpy")
@@ -509,10 +513,9 @@ def advance(n_steps, dt, pos, vel, pos0, pos_detect, radius, lx, ly, offs, faces
     still loads it more and more, and it must follow. Moving supports are active while they move.
     ``face_force`` (face, 4): each pair's forces, kept for the frozen pairs of sleepers.
 
-    ``out`` receives: steps done, rebuild needed (0/1), reaction on the moving
-    supports (upward force on the wall), kinetic energy, stored energy,
-    unbalanced-force ratio, then per block the upward force of a support block
-    on the wall (0 for the others). Returns nothing; ``acc`` carries the accumulators.
+    ``out`` receives (indices above): steps done, rebuild needed (0/1), kinetic energy, stored energy,
+    unbalanced-force ratio, then per block the force and moment (about its centroid) the wall exerts on a
+    support block. Returns nothing; ``acc`` carries the accumulators.
     """
     n_block = pos.shape[0]
     force = np.zeros((n_block, 3))
@@ -561,25 +564,22 @@ def advance(n_steps, dt, pos, vel, pos0, pos_detect, radius, lx, ly, offs, faces
     stored = contact_forces(pos, vel, vx, vy, offs, faces, props, kn, kt, min_half, contact_damping,
                             inv_mass, dt, shear, bonded, normal, energy, force, acc, False, active,
                             driven, calm, 0.0, face_force)
-    reaction = 0.0
     kinetic = 0.0
     unbalanced = 0.0
     for i in range(n_block):
-        out[6 + i] = -force[i, 1] if driven[i] else 0.0
-        if moving[i]:
-            reaction -= force[i, 1]
+        for d in range(3):
+            out[OUT_SCALARS + 3 * i + d] = force[i, d] if driven[i] else 0.0
         if not driven[i]:
             for d in range(3):
                 if free[i, d]:
                     kinetic += 0.5 * mass[i, d] * vel[i, d] * vel[i, d]
                     if d < 2:
                         unbalanced += abs(force[i, d] + load[i, d] + added_load[i, d])
-    out[0] = steps
-    out[1] = rebuild
-    out[2] = reaction
-    out[3] = kinetic
-    out[4] = stored
-    out[5] = unbalanced / load_norm if load_norm > 0.0 else 0.0
+    out[STEPS] = steps
+    out[REBUILD] = rebuild
+    out[KINETIC] = kinetic
+    out[STORED] = stored
+    out[UNBALANCED] = unbalanced / load_norm if load_norm > 0.0 else 0.0
 
 
 @jit

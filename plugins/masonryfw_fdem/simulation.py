@@ -35,7 +35,6 @@ GRAVITY_PHASE, SETTLEMENT_PHASE, SEARCH_PHASE = 0, 1, 2
 # the whole wall falling a thousand times its own size. Beyond it the integration has blown up.
 UNSTABLE_KINETIC_ENERGY = 1e3
 GRAVITY_TIME_LIMIT = 20.0  # scaled time units (sqrt(length / g)) for the gravity phase to come to rest
-OUT_SCALARS = 6  # the kernels' ``out``: six scalars, then one support force per block
 
 
 @dataclass(frozen=True)
@@ -75,37 +74,45 @@ class Controls:
     collapse_motion: float = 0.0  # block motion (centroid + rotation x radius) that makes a trial unstable
 
 
+@dataclass(frozen=True)
+class Record:
+    """One recorded chunk: the scalars (:attr:`History.COLUMNS`), every support's upward force on the wall
+    and the widest openings (None: not measured)."""
+
+    row: tuple
+    supports: np.ndarray
+    cracks: mf.Cracks | None
+
+
 @dataclass
 class History:
-    """One row per recorded chunk: the scalars, the support forces and the widest joint opening.
+    """The records of a run, each added whole (one append: a Ctrl-C never leaves a half record).
 
-    ``opening`` measures the widest masonry-joint opening [m] of block positions
-    (set by the solver; None: not measured).
+    ``weights`` are the settlement weights of the scene's supports (``mf.settlement_weights``, the rotation's
+    made non-dimensional like the moments): the ``reaction`` column is the settlement reaction
+    (``mf.settlement_reaction``) of the supports' wrenches. ``opening`` measures the widest openings of block positions (set by the solver).
     """
 
-    rows: list = field(default_factory=list)
-    supports: list = field(default_factory=list)  # (block,) upward force of each support on the wall
-    widest: list = field(default_factory=list)  # widest masonry-joint opening [m]
+    weights: np.ndarray
+    records: list = field(default_factory=list)
     snapshots: list = field(default_factory=list)  # (settlement, positions)
-    opening: Callable[[np.ndarray], float] | None = None
+    opening: Callable[[np.ndarray], mf.Cracks] | None = None
 
     COLUMNS = ("phase", "time", "settlement", "reaction", "kinetic", "stored", "work_gravity",
                "work_support", "dissipated_damping", "dissipated_friction", "released", "unbalanced", "load_factor")
 
     def add(self, phase: int, state: State, out: np.ndarray, load_factor: float = 0.0) -> None:
         acc = state.acc
-        self.rows.append((
-            phase, acc[kernels.TIME], acc[kernels.SETTLEMENT], out[2], out[3], out[4],
-            acc[kernels.WORK_GRAVITY], acc[kernels.WORK_SUPPORT],
-            acc[kernels.DISSIPATED_DAMPING], acc[kernels.DISSIPATED_FRICTION], acc[kernels.RELEASED], out[5],
-            load_factor,
-        ))
-        self.supports.append(out[OUT_SCALARS:].copy())
-        if self.opening is not None:
-            self.widest.append(self.opening(state.pos))
+        wrench = out[kernels.OUT_SCALARS:].reshape(-1, 3)  # the wall's action on each support
+        row = (phase, acc[kernels.TIME], acc[kernels.SETTLEMENT], float((wrench * self.weights).sum()),
+               out[kernels.KINETIC], out[kernels.STORED], acc[kernels.WORK_GRAVITY], acc[kernels.WORK_SUPPORT],
+               acc[kernels.DISSIPATED_DAMPING], acc[kernels.DISSIPATED_FRICTION], acc[kernels.RELEASED],
+               out[kernels.UNBALANCED], load_factor)
+        cracks = self.opening(state.pos) if self.opening is not None else None
+        self.records.append(Record(row, -wrench[:, 1], cracks))
 
     def table(self) -> dict[str, np.ndarray]:
-        data = np.asarray(self.rows, dtype=float).reshape(-1, len(self.COLUMNS))
+        data = np.asarray([r.row for r in self.records], dtype=float).reshape(-1, len(self.COLUMNS))
         return {name: data[:, i] for i, name in enumerate(self.COLUMNS)}
 
 
@@ -200,7 +207,7 @@ def advance(scene: Scene, controls: Controls, state: State, n_steps: int, rate: 
 
 def chunk(scene: Scene, controls: Controls, state: State, n_steps: int, rate: float, target: float) -> np.ndarray:
     """Run up to ``n_steps`` steps (rebuilding the pair list as needed); returns the kernel's ``out``."""
-    out = np.zeros(OUT_SCALARS + scene.driven.size)
+    out = np.zeros(kernels.OUT_SCALARS + 3 * scene.driven.size)
     left = n_steps
     while True:
         nodal = hasattr(state, "advance_chunk")  # deformable mode: the state steps its own nodes
@@ -208,21 +215,21 @@ def chunk(scene: Scene, controls: Controls, state: State, n_steps: int, rate: fl
             state.advance_chunk(scene, controls, left, rate, target, out)
         else:
             advance(scene, controls, state, left, rate, target, out)
-        if not out[3] < UNSTABLE_KINETIC_ENERGY:  # also catches nan
+        if not out[kernels.KINETIC] < UNSTABLE_KINETIC_ENERGY:  # also catches nan
             raise mf.SolveError(
-                f"fdem: the time integration blew up (kinetic energy {out[3]:.3g} W x length after "
+                f"fdem: the time integration blew up (kinetic energy {out[kernels.KINETIC]:.3g} W x length after "
                 f"{state.steps} steps, dt = {controls.dt:.3g} = {controls.dt / controls.dt_critical:.2f} dt_crit "
                 "in scaled units); lower the option dt_safety"
             )
-        done = int(out[0])
+        done = int(out[kernels.STEPS])
         state.steps += done
         left -= done
-        if out[1]:
+        if out[kernels.REBUILD]:
             if nodal:
                 state.rebuild_pairs(scene, controls)
             else:
                 rebuild(scene, controls, state)
-        if not out[1] or left <= 0 or (target > 0 and state.acc[kernels.SETTLEMENT] >= target):
+        if not out[kernels.REBUILD] or left <= 0 or (target > 0 and state.acc[kernels.SETTLEMENT] >= target):
             return out
 
 
@@ -240,11 +247,11 @@ def gravity_phase(scene, controls, state, history, progress) -> None:
         state.gravity_steps += state.steps - before
         history.add(GRAVITY_PHASE, state, out)
         ramped = state.acc[kernels.TIME] >= controls.load_ramp
-        if controls.gravity_time <= 0 and ramped and out[5] < controls.rest_tolerance:
+        if controls.gravity_time <= 0 and ramped and out[kernels.UNBALANCED] < controls.rest_tolerance:
             state.stop_reason = "at rest"
             break
         progress(0.05 * min(1.0, state.gravity_steps / max(total, 1)),
-                 f"fdem: gravity, unbalanced force ratio {out[5]:.2e}")
+                 f"fdem: gravity, unbalanced force ratio {out[kernels.UNBALANCED]:.2e}")
     else:
         if controls.gravity_time <= 0:
             raise mf.SolveError(
@@ -277,7 +284,7 @@ def plateau_reached(history: History, controls: Controls, reference: float) -> b
 
 def settlement_phase(scene, controls, state, history, progress) -> None:
     state.settlement_start = float(state.acc[kernels.TIME])
-    reference = history.rows[-1][3] if history.rows else 0.0
+    reference = history.records[-1].row[3] if history.records else 0.0
     pending = sorted(controls.snapshots)
     while state.acc[kernels.SETTLEMENT] < controls.target:
         if state.steps >= controls.max_steps:
@@ -291,7 +298,9 @@ def settlement_phase(scene, controls, state, history, progress) -> None:
             pending.pop(0)
             history.snapshots.append((settled, state.pos.copy()))  # the first record past the request
         progress(0.05 + 0.95 * min(1.0, settled / controls.target),
-                 f"fdem: settlement {settled / controls.target:.0%} of target, reaction {out[2]:.3g} W")
+                 f"fdem: settlement {settled / controls.target:.0%} of target, "
+                 f"reaction {history.records[-1].row[3] / reference:.3f} R0" if reference > 0 else
+                 f"fdem: settlement {settled / controls.target:.0%} of target")
         if plateau_reached(history, controls, reference):
             state.stop_reason = "reaction plateau"
             return
@@ -319,7 +328,7 @@ def hold(scene: Scene, controls: Controls, state: State, reference: np.ndarray, 
         if motion > controls.collapse_motion:
             return False, motion
         now = state.acc[kernels.TIME]
-        if now >= ramp_end and out[5] < controls.rest_tolerance:
+        if now >= ramp_end and out[kernels.UNBALANCED] < controls.rest_tolerance:
             return True, motion
         if now >= limit or state.steps >= controls.max_steps:
             return False, motion
@@ -376,14 +385,14 @@ def _bisect(scene, controls, state, history, progress):
 
 
 def run(scene: Scene, controls: Controls, state: State, load: np.ndarray, progress,
-        opening: Callable[[np.ndarray], float] | None = None) -> History:
+        opening: Callable[[np.ndarray], mf.Cracks] | None = None) -> History:
     """Gravity, then settlement, from ``state`` (rigid or deformable); returns the history
     (``opening``: :attr:`History.opening`).
 
     A KeyboardInterrupt keeps what was computed (``state.interrupted``, the state
     reached evaluated as a last record); one before the first record propagates.
     """
-    history = History(opening=opening)
+    history = History(mf.settlement_weights(scene.model) * [1.0, 1.0, scene.scales.length], opening=opening)
     state.set_loads(scene, load)
     try:
         gravity_phase(scene, controls, state, history, progress)
@@ -392,7 +401,7 @@ def run(scene: Scene, controls: Controls, state: State, load: np.ndarray, progre
         elif controls.target > 0 and scene.moving.any():
             settlement_phase(scene, controls, state, history, progress)
     except KeyboardInterrupt:
-        if not history.rows:
+        if not history.records:
             raise
         state.interrupted = True
         state.stop_reason = "interrupted"

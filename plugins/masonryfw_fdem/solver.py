@@ -121,13 +121,7 @@ def solve(model: xr.Dataset, options: Mapping[str, Any], progress=mf.no_progress
 
 def _solve(model: xr.Dataset, options: Mapping[str, Any], progress) -> xr.Dataset:
     scene = build_scene(model)
-    if scene.moving.any() and scene.moving.sum() == scene.driven.sum() and options["plateau_tolerance"] > 0:
-        raise mf.ModelError(
-            "fdem: every support of the wall settles, so together they carry its whole weight at any "
-            "settlement and the reaction plateau that stops the run is there from the start; set the option "
-            "plateau_tolerance=0 to run to the target settlement, or keep part of the base fixed "
-            "(a [settlement] profile: raise settlement.cutoff)"
-        )
+    mf.refuse_rigid_settlement(model, "fdem")
     controls = make_controls(scene, options)
     load = scene.dead + (options["load_factor"] or 0.0) * scene.live
     if options["mode"] == "deformable":
@@ -168,9 +162,10 @@ def _solve(model: xr.Dataset, options: Mapping[str, Any], progress) -> xr.Datase
 
 
 def opening_meter(scene: Scene):
-    """The widest masonry-joint opening [m] of block positions (``mf.widest_opening``, finite rotations)."""
-    def widest(pos: np.ndarray) -> float:
-        return mf.widest_opening(scene.model, postprocess.block_displacement(scene, pos), "finite")
+    """The widest crack in the masonry and the widest base gap of block positions (``mf.widest_crack``,
+    finite rotations)."""
+    def widest(pos: np.ndarray) -> mf.Cracks:
+        return mf.widest_crack(scene.model, postprocess.block_displacement(scene, pos), "finite")
     return widest
 
 
@@ -189,13 +184,17 @@ def history_variables(scene: Scene, history: History) -> dict:
     def var(values, units, long_name):
         return ("step", values, {"units": units, "long_name": long_name})
 
+    cracks = [r.cracks for r in history.records]
     settling = {
         "step_settlement": ("step", rows["settlement"] * length, mf.variable_attrs("step_settlement")),
         "step_reaction": ("step", rows["reaction"] * f, mf.variable_attrs("step_reaction")),
-        "step_support_reaction": (("step", "block"), np.array(history.supports).reshape(len(history.rows), -1) * f,
+        "step_support_reaction": (("step", "block"),
+                                  np.array([r.supports for r in history.records]).reshape(len(cracks), -1) * f,
                                   mf.variable_attrs("step_support_reaction")),
-        "step_crack_width_max": ("step", np.asarray(history.widest, dtype=float),
-                                 mf.variable_attrs("step_crack_width_max")),
+        "step_crack_width_max": ("step", np.array([c.width for c in cracks]), mf.variable_attrs("step_crack_width_max")),
+        "step_crack_interface": ("step", np.array([c.interface for c in cracks], dtype=np.int32),
+                                 mf.variable_attrs("step_crack_interface")),
+        "step_base_gap_max": ("step", np.array([c.base_gap for c in cracks]), mf.variable_attrs("step_base_gap_max")),
     } if scene.moving.any() else {
         "step_load_factor": var(rows["load_factor"], "1", "multiplier of the live load (tried) at the record"),
     }

@@ -112,9 +112,9 @@ class NewtonSolver:
         return State(u, strain, stress, tangent, active, residual)
 
     def reaction(self, state: State) -> float:
-        """Vertical force of the moving support on the wall (non-dimensional, upward positive)."""
-        p = self.problem
-        return float(state.residual[p.moving[p.moving_vertical]].sum())
+        """The settlement reaction (non-dimensional, ``mf.settlement_reaction``): minus the work of the moving
+        supports' nodal forces on the wall per unit settlement, over the reference rate."""
+        return self.problem.settlement_reaction(state.residual)
 
     def _norm(self, state: State) -> float:
         return float(np.linalg.norm(state.residual[self.free])) / self.reference

@@ -48,7 +48,8 @@ INCREMENTAL_OPTIONS = (
     mf.Option("load_tolerance", float, 1e-3,
               "without a moving support: the run ends when a halved load increment falls below this", above=0.0),
     mf.Option("plateau_slope", float, 0.01, "plateau: |dR/ds| (or, without a moving support, the load factor's "
-              "rate per unit displacement) below this fraction of the elastic (first step's) one ...", above=0.0),
+              "rate per unit displacement) below this fraction of the elastic (first step's) one ... "
+              "(0: no plateau stop, run to max_settlement)", at_least=0.0),
     mf.Option("plateau_steps", int, 3, "... over this many consecutive steps", above=0),
 )
 

@@ -38,7 +38,7 @@ class Problem:
     fixed: np.ndarray  # prescribed DOFs held at zero
     moving: np.ndarray  # prescribed DOFs that move with the support
     moving_direction: np.ndarray  # (moving,) displacement of each moving DOF per unit settlement
-    moving_vertical: np.ndarray  # bool (moving,): uy DOFs (their reactions sum to the vertical reaction)
+    moving_weight: np.ndarray  # (moving,) settlement weight: the reaction is -sum(residual[moving] * weight)
     support_uy: np.ndarray  # vertical DOFs of every support (fixed and moving)
     support_of: np.ndarray  # (support_uy,) the support block each belongs to
     length: float  # H [m]
@@ -61,6 +61,10 @@ class Problem:
     def compliance(self) -> np.ndarray:
         """``(points, 3, 3)`` inverses of ``D_points`` (the elastic strain of a stress), computed once."""
         return np.linalg.inv(self.D_points)
+
+    def settlement_reaction(self, nodal_force: np.ndarray) -> float:
+        """The settlement reaction of nodal forces on the wall (``mf.settlement_reaction``, non-dimensional)."""
+        return -float(nodal_force[self.moving] @ self.moving_weight)
 
     @property
     def free(self) -> np.ndarray:
@@ -316,6 +320,11 @@ def bed_rotations(angle: np.ndarray) -> tuple[np.ndarray | None, np.ndarray | No
     return stress_rotation(angle), stress_rotation(-angle)
 
 
+def reference_rate(model: xr.Dataset) -> float:
+    """``mf.settlement_reference_rate`` of the model (1 without a moving support)."""
+    return mf.settlement_reference_rate(model) or 1.0
+
+
 def build_problem(model: xr.Dataset, options) -> Problem:
     """Mesh the wall and set up materials, supports and gravity for the incremental method."""
     domain = wall_domain(model, options["mesh_size"], options["beta"], options["dilatancy"])
@@ -344,12 +353,8 @@ def build_problem(model: xr.Dataset, options) -> Problem:
     gravity = disc.body_force(body)
     fixed, moving, direction, support_uy, support_of = _support_dofs(mesh, disc, model, H, 1e-6 * size / H)
     searches_load = moving.size == 0
-    if not searches_load and fixed.size == 0:
-        raise mf.ModelError(
-            "jmm: every support of the wall settles, so together they carry its whole weight at any "
-            "settlement and the reaction that sizes the steps and stops the run never drops; keep part of "
-            "the base fixed (a [settlement] profile: raise settlement.cutoff)"
-        )
+    if not searches_load:
+        mf.refuse_rigid_settlement(model, "jmm")
     if searches_load and not np.any(mf.block_loads(model, "live")[masonry(model)]):
         raise mf.ModelError("jmm: no moving support to settle and no live load to raise: nothing to analyse")
     live = disc.body_force(live_body_force(model, blocks, domain.unit_weight))
@@ -358,7 +363,7 @@ def build_problem(model: xr.Dataset, options) -> Problem:
     return Problem(
         mesh=mesh, disc=disc, return_map=rmap, masonry_points=masonry_points, D_points=D_points,
         gravity=gravity, fixed=fixed, moving=moving, moving_direction=direction,
-        moving_vertical=moving % 2 == 1, support_uy=support_uy, support_of=support_of, length=H, mesh_size=size, stress=S, displacement=U, force=domain.force,
+        moving_weight=direction / reference_rate(model), support_uy=support_uy, support_of=support_of, length=H, mesh_size=size, stress=S, displacement=U, force=domain.force,
         beta=domain.beta, young=young, poisson=poisson, strength=domain.strength, live=live, to_bed=to_bed,
         from_bed=from_bed, face_bounds=face_bounds, searches_load=searches_load,
         n_block=model.sizes["block"],

@@ -34,6 +34,7 @@ class History:
     residuals: list = field(default_factory=list)
     supports: list = field(default_factory=list)  # (block,) upward force of each support on the wall
     crack_width: list = field(default_factory=list)  # crack band estimate (non-dimensional, as u)
+    crack_point: list = field(default_factory=list)  # the quadrature point where it is widest (-1: none)
     # (settlement, u) of the last steps, for the mechanism: as many as the plateau test looks at, plus one
     recent: deque = field(default_factory=lambda: deque(maxlen=2))
 
@@ -43,7 +44,9 @@ class History:
         self.reaction.append(newton.reaction(state))
         self.supports.append(np.bincount(p.support_of, weights=state.residual[p.support_uy],
                                          minlength=p.n_block))
-        self.crack_width.append(crack_band_width(p, state))
+        width, point = crack_band_width(p, state)
+        self.crack_width.append(width)
+        self.crack_point.append(point)
         self.load_factor.append(load_factor)
         self.displacement.append(float(np.hypot(state.u[0::2], state.u[1::2]).max(initial=0.0)))
         self.iterations.append(iterations)
@@ -56,8 +59,9 @@ class History:
         return len(self.iterations) - 1
 
 
-def crack_band_width(problem: Problem, state: State) -> float:
-    """Widest crack estimated from the plastic strain (non-dimensional, in the units of ``u``).
+def crack_band_width(problem: Problem, state: State) -> tuple[float, int]:
+    """Widest crack estimated from the plastic strain (non-dimensional, in the units of ``u``) and the
+    quadrature point where it is (-1 when nothing opens).
 
     The smeared crack band (Bazant & Oh 1983): a crack that localises in one row of
     cells of size h opens by the plastic strain across it times h. At every masonry
@@ -70,8 +74,11 @@ def crack_band_width(problem: Problem, state: State) -> float:
     plastic = plastic[p.masonry_points]
     if p.from_bed is not None:  # engineering strains turn with the inverse transpose of the stress rotation
         plastic = np.einsum("pji,pj->pi", p.from_bed, plastic)
-    opening = np.maximum(plastic[:, :2], 0.0).max(initial=0.0)
-    return float(opening * p.mesh_size / p.length)
+    opening = np.maximum(plastic[:, :2], 0.0).max(axis=1, initial=0.0)
+    widest = int(np.argmax(opening)) if opening.size else 0
+    if not opening.size or not opening[widest] > 0:
+        return 0.0, -1
+    return float(opening[widest] * p.mesh_size / p.length), int(np.flatnonzero(p.masonry_points)[widest])
 
 
 GRAVITY_ITERATIONS = 4  # times max_iterations: with c = sigma_t = 0 the domain is a cone, so smaller
@@ -101,7 +108,7 @@ def elastic_unloading_settlement(newton: NewtonSolver, state: State) -> tuple[fl
     p = newton.problem
     K = p.disc.stiffness(newton._regularised(state, False))  # the tangent the predictor solved with
     du = trial.u - state.u
-    slope = float((K @ du)[p.moving[p.moving_vertical]].sum())
+    slope = p.settlement_reaction(K @ du)
     reaction = newton.reaction(state)
     if not slope < 0 or not reaction > 0:
         raise mf.SolveError(
@@ -267,7 +274,21 @@ def mechanism(problem: Problem, model: xr.Dataset, history: History) -> np.ndarr
                            ux * p.displacement, uy * p.displacement, disc.weights.ravel(), (s1 - s0) * p.displacement)
 
 
-def result_dataset(problem: Problem, state: State, history: History, info: dict) -> xr.Dataset:
+def crack_interfaces(problem: Problem, model: xr.Dataset, history: History) -> np.ndarray:
+    """Per record, the joint within the masonry nearest to the point of the widest crack band (-1: none)."""
+    point = np.asarray(history.crack_point, dtype=np.int64)
+    out = np.full(point.size, -1, dtype=np.int32)
+    cracked = point >= 0
+    if cracked.any():
+        role = model.block_role.values
+        inside = mf.masonry_blocks(role)[model.interface_blocks.values.astype(np.int64)].all(axis=1)
+        qx, qy = problem.disc.qp_xy * problem.length
+        out[cracked] = mf.nearest_interface(model, qx[point[cracked]], qy[point[cracked]],
+                                            0.25 * problem.mesh_size, among=inside)
+    return out
+
+
+def result_dataset(problem: Problem, model: xr.Dataset, state: State, history: History, info: dict) -> xr.Dataset:
     """docs/format.md result variables (physical units) from the final converged state and the history."""
     p, disc = problem, problem.disc
     H, U = p.length, p.displacement
@@ -283,14 +304,15 @@ def result_dataset(problem: Problem, state: State, history: History, info: dict)
         **point_variables((qx, qy), failure, stress, "quadrature point", "in the last step"),
         **(load_factor_variables(history, U) if p.searches_load else {
             "step_settlement": variable("step", np.asarray(history.settlement) * U, "m", "imposed settlement"),
-            "step_reaction": variable("step", np.asarray(history.reaction) * p.force, "N",
-                                      "vertical reaction on the moving supports (their sum)"),
+            "step_reaction": ("step", np.asarray(history.reaction) * p.force, mf.variable_attrs("step_reaction")),
             "step_support_reaction": variable(("step", "block"), np.array(history.supports) * p.force, "N",
                                               mf.variable_attrs("step_support_reaction")["long_name"]),
             "step_crack_width_max": variable(
                 "step", np.asarray(history.crack_width) * U, "m",
                 "widest crack estimated as the plastic opening strain across the joints times the mesh size "
                 "(a smeared crack band, Bazant & Oh 1983)"),
+            "step_crack_interface": ("step", crack_interfaces(p, model, history),
+                                     mf.variable_attrs("step_crack_interface")),
         }),
         "step_newton_iterations": variable("step", np.asarray(history.iterations, dtype=np.int32), "1",
                                        "Newton iterations of the step (step 0: the whole gravity stage)"),
@@ -319,4 +341,4 @@ def solve(model: xr.Dataset, options, progress) -> xr.Dataset:
         raise KeyboardInterrupt  # interrupted before the gravity stage converged: nothing to keep
     progress(1.0, info["stop_reason"])
     flow = "associative" if options["dilatancy"] is None else "nonassociative"  # the continuum's flow rule
-    return with_mechanism(result_dataset(problem, state, history, info), mechanism(problem, model, history), flow)
+    return with_mechanism(result_dataset(problem, model, state, history, info), mechanism(problem, model, history), flow)

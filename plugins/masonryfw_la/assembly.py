@@ -46,6 +46,7 @@ class Wall:
     role: np.ndarray  # (block,)
     fixed: np.ndarray  # (block, dof) bool
     direction: np.ndarray  # (block, dof) settlement direction
+    settlement_weights: np.ndarray  # (block, dof) mf.settlement_weights: the settlement reaction's
     dead: np.ndarray  # (block, dof)
     live: np.ndarray
     thickness: np.ndarray
@@ -71,6 +72,7 @@ class Wall:
             role=v["block_role"],
             fixed=v["block_fixed"] != 0,
             direction=v["settlement_direction"].astype(float),
+            settlement_weights=mf.settlement_weights(model),
             dead=mf.block_loads(model, "dead"),
             live=mf.block_loads(model, "live"),
             thickness=v["block_thickness"].astype(float),

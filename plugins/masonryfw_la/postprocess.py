@@ -10,8 +10,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-import masonryfw as mf
-
 from .assembly import KinematicLP, Scales, Wall
 
 
@@ -59,13 +57,24 @@ def contact_forces(lp: KinematicLP, y: np.ndarray, n_interface: int, scales: Sca
     )
 
 
-def moving_support_reaction(wall: Wall, forces: ContactForces) -> float:
-    """Upward vertical force the ground must give the moving supports at collapse [N], each weighted
-    by its rate relative to the fastest (``mf.reaction_weights``; the plain sum at one rate).
+def support_wrench(wall: Wall, forces: ContactForces) -> np.ndarray:
+    """``(block, 3)``: the force (x, y) and moment about the centroid the contacts exert on every block
+    (on side 1 of an interface the force is ``N n + T t`` at each end, on side 0 its opposite)."""
+    fx = forces.normal * wall.normal[:, 0, None] + forces.shear * wall.tangent[:, 0, None]  # (interface, end)
+    fy = forces.normal * wall.normal[:, 1, None] + forces.shear * wall.tangent[:, 1, None]
+    n = wall.role.size
+    wrench = np.zeros((n, 3))
+    for side, sign in ((1, 1.0), (0, -1.0)):
+        block = wall.sides[:, side]
+        arm_x = wall.end_x - wall.centroid[block, 0, None]
+        arm_y = wall.end_y - wall.centroid[block, 1, None]
+        for d, values in enumerate((fx, fy, arm_x * fy - arm_y * fx)):
+            wrench[:, d] += sign * np.bincount(block, weights=values.sum(axis=1), minlength=n)
+    return wrench
 
-    Minus the vertical component of the contact forces the wall exerts on them
-    (on side 1 the force is ``N n + T t``, on side 0 its opposite).
-    """
-    moving = mf.reaction_weights(wall.role, wall.direction)[wall.sides]  # (interface, side)
-    on_side1_y = forces.normal.sum(axis=1) * wall.normal[:, 1] + forces.shear.sum(axis=1) * wall.tangent[:, 1]
-    return float(-(on_side1_y * (moving[:, 1] - moving[:, 0])).sum())
+
+def moving_support_reaction(wall: Wall, forces: ContactForces) -> float:
+    """The settlement reaction at collapse [N] (``mf.settlement_reaction``: the work-conjugate of the
+    settlement parameter, each support weighted by its motion; the upward reaction for one support
+    translating down): ``(1 - alpha) R0`` by equilibrium of the settlement column."""
+    return float((support_wrench(wall, forces) * wall.settlement_weights).sum())

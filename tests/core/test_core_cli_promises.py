@@ -367,7 +367,7 @@ def test_a_broken_drawing_is_named_and_an_overlapping_one_can_still_be_drawn(tmp
     doc.saveas(tmp_path / "wall.dxf")
     done = run(["build", "wall.toml", "-o", "wall.nc"], tmp_path)
     assert done.returncode == 1 and "Traceback" not in done.stderr
-    assert re.search(r"LWPOLYLINE #\w+ on layer 0: open \(it starts at \(0, 0\) and ends at \(200, 100\)", done.stderr)
+    assert re.search(r"LWPOLYLINE #\w+ on layer 0: open: it starts at \(0, 0\) m and ends at \(0.2, 0.1\) m", done.stderr)
     assert not (tmp_path / "wall.nc").exists()
     doc = ezdxf.new()
     doc.header["$INSUNITS"] = 4

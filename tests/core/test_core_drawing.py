@@ -129,8 +129,8 @@ def test_an_open_polyline_is_refused_with_its_ends(tmp_path):
     doc.modelspace().add_lwpolyline([(0, 0), (100, 0), (100, 50), (0, 50)], close=False,
                                     dxfattribs={"layer": "WALL"})
     doc.saveas(tmp_path / "open.dxf")
-    with pytest.raises(mf.SpecError, match=r"LWPOLYLINE #\w+ on layer WALL: open \(it starts at \(0, 0\) and ends "
-                                           r"at \(0, 50\)"):
+    with pytest.raises(mf.SpecError, match=r"LWPOLYLINE #\w+ on layer WALL: open: it starts at \(0, 0\) m and ends "
+                                           r"at \(0, 0.05\) m, 0.05 m apart, more than the snap tolerance"):
         read_drawing(tmp_path / "open.dxf")
 
 

@@ -25,23 +25,39 @@ def moving_supports(model):
     return moving, x0
 
 
+def top_corners(model, blocks):
+    """Per support block: the x of its top corners (left, right) and their motion (ux, uy) per unit t, from
+    ``settlement_direction`` as a small rigid motion about the centroid."""
+    nodes = np.c_[model.node_x.values, model.node_y.values].reshape(-1, 4, 2)[blocks]  # rectangles
+    x = np.c_[nodes[:, :, 0].min(axis=1), nodes[:, :, 0].max(axis=1)]
+    top = nodes[:, :, 1].max(axis=1)
+    d = model.settlement_direction.values[blocks]
+    cx, cy = model.block_centroid_x.values[blocks], model.block_centroid_y.values[blocks]
+    ux = d[:, 0, None] - d[:, 2, None] * (top - cy)[:, None]
+    uy = d[:, 1, None] + d[:, 2, None] * (x - cx[:, None])
+    return x, ux * np.ones_like(x), uy
+
+
 def test_gaussian_trough_segments_follow_peck_and_oreilly_new():
-    """The issue's example: every moving segment's direction is (h, -S(x_mid), 0) with
-    S = exp(-(x_mid - x0)^2 / (2 i^2)) and h = (x_mid - x0) / z0 times the vertical one; the segments
-    whose rate is below the cutoff are fixed and merge into one block on each side."""
+    """The ground is continuous: the top corners of every segment move down by S(x) = exp(-(x - x0)^2 /
+    (2 i^2)) at the segment ends (0 where S <= the cutoff), so neighbouring segments meet; their top edge
+    moves sideways by the mean of h = -(x - x0) / z0 S at its ends; segments whose ends both stay still are
+    fixed and merge into one block on each side."""
     model = mf.build({**BASE, "settlement": TROUGH})
     role = model.block_role.values
     supports = np.flatnonzero(np.isin(role, [ROLE["fixed_support"], ROLE["moving_support"]]))
-    cx = model.block_centroid_x.values[supports]
-    direction = model.settlement_direction.values[supports]
+    supports = supports[np.argsort(model.block_centroid_x.values[supports])]
+    x, ux, uy = top_corners(model, supports)
+    rate = np.exp(-0.5 * ((x - 1.0) / 0.3) ** 2)
+    rate = np.where(rate <= 0.05, 0.0, rate)
+    np.testing.assert_allclose(uy, -rate, atol=1e-12)
+    np.testing.assert_allclose(uy[1:, 0], uy[:-1, 1], atol=1e-12)  # continuous at every common end
+    h = -(x - 1.0) / 10.0 * rate
+    np.testing.assert_allclose(ux, h.mean(axis=1, keepdims=True) * np.ones_like(h), atol=1e-12)
     moving = role[supports] == ROLE["moving_support"]
-    rate = np.exp(-0.5 * ((cx - 1.0) / 0.3) ** 2)
-    assert np.all(rate[moving] > 0.05) and np.all(rate[~moving] <= 0.05 + 1e-12)
-    np.testing.assert_allclose(direction[moving, 1], -rate[moving], rtol=1e-12)
-    np.testing.assert_allclose(direction[moving, 0], (cx[moving] - 1.0) / 10.0 * -rate[moving], rtol=1e-12)
-    assert moving.sum() == 14  # x_mid 0.35 .. 1.65: |x_mid - 1| <= 0.3 sqrt(2 ln 20) = 0.735
-    assert (~moving).sum() == 2  # [0, 0.3] and [1.7, 4] each merged
-    np.testing.assert_array_equal(model.block_fixed.values[supports[moving]], [[0, 0, 1]] * 14)
+    assert moving.sum() == 16  # ends 0.3 .. 1.7: S > 0.05 for |x - 1| < 0.3 sqrt(2 ln 20) = 0.735
+    assert (~moving).sum() == 2  # [0, 0.2] and [1.8, 4] each merged
+    np.testing.assert_array_equal(model.block_fixed.values[supports[moving]], [[0, 0, 0]] * 16)
     # the paper's loading per support: the uniform share of the weight, up (dead) and down (live)
     weight = -mf.block_loads(model, "dead")[mf.masonry_blocks(role), 1].sum()
     np.testing.assert_allclose(mf.block_loads(model, "dead")[supports[moving], 1], weight * 0.1 / 4.0)
@@ -58,12 +74,17 @@ def test_profile_lengths_in_millimetres_give_the_metre_model():
 
 
 def test_linear_and_table_profiles():
+    """A tilt's segments all turn by the same angle and meet: together one rigid rotation of the base about
+    the profile's start; a table is interpolated at the segment ends."""
     tilt = mf.build({**BASE, "settlement": {"profile": "linear", "segment": 1.0}})
-    moving = tilt.block_role.values == ROLE["moving_support"]
-    np.testing.assert_allclose(-tilt.settlement_direction.values[moving, 1], [0.125, 0.375, 0.625, 0.875])
+    moving = np.flatnonzero(tilt.block_role.values == ROLE["moving_support"])
+    np.testing.assert_allclose(tilt.settlement_direction.values[moving, 2], -0.25)
+    _, _, uy = top_corners(tilt, moving)
+    np.testing.assert_allclose(-uy, [[0.0, 0.25], [0.25, 0.5], [0.5, 0.75], [0.75, 1.0]], atol=1e-12)
     table = mf.build({**BASE, "settlement": {"profile": "table", "segment": 1.0, "points": [[1.0, 0.0], [3.0, 1.0]]}})
-    moving = table.block_role.values == ROLE["moving_support"]
-    np.testing.assert_allclose(-table.settlement_direction.values[moving, 1], [0.25, 0.75, 1.0])
+    moving = np.flatnonzero(table.block_role.values == ROLE["moving_support"])
+    _, _, uy = top_corners(table, moving)
+    np.testing.assert_allclose(-uy, [[0.0, 0.5], [0.5, 1.0], [1.0, 1.0]], atol=1e-12)
 
 
 def test_rate_of_a_support_range_scales_its_direction():
@@ -144,8 +165,9 @@ def test_support_profile_of_a_trough_model():
     model = mf.build({**BASE, "settlement": TROUGH})
     x, v = mf.support_profile(model)
     assert np.all(np.diff(x) > 0)
-    moving = v < 0
-    np.testing.assert_allclose(v[moving], -np.exp(-0.5 * ((x[moving] - 1.0) / 0.3) ** 2), rtol=1e-12)
+    moving = v < 0  # 0.1 m segments: the ground at a midpoint is the mean of its ends' (0 at or below the cutoff)
+    ends = np.exp(-0.5 * ((x[moving, None] + [-0.05, 0.05] - 1.0) / 0.3) ** 2)
+    np.testing.assert_allclose(v[moving], -np.where(ends <= 0.05, 0.0, ends).mean(axis=1), rtol=1e-12)
 
 
 def test_cli_builds_solves_and_draws_a_trough_wall(tmp_path):

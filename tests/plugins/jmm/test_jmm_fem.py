@@ -88,7 +88,7 @@ def shear_block_problem(beta=1.5, pressure=1.0, width=1.0, height=0.5, n=(8, 4),
         mesh=None, disc=disc, return_map=ReturnMap(strength, D, vertex_stiffness),
         masonry_points=np.ones(disc.n_points, bool), D_points=np.broadcast_to(D, (disc.n_points, 3, 3)).copy(),
         gravity=load, fixed=np.concatenate([2 * base, 2 * base + 1]), moving=2 * driven,
-        moving_direction=y[driven] / height, moving_vertical=np.zeros(driven.size, bool),
+        moving_direction=y[driven] / height, moving_weight=np.zeros(driven.size),
         support_uy=2 * base + 1, support_of=np.zeros(base.size, int), length=1.0, mesh_size=edge, stress=1.0, displacement=1.0, force=1.0, beta=beta, young=E, poisson=NU,
         strength=strength,
     )

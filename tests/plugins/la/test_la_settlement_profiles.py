@@ -29,21 +29,24 @@ def trough(center: float, width: float = 0.6, segment: float = 0.2, **more) -> d
                             "cutoff": 0.05, **more})
 
 
-def test_la_profile_at_rate_one_is_the_single_moving_support(walls):
-    """A measured profile, 0 left of x = 2 m and 1 right of it, cut into ten 0.2 m segments, is the
-    single support from 2 m to 4 m: alpha to 1e-9."""
+def test_la_tilt_of_the_ground_is_the_single_support_rotating_about_the_pivot(walls):
+    """The continuous ground of a tilt starting at x = 2 m, cut into ten 0.2 m segments, is one rigid rotation
+    of the base about (2, 0): the same problem as a single support from 2 m to 4 m rotating about that pivot
+    (the paper's loads do the same work per unit rotation: W L_s / L on each segment, linear rates), so the
+    same alpha to 1e-9, and in both the settlement reaction at collapse is (1 - alpha) R0."""
     single = mf.build(wall(supports={"fixed": {"kind": "fixed", "start": 0.0, "end": 2.0},
-                                     "settling": {"kind": "moving", "start": 2.0, "end": 4.0}}))
-    profiled = mf.build(wall(settlement={"profile": "table", "points": [[0.0, 0.0], [1.999, 0.0], [2.001, 1.0],
-                                                                        [4.0, 1.0]], "segment": 0.2}))
+                                     "settling": {"kind": "moving", "start": 2.0, "end": 4.0,
+                                                  "motion": "rotation", "pivot": [2.0, 0.0]}}))
+    profiled = mf.build(wall(settlement={"profile": "linear", "start": 2.0, "segment": 0.2}))
     moving = profiled.block_role.values == walls.ROLE["moving_support"]
     assert moving.sum() == 10
-    np.testing.assert_allclose(profiled.settlement_direction.values[moving], [[0.0, -1.0, 0.0]] * 10)
-    a = float(walls.solve(single, solver="highs").collapse_multiplier)
-    b = float(walls.solve(profiled, solver="highs").collapse_multiplier)
+    np.testing.assert_allclose(profiled.settlement_direction.values[moving, 2], -0.5)  # one angle per unit t
+    results = [walls.solve(m, solver="highs") for m in (single, profiled)]
+    a, b = (float(r.collapse_multiplier) for r in results)
     assert 0 < a < 1
     assert b == pytest.approx(a, abs=1e-9)
-    assert mf.dead_reaction(profiled) == pytest.approx(mf.dead_reaction(single), rel=1e-12)
+    for model, result, alpha in zip((single, profiled), results, (a, b)):
+        assert float(result.moving_support_reaction) == pytest.approx((1 - alpha) * mf.dead_reaction(model), rel=1e-6)
 
 
 def mirrored_blocks(model) -> np.ndarray:
@@ -111,18 +114,22 @@ def test_la_trough_under_a_bundled_facade():
     assert 0 < float(result.collapse_multiplier) < 1
 
 
-def test_la_collapse_reaction_of_a_trough_is_one_minus_alpha_of_the_dead_reactions(walls):
-    """The dual forces on the settling segments, each weighted by its rate over the fastest one's (the
-    reactions' work on the one settlement parameter, which the LP fixes): (1 - alpha) R0, R0 their dead
-    loads weighted alike. (The plain sum is not unique when the rates differ.)"""
-    model = mf.build(trough(2.0))
+@pytest.mark.parametrize("spec", [pytest.param(trough(2.0), id="sagging"),
+                                  pytest.param(trough(4.0, depth=5.0), id="hogging-with-horizontal-motion")])
+def test_la_collapse_reaction_of_a_trough_is_one_minus_alpha_of_the_dead_reactions(walls, spec):
+    """The settlement reaction of the dual contact forces on the settling segments (their forces and moments
+    on the segments, each weighted by its motion: the work on the one settlement parameter, which the LP
+    fixes, horizontal ground motion and rotations included) is (1 - alpha) R0, R0 the dead loads' alike."""
+    model = mf.build(spec)
     result = walls.solve(model, solver="highs")
     alpha = float(result.collapse_multiplier)
+    assert 0 < alpha < 1
     assert float(result.moving_support_reaction) == pytest.approx((1 - alpha) * mf.dead_reaction(model), rel=1e-6)
 
 
 def test_jmm_limit_refuses_supports_at_different_rates():
-    """Its LP minimises one vertical reaction: a profile needs the incremental jmm (a clear refusal)."""
+    """Its LP minimises one vertical reaction: a profile (segments that turn and settle at their own rates) needs
+    the incremental jmm (a clear refusal)."""
     model = mf.build(trough(2.0))
-    with pytest.raises(mf.ModelError, match="settle at different rates"):
+    with pytest.raises(mf.ModelError, match="needs a downward vertical translation.*use the solver jmm"):
         mf.solve(model, "jmm-limit")

@@ -1,0 +1,140 @@
+"""Inputs that are valid but plainly wrong: warnings that name the key, the value and what was probably meant.
+
+A model can be consistent (``check`` finds no problem) and still describe no real
+wall: a unit weight typed in kN/m3, metre values under ``length_unit = "mm"``, a
+friction angle in radians. :func:`plausibility` compares a model with the ranges
+of real masonry and says, for each value outside them, which spec key it came
+from, what it is and the nearest plausible reading:
+
+- unit weight 5-40 kN/m3 (brick, stone, concrete block; a density in kg/m3 or a
+  value in kN/m3 is recognised);
+- units (the median masonry block) 10 mm to 2 m in each direction, the masonry
+  at least 0.1 m wide and high (metres under ``length_unit = "mm"`` are
+  recognised);
+- friction angles 10-60 degrees (a coefficient or radians typed as degrees is
+  recognised);
+- Young's modulus 0.1-100 GPa (MPa or GPa typed as Pa is recognised).
+
+They are warnings, not errors: a laboratory model or a deliberately extreme
+study may step outside. ``masonryfw build`` and ``solve`` print them,
+``masonryfw check`` lists them after the problems and ``check --strict`` counts
+them as problems. The ranges are wide on purpose: a warning that cries wolf is
+soon ignored.
+"""
+from __future__ import annotations
+
+import math
+import warnings
+
+import numpy as np
+import xarray as xr
+
+from .geometry import block_bounds
+from .schema import flags
+
+UNIT_WEIGHT = (5.0e3, 40.0e3)  # N m-3
+UNIT_SIZE = (0.01, 2.0)  # m, each side of the median masonry block
+WALL_SIZE = 0.1  # m, the masonry's smallest extent
+FRICTION_ANGLE = (10.0, 60.0)  # degrees
+YOUNG_MODULUS = (0.1e9, 100.0e9)  # Pa
+GRAVITY = 9.81  # m s-2
+
+
+class PlausibilityWarning(UserWarning):
+    """A value outside the range of real masonry (see :mod:`masonryfw.plausibility`)."""
+
+
+def _within(value: float, bounds: tuple[float, float]) -> bool:
+    return bounds[0] <= value <= bounds[1]
+
+
+def _reading(value: float, bounds: tuple[float, float], readings) -> str:
+    """The first ``(factor, text)`` of ``readings`` that brings ``value`` into ``bounds``, as advice."""
+    for factor, text in readings:
+        if _within(value * factor, bounds):
+            return f"; probably {text}: {value * factor:.6g}"
+    return ""
+
+
+def _spec_info(model: xr.Dataset) -> tuple[bool, str]:
+    """``(drawn, length unit)`` of the spec the model was built from (parametric, m when unknown)."""
+    text = str(model.attrs.get("source_spec", ""))
+    drawn = "source_drawing" in model.attrs
+    unit = "m"
+    for line in text.splitlines():
+        key, _, value = line.partition("=")
+        if key.strip() == "length_unit":
+            unit = value.split("#")[0].strip().strip("\"'")
+    return drawn, unit
+
+
+def plausibility(model: xr.Dataset) -> list[str]:
+    """One message per implausible value of ``model`` (a model or result dataset; module docstring)."""
+    role = np.asarray(model.block_role.values)
+    codes = flags("block_role")
+    masonry = np.isin(role, [codes["unit"], codes["lintel"]])
+    if not masonry.any():
+        return []
+    drawn, length_unit = _spec_info(model)
+    messages = []
+    weight = float(np.median(model.block_unit_weight.values[masonry]))
+    if not _within(weight, UNIT_WEIGHT):
+        advice = _reading(weight, UNIT_WEIGHT, [(1e3, "kN/m3 were meant, in N/m3"),
+                                                (GRAVITY, "a density in kg/m3 was given; its weight in N/m3 is")])
+        messages.append(f"material.unit_weight (block_unit_weight) = {weight:.6g} N/m3: masonry weighs "
+                        f"{UNIT_WEIGHT[0] / 1e3:g}-{UNIT_WEIGHT[1] / 1e3:g} kN/m3{advice}")
+    xmin, xmax, ymin, ymax = block_bounds(model.node_x.values, model.node_y.values, model.block_node_count.values)
+    unit_sizes = {"length": float(np.median((xmax - xmin)[masonry])),
+                  "height": float(np.median((ymax - ymin)[masonry]))}
+    metres = "; probably metres were meant: remove length_unit = \"mm\" (it scales every length by 0.001)" \
+        if length_unit == "mm" else ""
+    for side, size in unit_sizes.items():
+        if not _within(size, UNIT_SIZE):
+            where = f"the drawing's median block {side}" if drawn else f"unit.{side}"
+            advice = metres if size < UNIT_SIZE[0] and metres else ""
+            messages.append(f"{where} = {size:.6g} m: masonry units are {UNIT_SIZE[0] * 1e3:g} mm to "
+                            f"{UNIT_SIZE[1]:g} m{advice}")
+    extent = {"width": float(xmax[masonry].max() - xmin[masonry].min()),
+              "height": float(ymax[masonry].max() - ymin[masonry].min())}
+    for side, size in extent.items():
+        if size < WALL_SIZE:
+            where = "the drawing" if drawn else f"wall.{side}"
+            messages.append(f"{where}: the masonry is {size:.6g} m {'wide' if side == 'width' else 'high'}, less "
+                            f"than {WALL_SIZE:g} m{metres}")
+    messages += _friction(model)
+    if "block_young_modulus" in model:
+        young = float(np.median(model.block_young_modulus.values[masonry]))
+        if young > 0 and not _within(young, YOUNG_MODULUS):
+            advice = _reading(young, YOUNG_MODULUS, [(1e6, "MPa were meant, in Pa"), (1e9, "GPa were meant, in Pa"),
+                                                     (1e3, "kPa were meant, in Pa")])
+            messages.append(f"material.young_modulus (block_young_modulus) = {young:.6g} Pa: masonry has "
+                            f"{YOUNG_MODULUS[0] / 1e9:g}-{YOUNG_MODULUS[1] / 1e9:g} GPa{advice}")
+    return messages
+
+
+def _friction(model: xr.Dataset) -> list[str]:
+    """The joints' median friction angle, with the readings that would make it plausible: a coefficient or
+    radians typed as the angle in degrees, or degrees typed as the coefficient."""
+    if model.sizes.get("interface", 0) == 0:
+        return []
+    mu = float(np.median(model.interface_friction.values))
+    angle = math.degrees(math.atan(mu))
+    if _within(angle, FRICTION_ANGLE):
+        return []
+    readings = []
+    if _within(math.degrees(math.atan(angle)), FRICTION_ANGLE):
+        readings.append(f"the coefficient mu = {angle:.3g} ({math.degrees(math.atan(angle)):.3g} deg) given as "
+                        "friction_angle (write friction = ...)")
+    if _within(math.degrees(angle), FRICTION_ANGLE):
+        readings.append(f"radians: {angle:.3g} rad is {math.degrees(angle):.3g} deg")
+    if _within(mu, FRICTION_ANGLE):
+        readings.append(f"degrees given as the coefficient: write friction_angle = {mu:.6g}")
+    advice = f"; probably {' or '.join(readings)}" if readings else ""
+    return [f"material.friction_angle (or friction) = {angle:.6g} deg (interface_friction mu = {mu:.6g}): masonry "
+            f"joints have {FRICTION_ANGLE[0]:g}-{FRICTION_ANGLE[1]:g} deg{advice}"]
+
+
+def warn_implausible(model: xr.Dataset) -> None:
+    """Issue a :class:`PlausibilityWarning` for each message of :func:`plausibility`."""
+    for message in plausibility(model):
+        warnings.warn(message, PlausibilityWarning, stacklevel=2)
