@@ -95,7 +95,6 @@ from .semantics import (
     relative_motion,
     rigid_fit,
     settlement_reaction,
-    settlement_reference_rate,
     settlement_weights,
     states_at,
     support_blocks,

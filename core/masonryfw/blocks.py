@@ -17,8 +17,8 @@ and loads are made; the parametric builder, the import of drawings and
   loading: the weight acts horizontally as live load on every unit and lintel,
   and every support is held;
 - a moving support translates vertically (``block_fixed`` 1 0 1, direction
-  0 -1 0), rotates about a pivot (free, direction of the small rotation that
-  moves its centroid down, as a unit vector), either scaled by its ``rate``, or
+  0 -1 0), rotates about a pivot (free, the small rotation that moves its
+  centroid down by 1), either scaled by its ``rate``, or
   is a segment of a continuous ground (free: its top edge follows the ground's
   motion given at the edge's two ends, :func:`ground_direction`): all moving
   supports move as ``u_s = t * settlement_direction_s`` with one settlement
@@ -26,7 +26,6 @@ and loads are made; the parametric builder, the import of drawings and
 """
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -84,11 +83,11 @@ class Support:
 
 
 def rotation_direction(centre, pivot) -> np.ndarray:
-    """Unit dof-space direction of a small rotation about ``pivot`` that moves ``centre`` down."""
+    """Dof-space motion of the small rotation about ``pivot`` that moves ``centre`` down by 1: the
+    settlement parameter is the settlement of the support's centroid."""
     dx, dy = centre[0] - pivot[0], centre[1] - pivot[1]
-    omega = -math.copysign(1.0, dx)
-    direction = np.array([-omega * dy, omega * dx, omega])
-    return direction / np.linalg.norm(direction)
+    omega = -1.0 / dx
+    return np.array([-omega * dy, omega * dx, omega])
 
 
 def ground_direction(edge: GroundEdge, centre) -> np.ndarray:

@@ -63,7 +63,10 @@ class _MasonryGroup(click.Group):
 
     def invoke(self, ctx):
         try:
-            return super().invoke(ctx)
+            with warnings.catch_warnings():
+                warnings.showwarning = _show_warning
+                warnings.simplefilter("default")
+                return super().invoke(ctx)
         except Interrupted as exc:
             click.echo(str(exc), err=True)
             ctx.exit(INTERRUPTED)
@@ -176,14 +179,26 @@ def _support_lines(model) -> list[str]:
     lines = []
     for block in np.flatnonzero(np.isin(model.block_role.values, [roles["fixed_support"], roles["moving_support"]])):
         held = model.block_fixed.values[block]
-        direction = model.settlement_direction.values[block]
         if model.block_role.values[block] == roles["fixed_support"]:
             motion = f"fixed (held {' '.join(map(str, held))})"
         else:
-            how = "vertical translation" if held.tolist() == [1, 0, 1] else "rotation about a pivot"
-            motion = f"moving: {how}, settlement direction ({', '.join(f'{d:.4g}' for d in direction)})"
+            motion = "moving: " + _support_motion(model.settlement_direction.values[block], xmin[block], xmax[block],
+                                                  float(model.block_centroid_x.values[block]))
         lines.append(f"  block {block}: x {xmin[block]:.6g}..{xmax[block]:.6g} m, {motion}")
     return lines
+
+
+def _support_motion(direction, x0: float, x1: float, centre_x: float) -> str:
+    """What a moving support does per unit settlement parameter t, in words: its settlement (at its two ends
+    when it turns), sideways motion and rotation, then the settlement direction itself."""
+    ux, uy, rz = (float(d) for d in direction)
+    raw = f"settlement direction ({', '.join(f'{d:.4g}' for d in direction)})"
+    if rz == 0:
+        sideways = f", sideways {ux:.4g}" if ux else ""
+        return f"translates: settles {-uy:.4g}{sideways} per unit t; {raw}"
+    left, right = -(uy + rz * (x0 - centre_x)) + 0.0, -(uy + rz * (x1 - centre_x)) + 0.0  # no "-0"
+    return (f"translates and turns: settles {left:.4g} at its left end and {right:.4g} at its right, turns "
+            f"{rz:.4g} rad per unit t; {raw}")
 
 
 def _load_lines(model) -> list[str]:
@@ -428,14 +443,12 @@ def main(argv: list[str] | None = None) -> None:
     """
     if hasattr(signal, "SIGPIPE"):
         signal.signal(signal.SIGPIPE, signal.SIG_DFL)
-    with warnings.catch_warnings():
-        warnings.showwarning = _show_warning
-        try:
-            code = cli.main(args=argv, prog_name="masonryfw", standalone_mode=False)
-        except click.ClickException as exc:  # usage errors: exit 2
-            exc.show()
-            sys.exit(exc.exit_code)
-        except click.exceptions.Abort:  # click's form of a KeyboardInterrupt outside a solve
-            click.echo("interrupted: nothing written", err=True)
-            sys.exit(INTERRUPTED)
+    try:
+        code = cli.main(args=argv, prog_name="masonryfw", standalone_mode=False)
+    except click.ClickException as exc:  # usage errors: exit 2
+        exc.show()
+        sys.exit(exc.exit_code)
+    except click.exceptions.Abort:  # click's form of a KeyboardInterrupt outside a solve
+        click.echo("interrupted: nothing written", err=True)
+        sys.exit(INTERRUPTED)
     sys.exit(code if isinstance(code, int) else 0)

@@ -130,7 +130,7 @@ def _friction(model: xr.Dataset) -> list[str]:
     if _within(mu, FRICTION_ANGLE):
         readings.append(f"degrees given as the coefficient: write friction_angle = {mu:.6g}")
     advice = f"; probably {' or '.join(readings)}" if readings else ""
-    return [f"material.friction_angle (or friction) = {angle:.6g} deg (interface_friction mu = {mu:.6g}): masonry "
+    return [f"material.friction_angle (or friction) = {angle:.3g} deg (interface_friction mu = {mu:.6g}): masonry "
             f"joints have {FRICTION_ANGLE[0]:g}-{FRICTION_ANGLE[1]:g} deg{advice}"]
 
 

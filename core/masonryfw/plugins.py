@@ -22,6 +22,7 @@ from pathlib import Path
 from typing import Any
 
 import click
+import numpy as np
 import pluggy
 import xarray as xr
 
@@ -353,6 +354,9 @@ def _derive_comparable_fields(name: str, model: xr.Dataset, produced: xr.Dataset
         raise SolveError(f"solver {name} returned {', '.join(derived_too)}; the core derives them from "
                          "step_crack_width_max and step_settlement (docs/format.md): return only those")
     produced = produced.assign(damage_variables(model, produced))
+    if "step" in produced.dims and "step" not in produced.coords:  # labelled records for plain xarray
+        produced = produced.assign_coords(step=("step", np.arange(produced.sizes["step"], dtype=np.int32),
+                                                variable_attrs("step")))
     primary = "block_displacement" if "block_displacement" in produced else "qp_failure"
     if primary not in produced:
         return produced

@@ -16,8 +16,10 @@ per unit of the settlement parameter ``t`` (for a trough, ``t`` is ``S_max``):
 ``round(width / segment)`` equal segments (at least one); ``segment`` defaults to
 a quarter of the unit length (``DEFAULT_SEGMENT_UNITS``: where the widest crack has
 converged to within 10 %, docs/settlements.md). The ground's motion is known at the segment ends (the
-*nodes*): the profile's rate there, or 0 where that rate is at most ``cutoff``
-(default 0.01), so the cut-off ground joins the rest without a step. Every
+*nodes*): the profile's rate there less ``cutoff`` c (default 0.01), over ``1 - c``,
+and 0 where the rate is at most c: the far field stays still, the ground joins it
+without a step or a ramp, a rate of 1 stays 1 (t is still S_max), and the ground
+is within c of the profile everywhere. Every
 segment moves as a rigid block whose top edge follows the straight line between
 its two nodes: it translates and rotates (small rotations), and two
 neighbouring segments meet at their common node at every settlement; the
@@ -103,7 +105,7 @@ def read_profile(top: SpecTable, wall_width: float, unit_length: float) -> Profi
             raise SpecError(f"spec key {table.key(key)!r} only applies to profile = "
                             f"{' or '.join(map(repr, kinds))}")
     segment = table.number("segment", DEFAULT_SEGMENT_UNITS * unit_length / top.scale, length=True, positive=True)
-    cutoff = table.number("cutoff", DEFAULT_CUTOFF, minimum=0.0)
+    cutoff = table.number("cutoff", DEFAULT_CUTOFF, minimum=0.0, below=1.0)
     if kind == "gaussian":
         return Profile(kind, segment, cutoff, center=table.number("center", length=True),
                        width=table.number("width", length=True, positive=True),
@@ -146,10 +148,14 @@ def contact_lengths(edges: np.ndarray, base: np.ndarray) -> np.ndarray:
 
 
 def node_motion(profile: Profile, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """``(down, horizontal)`` rates of the ground at the nodes ``x``: the profile's, 0 at or below the cutoff."""
-    down = profile.rate(x)
-    still = down <= profile.cutoff
-    return np.where(still, 0.0, down), np.where(still, 0.0, profile.horizontal(x))
+    """``(down, horizontal)`` rates of the ground at the nodes ``x``: the profile's rate less the cutoff c, over
+    ``1 - c`` (so a rate of 1 stays 1, S_max stays t), 0 where the rate is at most c; the horizontal motion
+    scaled alike. Continuous, and within c of the profile everywhere."""
+    rate = profile.rate(x)
+    down = np.maximum(rate - profile.cutoff, 0.0) / (1.0 - profile.cutoff)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        share = np.where(rate > 0, down / rate, 0.0)
+    return down, profile.horizontal(x) * share
 
 
 def profile_segments(profile: Profile, width: float, base: np.ndarray) -> list[Segment]:

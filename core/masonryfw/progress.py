@@ -5,6 +5,7 @@ A solver receives a plain callable ``progress(fraction, message)`` with
 """
 from __future__ import annotations
 
+import shutil
 import sys
 import threading
 from collections.abc import Callable
@@ -46,19 +47,24 @@ def interruptible(call: Callable[[], T]) -> T:
 
 
 class StderrBar:
-    """``progress(fraction, message)`` drawn as one line ``[####......]  40% message`` on a stream."""
+    """``progress(fraction, message)`` drawn as one line ``[####......]  40% message`` on a stream, as wide as
+    the terminal: a message that does not fit loses words from its middle (``...``), never its end, where the
+    solvers put the numbers (a reaction, a settlement)."""
 
-    width = 30
+    width = 20
 
-    def __init__(self, stream):
+    def __init__(self, stream, columns: int | None = None):
         self.stream = stream
+        self.columns = columns or shutil.get_terminal_size((80, 24)).columns
         self.drawn = False
 
     def __call__(self, fraction: float, message: str = "") -> None:
         done = min(max(float(fraction), 0.0), 1.0)
         filled = round(done * self.width)
         bar = "#" * filled + "." * (self.width - filled)
-        self.stream.write(f"\r[{bar}] {done:4.0%} {message[:40]:<40}")
+        head = f"[{bar}] {done:4.0%} "
+        room = max(self.columns - len(head) - 1, 10)
+        self.stream.write(f"\r{head}{fitted(message, room):<{room}}")
         self.stream.flush()
         self.drawn = True
 
@@ -66,6 +72,15 @@ class StderrBar:
         if self.drawn:
             self.stream.write("\n")
             self.stream.flush()
+
+
+def fitted(message: str, room: int) -> str:
+    """``message`` in at most ``room`` characters: its start and its end kept, the middle replaced by ``...``."""
+    if len(message) <= room:
+        return message
+    keep = room - 3
+    tail = (keep + 1) // 2
+    return message[:keep - tail] + "..." + message[len(message) - tail:]
 
 
 def progress_bar(wanted: bool | None) -> StderrBar | None:

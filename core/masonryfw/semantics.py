@@ -37,7 +37,7 @@ import xarray as xr
 
 from .dofs import block_loads
 from .errors import ModelError
-from .geometry import block_offsets, model_scale, node_block, polygon_area_centroid
+from .geometry import block_offsets, model_scale, node_block
 from .schema import flags, variable_attrs
 
 #: A joint moving at most this share of the largest masonry-joint motion is intact.
@@ -349,33 +349,11 @@ class KeyNumber:
         return f"{self.name} = {self.value:.6g}{unit}"
 
 
-def settlement_reference_rate(model: xr.Dataset) -> float:
-    """The rate the settlement reaction is measured against: the fastest downward motion of any point of a
-    moving support per unit settlement parameter (the point of a trough's S_max, when a support reaches it;
-    over the supports' vertices, as a rigid block's vertical motion is linear in x). Without any downward
-    motion, the largest motion; 0 without a moving support."""
-    role = np.asarray(model.block_role.values)
-    moving = role == _ROLE["moving_support"]
-    d = np.asarray(model.settlement_direction.values, dtype=float)
-    if not moving.any():
-        return 0.0
-    counts = np.asarray(model.block_node_count.values)
-    x = np.asarray(model.node_x.values, dtype=float)
-    _, cx, _ = polygon_area_centroid(x, np.asarray(model.node_y.values, dtype=float), counts)
-    owner = node_block(counts)
-    on = moving[owner]
-    down = -(d[owner, 1] + d[owner, 2] * (x - cx[owner]))[on]
-    fastest = float(down.max())
-    return fastest if fastest > 0 else float(np.linalg.norm(d[moving], axis=1).max())
-
-
 def settlement_weights(model: xr.Dataset) -> np.ndarray:
-    """``(block, 3)``: every moving support's ``settlement_direction`` over the reference rate
-    (:func:`settlement_reference_rate`), 0 for other blocks: the weights of :func:`settlement_reaction`."""
+    """``(block, 3)``: every moving support's ``settlement_direction``, 0 for other blocks: the weights of
+    :func:`settlement_reaction`."""
     moving = np.asarray(model.block_role.values) == _ROLE["moving_support"]
-    weights = np.where(moving[:, None], np.asarray(model.settlement_direction.values, dtype=float), 0.0)
-    reference = settlement_reference_rate(model)
-    return weights / reference if reference > 0 else weights
+    return np.where(moving[:, None], np.asarray(model.settlement_direction.values, dtype=float), 0.0)
 
 
 def settlement_reaction(model: xr.Dataset, wrench: np.ndarray) -> np.ndarray:
@@ -383,11 +361,12 @@ def settlement_reaction(model: xr.Dataset, wrench: np.ndarray) -> np.ndarray:
     and moment (about each block's centroid) the *wall exerts on* each support.
 
     The force conjugate to the settlement parameter t: the work the supports' reactions do on the wall
-    per unit of t, with the sign flipped, over the reference rate (:func:`settlement_weights`). With one
-    moving support translating down it is that support's upward vertical reaction; with several at their
-    own rates, rotating or moving sideways (a trough's segments), it is the one quantity equilibrium fixes
-    (la's alpha is a share of it: ``(1 - alpha) R0`` at collapse), and it stays defined when the whole
-    base settles (a rigid-body settlement leaves it at R0; a trough makes it drop).
+    per unit of t, with the sign flipped, ``sum_s F_s . d_s``. With one support translating down at rate 1
+    it is that support's upward vertical reaction; over a settlement profile (t = S_max) every part of
+    the settling ground counts by its settlement over S_max, its rotation and sideways motion included.
+    It is the one reaction equilibrium fixes with one settlement parameter (la's alpha is a share of it:
+    ``(1 - alpha) R0`` at collapse), it converges as the ground is cut into finer segments, and it stays
+    defined when the whole base settles (a rigid translation leaves it at R0; a trough makes it drop).
     """
     return np.einsum("...bd,bd->...", np.asarray(wrench, dtype=float), settlement_weights(model))
 
@@ -504,6 +483,12 @@ def key_numbers(result: xr.Dataset) -> list[KeyNumber]:
         numbers += _history_numbers(result)
     if "step_crack_width_max" in result:
         numbers += _crack_numbers(result)
+    for name, what in (("deflection_ratio", "deflection ratio of the imposed profile at the last record "
+                                              "(sagging positive, Burland & Wroth 1974)"),
+                       ("angular_distortion", "angular distortion of the imposed profile at the last record [rad]")):
+        if f"step_{name}" in result and result[f"step_{name}"].size:
+            numbers.append(KeyNumber(name, float(result[f"step_{name}"].values[-1]), "1" if "ratio" in name else "rad",
+                                     what))
     if "macro_block" in result:
         masonry = masonry_blocks(result.block_role.values)
         count = np.unique(result.macro_block.values[masonry]).size

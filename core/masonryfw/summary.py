@@ -53,6 +53,11 @@ def _crack_text(numbers: dict) -> str:
     return _mm(numbers["crack_width"]) + (f" ({'; '.join(where)})" if where else "")
 
 
+def _slope(radians: float) -> str:
+    """``1/830`` (the engineers' way of writing a small slope), ``0`` for none."""
+    return f"1/{1 / abs(radians):.0f}" if radians else "0"
+
+
 def _damage_name(category: float) -> str:
     names = {value: name.replace("_", " ") for name, value in flags("step_damage_category").items()}
     return f"{int(category)} {names.get(int(category), '')}".strip()
@@ -65,7 +70,8 @@ _HEADLINES = (
     ("collapse_reaction", "collapse reaction", lambda n: f"{n['collapse_reaction']:.4g} N",
      "reaction on the settling supports when the mechanism forms, (1 - alpha) R0"),
     ("dead_reaction", "dead reaction R0", lambda n: f"{n['dead_reaction']:.4g} N",
-     "reaction on the settling supports under the weight alone"),
+     "reaction of the settling ground under the weight alone (over a profile the settlement reaction: each "
+     "part weighted by its settlement per unit of the settlement parameter, S_max for a trough)"),
     ("minimum_reaction", "minimum reaction", lambda n: f"{n['minimum_reaction']:.4g} N at "
      f"{_mm(n['minimum_reaction_settlement'])}", "smallest reaction of the history, and the settlement there"),
     ("plateau_reaction", "plateau reaction", lambda n: f"{n['plateau_reaction']:.4g} N from "
@@ -77,6 +83,11 @@ _HEADLINES = (
      "largest over the run, Burland et al. (1977) by crack width: 0 negligible .. 5 very severe"),
     ("base_gap", "base gap", lambda n: _mm(n["base_gap"]),
      "widest gap between the wall and the ground over the run (not a crack in the masonry)"),
+    ("deflection_ratio", "deflection ratio", lambda n: f"{n['deflection_ratio']:.3g}",
+     "of the imposed ground at the last record: its largest distance from the chord over the chord's length "
+     "(sagging positive)"),
+    ("angular_distortion", "angular distortion", lambda n: _slope(n["angular_distortion"]),
+     "of the imposed ground at the last record: its largest slope less the chord's tilt"),
     ("macro_blocks", "macro-blocks", lambda n: f"{int(n['macro_blocks'])}",
      "pieces the masonry breaks into (blocks joined by intact joints)"),
 )

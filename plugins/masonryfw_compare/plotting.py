@@ -209,12 +209,11 @@ def draw_model(datasets: Sequence[xr.Dataset], ax, options: Mapping[str, Any]) -
             handles.append(Line2D([], [], color=colour, lw=1.5, label=f"{name} ({int(chosen.sum())})"))
     size = mf.model_scale(geo.node_x.values, geo.node_y.values)
     moving = np.flatnonzero(roles == "moving_support")
-    fastest = float(np.linalg.norm(geo.settlement_direction.values[moving, :2], axis=1).max(initial=0.0))
-    for block in moving:  # arrows as long as the rates: a settlement profile shows its shape
-        direction = geo.settlement_direction.values[block, :2]
-        if np.linalg.norm(direction) > 0:
-            start = np.array([geo.block_centroid_x.values[block], geo.block_centroid_y.values[block]])
-            tip = start + 0.08 * size * direction / fastest
+    starts, motions = _ground_arrows(geo, moving)
+    fastest = float(np.linalg.norm(motions, axis=1).max(initial=0.0))
+    for start, motion in zip(starts, motions):  # as long as the rates: a settlement profile shows its shape
+        if np.linalg.norm(motion) > 0:
+            tip = start + 0.08 * size * motion / fastest
             ax.annotate("", xy=tip, xytext=start,
                         arrowprops={"arrowstyle": "-|>", "color": "#b00000", "lw": 1.2}, zorder=3)
             ax.update_datalim([tip])
@@ -225,6 +224,16 @@ def draw_model(datasets: Sequence[xr.Dataset], ax, options: Mapping[str, Any]) -
     if handles:
         ax.legend(handles=handles, title="interfaces", fontsize="small", loc="upper left", bbox_to_anchor=(1.01, 1.0))
     _finish(ax, ds)
+
+
+def _ground_arrows(geo: xr.Dataset, moving: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Per moving support: the middle of its top edge and that point's motion per unit settlement (a
+    support that turns moves its centroid sideways, its top edge less)."""
+    xmin, xmax, _, ymax = mf.block_bounds(geo.node_x.values, geo.node_y.values, geo.block_node_count.values)
+    points = np.c_[0.5 * (xmin + xmax), ymax][moving]
+    d = geo.settlement_direction.values[moving]
+    arm = points - np.c_[geo.block_centroid_x.values[moving], geo.block_centroid_y.values[moving]]
+    return points, np.c_[d[:, 0] - d[:, 2] * arm[:, 1], d[:, 1] + d[:, 2] * arm[:, 0]]
 
 
 def draw_mechanism(datasets: Sequence[xr.Dataset], ax, options: Mapping[str, Any]) -> None:

@@ -48,7 +48,7 @@ PLOTTERS = {
                  "macro-blocks numbered, cracks on the blocks' faces",
                  (AMPLIFICATION_OPTION, THRESHOLD_OPTION)),
         _plotter("cracks", "joints that open, slide or both, in colours", (THRESHOLD_OPTION,)),
-        _plotter("forces", "contact forces at collapse as thrust segments",
+        _plotter("forces", "contact forces (at collapse, or at the last record) as thrust segments",
                  (mf.Option("scale", float, 1.0, "largest segment, in median interface lengths", above=0.0),)),
         _plotter("plastic", "plastic quadrature points over the mesh (continuum results)",
                  (mf.Option("marker_size", float, 4.0, "marker area [pt^2]", above=0.0),)),

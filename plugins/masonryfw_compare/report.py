@@ -108,13 +108,20 @@ def _mechanism_source(ds: xr.Dataset) -> str:
     return "the continuum's collapse velocities from its limit LP, fitted per block"
 
 
+def _forces_state(ds: xr.Dataset) -> str:
+    """When a result's contact forces act: at the last record of an incremental run, else at collapse."""
+    if "step_settlement" in ds and ds.step_settlement.size:
+        return f"at the last record (settlement {1e3 * float(ds.step_settlement.values[-1]):.3g} mm)"
+    return "at the last trial of the load-factor search" if "trial_load_factor" in ds else "at collapse"
+
+
 def _result_figures(ds: xr.Dataset, label: str) -> list[str]:
     """The figures a single result supports, each with a caption saying how to read it."""
     captions = {
         "mechanism": f"the mechanism ({_mechanism_source(ds)}, amplified); the dominant macro-blocks numbered by "
                      "size, cracked joints heavy on the blocks' faces.",
         "cracks": "joints that open, slide or both.",
-        "forces": "joint resultants at collapse; colour: the share of the friction used.",
+        "forces": f"joint resultants {_forces_state(ds)}; colour: the share of the friction used.",
         "plastic": "plastic quadrature points of the continuum.",
     }
     return [_figure([ds], kind, f"{label}: {captions[kind]}") for kind in drawable_kinds(ds)]
@@ -126,14 +133,15 @@ def _history_section(datasets: Sequence[xr.Dataset]) -> list[str]:
         return []
     datasets = [ds for ds in datasets if "step_settlement" in ds or "collapse_multiplier" in ds]  # what it draws
     parts = ["<h2>Reaction against settlement</h2>",
-             _figure(datasets, "history", "Reaction on the settling supports of every incremental result, with the "
-                     "dead load R0 and the limit analyses' collapse reaction (1 - alpha) R0; strips along the top: "
-                     "the damage category."),
+             _figure(datasets, "history", "Reaction on the settling supports of every incremental result (over a "
+                     "profile the settlement reaction: each segment's reaction weighted by how fast the ground under "
+                     "it settles), with the dead reaction R0 and the limit analyses' collapse reaction (1 - alpha) R0; "
+                     "strips along the top: the damage category."),
              _figure(datasets, "history", "The same on a logarithmic settlement axis (the first fractions of a "
                      "millimetre).", {"xscale": "log"})]
     if all("step_damage_category" in ds for ds in incremental):
-        parts.append(_figure(incremental, "history", "Damage category and widest crack against settlement.",
-                             {"quantity": "damage"}))
+        parts.append(_figure(incremental, "history", "Widest crack in the masonry against settlement, over the "
+                             "bands of the damage categories.", {"quantity": "damage"}))
     return parts
 
 

@@ -157,7 +157,8 @@ def _solve(model: xr.Dataset, options: Mapping[str, Any], progress) -> xr.Datase
     if state.trials:
         result.attrs["fdem_unstable_load_factor"] = state.collapse_bracket[1] if state.collapse_bracket[1] is not None \
             else np.nan
-    progress(1.0, f"fdem: {state.stop_reason} after {state.steps} steps")
+    if not state.interrupted:  # an interrupted run leaves the bar where it stopped
+        progress(1.0, f"fdem: {state.stop_reason} after {state.steps} steps")
     return result
 
 

@@ -113,7 +113,7 @@ class NewtonSolver:
 
     def reaction(self, state: State) -> float:
         """The settlement reaction (non-dimensional, ``mf.settlement_reaction``): minus the work of the moving
-        supports' nodal forces on the wall per unit settlement, over the reference rate."""
+        supports' nodal forces on the wall per unit settlement."""
         return self.problem.settlement_reaction(state.residual)
 
     def _norm(self, state: State) -> float:

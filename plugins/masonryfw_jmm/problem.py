@@ -320,11 +320,6 @@ def bed_rotations(angle: np.ndarray) -> tuple[np.ndarray | None, np.ndarray | No
     return stress_rotation(angle), stress_rotation(-angle)
 
 
-def reference_rate(model: xr.Dataset) -> float:
-    """``mf.settlement_reference_rate`` of the model (1 without a moving support)."""
-    return mf.settlement_reference_rate(model) or 1.0
-
-
 def build_problem(model: xr.Dataset, options) -> Problem:
     """Mesh the wall and set up materials, supports and gravity for the incremental method."""
     domain = wall_domain(model, options["mesh_size"], options["beta"], options["dilatancy"])
@@ -363,7 +358,7 @@ def build_problem(model: xr.Dataset, options) -> Problem:
     return Problem(
         mesh=mesh, disc=disc, return_map=rmap, masonry_points=masonry_points, D_points=D_points,
         gravity=gravity, fixed=fixed, moving=moving, moving_direction=direction,
-        moving_weight=direction / reference_rate(model), support_uy=support_uy, support_of=support_of, length=H, mesh_size=size, stress=S, displacement=U, force=domain.force,
+        moving_weight=direction, support_uy=support_uy, support_of=support_of, length=H, mesh_size=size, stress=S, displacement=U, force=domain.force,
         beta=domain.beta, young=young, poisson=poisson, strength=domain.strength, live=live, to_bed=to_bed,
         from_bed=from_bed, face_bounds=face_bounds, searches_load=searches_load,
         n_block=model.sizes["block"],

@@ -23,40 +23,52 @@ from .problem import Problem, build_problem
 MIN_INCREMENT = 1e-4  # of the elastic unloading settlement: below it a failing step stops the run
 
 
+@dataclass(frozen=True)
+class Record:
+    """One converged step (the first: the gravity stage), non-dimensional."""
+
+    settlement: float
+    reaction: float  # the settlement reaction
+    load_factor: float
+    displacement: float  # largest node displacement
+    iterations: int
+    plastic_points: int
+    supports: np.ndarray  # (block,) upward force of each support on the wall
+    crack_width: float  # crack band estimate (as u)
+    crack_point: int  # the quadrature point where it is widest (-1: none)
+
+
 @dataclass
 class History:
-    settlement: list = field(default_factory=list)
-    reaction: list = field(default_factory=list)
-    load_factor: list = field(default_factory=list)
-    displacement: list = field(default_factory=list)  # largest node displacement (non-dimensional)
-    iterations: list = field(default_factory=list)
-    plastic_points: list = field(default_factory=list)
-    residuals: list = field(default_factory=list)
-    supports: list = field(default_factory=list)  # (block,) upward force of each support on the wall
-    crack_width: list = field(default_factory=list)  # crack band estimate (non-dimensional, as u)
-    crack_point: list = field(default_factory=list)  # the quadrature point where it is widest (-1: none)
+    """The converged steps, each added whole as one record (a Ctrl-C never leaves a half one); the columns
+    are read as lists (``history.reaction``)."""
+
+    records: list = field(default_factory=list)
     # (settlement, u) of the last steps, for the mechanism: as many as the plateau test looks at, plus one
     recent: deque = field(default_factory=lambda: deque(maxlen=2))
 
     def add(self, newton: NewtonSolver, state: State, settlement: float, load_factor: float, iterations: int) -> None:
         p = newton.problem
-        self.settlement.append(settlement)
-        self.reaction.append(newton.reaction(state))
-        self.supports.append(np.bincount(p.support_of, weights=state.residual[p.support_uy],
-                                         minlength=p.n_block))
         width, point = crack_band_width(p, state)
-        self.crack_width.append(width)
-        self.crack_point.append(point)
-        self.load_factor.append(load_factor)
-        self.displacement.append(float(np.hypot(state.u[0::2], state.u[1::2]).max(initial=0.0)))
-        self.iterations.append(iterations)
-        self.plastic_points.append(int(state.active.any(axis=1).sum()))
-        self.recent.append((settlement, state.u.copy()))
+        record = Record(settlement, newton.reaction(state), load_factor,
+                        float(np.hypot(state.u[0::2], state.u[1::2]).max(initial=0.0)), iterations,
+                        int(state.active.any(axis=1).sum()),
+                        np.bincount(p.support_of, weights=state.residual[p.support_uy], minlength=p.n_block),
+                        width, point)
+        recent = (settlement, state.u.copy())
+        self.records.append(record)
+        self.recent.append(recent)
+
+    def __getattr__(self, name: str) -> list:
+        """A column of the records, ``history.reaction`` for every record's ``reaction``."""
+        if name in Record.__dataclass_fields__:
+            return [getattr(r, name) for r in self.__dict__.get("records", [])]
+        raise AttributeError(name)
 
     @property
     def steps(self) -> int:
         """Steps after the gravity stage."""
-        return len(self.iterations) - 1
+        return len(self.records) - 1
 
 
 def crack_band_width(problem: Problem, state: State) -> tuple[float, int]:
@@ -176,7 +188,6 @@ def run(problem: Problem, options, progress) -> tuple[State, History, dict]:
             last_increment = (trial.u - state.u, target - settlement)
             state, settlement = trial, target
             history.add(newton, state, settlement, 0.0, report.iterations)
-            history.residuals.append(report.residuals)
             progress(min(0.99, settlement / limit), f"step {history.steps}: settlement "
                      f"{settlement * problem.displacement:.3g} m, reaction {history.reaction[-1] * problem.force:.4g} N, "
                      f"{report.iterations} Newton iterations")
@@ -232,7 +243,6 @@ def run_load_factor(problem: Problem, options, progress) -> tuple[State, History
             last = (trial.u - state.u, target - factor)
             state, factor = trial, target
             history.add(newton, state, 0.0, factor, report.iterations)
-            history.residuals.append(report.residuals)
             progress(min(0.99, history.steps / options["max_steps"]),
                      f"step {history.steps}: load factor {factor:.4g}, {report.iterations} Newton iterations")
             if _load_plateau(history, options):
@@ -339,6 +349,7 @@ def solve(model: xr.Dataset, options, progress) -> xr.Dataset:
     state, history, info = (run_load_factor if problem.searches_load else run)(problem, options, progress)
     if info["interrupted"] and len(history.iterations) == 0:
         raise KeyboardInterrupt  # interrupted before the gravity stage converged: nothing to keep
-    progress(1.0, info["stop_reason"])
+    if not info["interrupted"]:  # an interrupted run leaves the bar where it stopped
+        progress(1.0, info["stop_reason"])
     flow = "associative" if options["dilatancy"] is None else "nonassociative"  # the continuum's flow rule
     return with_mechanism(result_dataset(problem, model, state, history, info), mechanism(problem, model, history), flow)

@@ -18,7 +18,7 @@ import importlib
 
 import masonryfw as mf
 
-from .commands import COMMANDS
+from .commands import available_commands
 
 #: The Python API, imported on first access (PEP 562): registering the plugin stays cheap.
 _PUBLIC = {
@@ -37,4 +37,4 @@ def __getattr__(name: str):
 
 @mf.hookimpl
 def masonryfw_commands():
-    return list(COMMANDS)
+    return available_commands()

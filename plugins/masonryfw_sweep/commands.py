@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import contextlib
+import importlib.util
 import shlex
 import sys
 from pathlib import Path
@@ -120,3 +121,12 @@ def archive_command(directory: str, sweep_file: str | None, verify: bool) -> Non
 
 
 COMMANDS = (sweep_command, archive_command)
+#: What ``masonryfw plugins`` and ``--help`` say of ``sweep`` when dask.distributed is not installed.
+NEEDS_DASK = "needs dask, not installed: pip install 'masonryfw[sweep]'"
+
+
+def available_commands() -> list[click.Command]:
+    """The commands, ``sweep`` saying what it needs when dask.distributed is missing (looked up, not imported)."""
+    if importlib.util.find_spec("distributed") is None:
+        sweep_command.short_help = NEEDS_DASK
+    return list(COMMANDS)

@@ -166,8 +166,9 @@ def test_rotating_support_direction_is_the_rigid_rotation_about_the_pivot():
     })
     ds = build(spec)
     moving = np.flatnonzero(ds.block_role.values == ROLE["moving_support"])[0]
-    # centre (0.3, -0.025); clockwise rotation (rz = -1) about (0.2, 0): v = -1 * (-r_y, r_x) = (-0.025, -0.1)
-    expected = np.array([-0.025, -0.1, -1.0]) / math.sqrt(0.025**2 + 0.1**2 + 1.0)
+    # centre (0.3, -0.025); clockwise rotation rz about (0.2, 0): v = rz (-r_y, r_x) = rz (0.025, 0.1); the
+    # settlement parameter is the centroid's settlement, v_y = -1: rz = -10, v = (-0.25, -1)
+    expected = np.array([-0.25, -1.0, -10.0])
     assert ds.settlement_direction.values[moving] == pytest.approx(expected, rel=1e-12)
     assert ds.block_fixed.values[moving].tolist() == [0, 0, 0]
 

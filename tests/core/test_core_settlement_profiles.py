@@ -39,17 +39,16 @@ def top_corners(model, blocks):
 
 
 def test_gaussian_trough_segments_follow_peck_and_oreilly_new():
-    """The ground is continuous: the top corners of every segment move down by S(x) = exp(-(x - x0)^2 /
-    (2 i^2)) at the segment ends (0 where S <= the cutoff), so neighbouring segments meet; their top edge
-    moves sideways by the mean of h = -(x - x0) / z0 S at its ends; segments whose ends both stay still are
-    fixed and merge into one block on each side."""
+    """The ground is continuous: the top corners of every segment move down by (S - c) / (1 - c) at the
+    segment ends, S(x) = exp(-(x - x0)^2 / (2 i^2)) less the cutoff c (0 where S <= c), so neighbouring
+    segments meet; their top edge moves sideways by the mean of h = -(x - x0) / z0 times that at its ends;
+    segments whose ends both stay still are fixed and merge into one block on each side."""
     model = mf.build({**BASE, "settlement": TROUGH})
     role = model.block_role.values
     supports = np.flatnonzero(np.isin(role, [ROLE["fixed_support"], ROLE["moving_support"]]))
     supports = supports[np.argsort(model.block_centroid_x.values[supports])]
     x, ux, uy = top_corners(model, supports)
-    rate = np.exp(-0.5 * ((x - 1.0) / 0.3) ** 2)
-    rate = np.where(rate <= 0.05, 0.0, rate)
+    rate = np.maximum(np.exp(-0.5 * ((x - 1.0) / 0.3) ** 2) - 0.05, 0.0) / 0.95
     np.testing.assert_allclose(uy, -rate, atol=1e-12)
     np.testing.assert_allclose(uy[1:, 0], uy[:-1, 1], atol=1e-12)  # continuous at every common end
     h = -(x - 1.0) / 10.0 * rate
@@ -76,7 +75,7 @@ def test_profile_lengths_in_millimetres_give_the_metre_model():
 def test_linear_and_table_profiles():
     """A tilt's segments all turn by the same angle and meet: together one rigid rotation of the base about
     the profile's start; a table is interpolated at the segment ends."""
-    tilt = mf.build({**BASE, "settlement": {"profile": "linear", "segment": 1.0}})
+    tilt = mf.build({**BASE, "settlement": {"profile": "linear", "segment": 1.0, "cutoff": 0.0}})
     moving = np.flatnonzero(tilt.block_role.values == ROLE["moving_support"])
     np.testing.assert_allclose(tilt.settlement_direction.values[moving, 2], -0.25)
     _, _, uy = top_corners(tilt, moving)
@@ -84,7 +83,8 @@ def test_linear_and_table_profiles():
     table = mf.build({**BASE, "settlement": {"profile": "table", "segment": 1.0, "points": [[1.0, 0.0], [3.0, 1.0]]}})
     moving = np.flatnonzero(table.block_role.values == ROLE["moving_support"])
     _, _, uy = top_corners(table, moving)
-    np.testing.assert_allclose(-uy, [[0.0, 0.5], [0.5, 1.0], [1.0, 1.0]], atol=1e-12)
+    half = (0.5 - 0.01) / 0.99  # the default cutoff 0.01 taken off, a rate of 1 kept
+    np.testing.assert_allclose(-uy, [[0.0, half], [half, 1.0], [1.0, 1.0]], atol=1e-12)
 
 
 def test_rate_of_a_support_range_scales_its_direction():
@@ -165,9 +165,9 @@ def test_support_profile_of_a_trough_model():
     model = mf.build({**BASE, "settlement": TROUGH})
     x, v = mf.support_profile(model)
     assert np.all(np.diff(x) > 0)
-    moving = v < 0  # 0.1 m segments: the ground at a midpoint is the mean of its ends' (0 at or below the cutoff)
+    moving = v < 0  # 0.1 m segments: the ground at a midpoint is the mean of its ends' (less the cutoff)
     ends = np.exp(-0.5 * ((x[moving, None] + [-0.05, 0.05] - 1.0) / 0.3) ** 2)
-    np.testing.assert_allclose(v[moving], -np.where(ends <= 0.05, 0.0, ends).mean(axis=1), rtol=1e-12)
+    np.testing.assert_allclose(v[moving], -(np.maximum(ends - 0.05, 0.0) / 0.95).mean(axis=1), rtol=1e-12)
 
 
 def test_cli_builds_solves_and_draws_a_trough_wall(tmp_path):

@@ -71,26 +71,28 @@ def test_fdem_support_reactions_carry_the_weight_and_sum_to_the_reaction():
 def test_fdem_tilt_of_the_ground_is_the_single_support_rotating_about_the_pivot():
     """A tilt from x = 0.6 m under a 1.2 m wall, cut into three 0.2 m segments, is one rigid rotation of the
     base about (0.6, 0): the single support from 0.6 m rotating about that pivot. The two models scale their
-    settlement parameters differently, so both reactions are compared as the moment conjugate to the base's
-    rotation theta (the settlement reaction times the reference rate over the rotation per unit t) against
-    theta: within 3e-3 of its value at rest."""
+    settlement parameters differently (the tilt's rate 1 at the wall's end, the support's at its centroid),
+    so both turn at the same angular speed and are compared as the moment conjugate to the base's rotation
+    theta (the settlement reaction over the rotation per unit t) against theta: within 3e-3 of its value at
+    rest."""
     wall = {**LONG_WALL, "wall": {"width": 1.2, "height": 0.4, "thickness": 0.1},
             "unit": {"length": 0.2, "height": 0.1}}
     single = mf.build({**wall, "supports": {"f": {"kind": "fixed", "start": 0.0, "end": 0.6},
                                             "m": {"kind": "moving", "start": 0.6, "end": 1.2,
                                                   "motion": "rotation", "pivot": [0.6, 0.0]}}})
-    profiled = mf.build({**wall, "settlement": {"profile": "linear", "start": 0.6, "segment": 0.2}})
+    profiled = mf.build({**wall, "settlement": {"profile": "linear", "start": 0.6, "segment": 0.2, "cutoff": 0.0}})
     assert (profiled.block_role.values == ROLE["moving_support"]).sum() == 3
     curves = []
     for model in (single, profiled):
         moving = model.block_role.values == ROLE["moving_support"]
-        per_t = float(model.settlement_direction.values[moving, 2][0])  # rotation per unit t
-        scale = mf.settlement_reference_rate(model)
-        result = mf.solve(model, "fdem", {"settlement": 0.005 / abs(per_t), "plateau_tolerance": 0.0})
+        per_t = abs(float(model.settlement_direction.values[moving, 2][0]))  # rotation per unit t
+        # the same angular speed in both: the default loading rate at the tilt's 1.667 rad per unit t
+        result = mf.solve(model, "fdem", {"settlement": 0.005 / per_t, "plateau_tolerance": 0.0,
+                                          "loading_rate": 2e-3 * (1 / 0.6) / per_t})
         settling = result.step_phase.values == 1
-        theta = result.step_settlement.values[settling] * abs(per_t)
-        moment = result.step_reaction.values * scale / abs(per_t)
-        curves.append((theta, moment[settling], float(moment[after_gravity(result)])))
+        moment = result.step_reaction.values / per_t
+        curves.append((result.step_settlement.values[settling] * per_t, moment[settling],
+                       float(moment[after_gravity(result)])))
     grid = np.linspace(0.0, 0.004, 30)
     (ta, ma, m0), (tb, mb, _) = curves
     # 1.7e-3 measured (the units' bed contacts split at the segment ends); fdem's plateau tolerance is 5e-3 R0

@@ -37,7 +37,7 @@ def test_la_tilt_of_the_ground_is_the_single_support_rotating_about_the_pivot(wa
     single = mf.build(wall(supports={"fixed": {"kind": "fixed", "start": 0.0, "end": 2.0},
                                      "settling": {"kind": "moving", "start": 2.0, "end": 4.0,
                                                   "motion": "rotation", "pivot": [2.0, 0.0]}}))
-    profiled = mf.build(wall(settlement={"profile": "linear", "start": 2.0, "segment": 0.2}))
+    profiled = mf.build(wall(settlement={"profile": "linear", "start": 2.0, "segment": 0.2, "cutoff": 0.0}))
     moving = profiled.block_role.values == walls.ROLE["moving_support"]
     assert moving.sum() == 10
     np.testing.assert_allclose(profiled.settlement_direction.values[moving, 2], -0.5)  # one angle per unit t
