@@ -84,7 +84,7 @@ FIRST_INCREMENTS = (0.2, 0.1, 0.05, 0.025)  # of the elastic unloading settlemen
 
 def fixed_settlement_run(case: str, **given):
     """A run to CONVERGENCE_SETTLEMENT with the plateau stop off: the result and its run time."""
-    options = {"max_settlement": CONVERGENCE_SETTLEMENT, "plateau_slope": 1e-12, "max_steps": 1000, **given}
+    options = {"settlement": CONVERGENCE_SETTLEMENT, "plateau_slope": 1e-12, "max_steps": 1000, **given}
     start = time.perf_counter()
     result = mf.solve(mf.open_model(case), "jmm", options)
     seconds = time.perf_counter() - start

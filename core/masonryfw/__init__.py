@@ -70,6 +70,7 @@ from .plugins import (
     solve,
     solver_version,
 )
+from .profiles import model_profile
 from .progress import ProgressCallback, StderrBar, interruptible, no_progress, progress_bar
 from .resources import available_memory, duration_text, size_text
 from .schema import FORMAT_VERSION, flags, load_schema, variable_attrs

@@ -45,7 +45,7 @@ from .errors import SpecError
 from .imported import build_drawn, is_drawn, parse_drawn_spec, resolved_drawing
 from .model import checked_model
 from .plausibility import warn_implausible
-from .profiles import profile_segments, read_profile
+from .profiles import Profile, profile_segments, read_profile, with_profile
 from .schema import flags
 from .spec import (
     LENGTH_UNITS,
@@ -129,6 +129,7 @@ class Wall:
     supports: tuple[Support, ...]
     loading: str
     tilt_direction: int
+    profile: Profile | None = None
 
     @property
     def height(self) -> float:
@@ -185,17 +186,17 @@ def parse_spec(spec: dict) -> Wall:
     )
     result = replace(result, openings=_openings(top, result))
     if top.has("settlement"):
-        result = replace(result, supports=_profile_supports(top, result))
+        result = replace(result, profile=read_profile(top, result.width, result.unit_length))
+        result = replace(result, supports=_profile_supports(result))
     return result
 
 
-def _profile_supports(top: SpecTable, wall: Wall) -> tuple[Support, ...]:
+def _profile_supports(wall: Wall) -> tuple[Support, ...]:
     """The support segments of the ``[settlement]`` profile under the wall's bottom course (a continuous
     ground: :mod:`masonryfw.profiles`)."""
-    profile = read_profile(top, wall.width, wall.unit_length)
     x0, x1, y0, _, _ = masonry_blocks(wall)
     bottom = y0 <= wall.tol
-    segments = profile_segments(profile, wall.width, np.c_[x0[bottom], x1[bottom]])
+    segments = profile_segments(wall.profile, 0.0, wall.width, np.c_[x0[bottom], x1[bottom]])
     return tuple(
         Support(f"segment {k} [{s.start:.6g}, {s.end:.6g}] m", "moving", s.start, s.end, "ground", None,
                 ground=blocks.GroundEdge((s.start, s.end), 0.0, s.down, s.horizontal))
@@ -441,6 +442,7 @@ def _build_parametric(spec_dict: dict, text: str, validate: bool) -> xr.Dataset:
         attrs["comment"] = wall.description
     ds = blocks.model_from_blocks(*blocks.rectangle_nodes(x0, x1, y0, y1), role, wall.thickness, material, supports,
                                   wall.loading, wall.tilt_direction, attrs)
+    ds = with_profile(ds, wall.profile)
     return checked_model(ds, repr(wall.title)) if validate else ds
 
 

@@ -21,7 +21,11 @@ categories and the distortion of the imposed settlement profile.
   wall rather than per sagging or hogging zone); the **angular distortion** is
   the largest slope between neighbouring points once the chord's tilt is
   removed. Both grow linearly with the settlement parameter
-  (``step_deflection_ratio``, ``step_angular_distortion``).
+  (``step_deflection_ratio``, ``step_angular_distortion``);
+- the engineers' **stage 2** on the continuous greenfield profile a model was
+  built over, the LTSM strain and its category (``step_ltsm_strain``,
+  ``step_ltsm_category``, :mod:`masonryfw.assessment`), beside the model's own
+  damage.
 """
 from __future__ import annotations
 
@@ -30,13 +34,15 @@ from dataclasses import dataclass
 import numpy as np
 import xarray as xr
 
+from .assessment import ltsm_variables
 from .schema import variable_attrs
 from .semantics import masonry_blocks, relative_motion, support_blocks
 
 #: Upper crack widths [m] of damage categories 0 to 4 (category 5 beyond the last).
 DAMAGE_LIMITS = (1.0e-4, 1.0e-3, 5.0e-3, 15.0e-3, 25.0e-3)
 #: Variables the core derives from a result's history (a solver must not return them).
-DERIVED_STEP_VARIABLES = ("step_damage_category", "step_deflection_ratio", "step_angular_distortion")
+DERIVED_STEP_VARIABLES = ("step_damage_category", "step_deflection_ratio", "step_angular_distortion",
+                          "step_ltsm_strain", "step_ltsm_category")
 
 
 def damage_category(width) -> np.ndarray:
@@ -110,5 +116,6 @@ def damage_variables(model: xr.Dataset, produced: xr.Dataset) -> dict[str, tuple
         settlement = np.asarray(produced.step_settlement.values, dtype=float)
         derived["step_deflection_ratio"] = ("step", ratio * settlement, variable_attrs("step_deflection_ratio"))
         derived["step_angular_distortion"] = ("step", angle * settlement, variable_attrs("step_angular_distortion"))
+        derived.update(ltsm_variables(model, settlement))
     return derived
 

@@ -7,6 +7,11 @@ per unit of the settlement parameter ``t`` (for a trough, ``t`` is ``S_max``):
   with ``center`` x0 and ``width`` i (the distance from the axis to the
   inflection point); with ``depth`` z0 the ground also moves towards the axis
   (O'Reilly & New 1982): horizontal ``-(x - x0) / z0`` times the vertical rate;
+- ``tunnel``: the same trough from the tunnel's parameters (Mair, Taylor & Burland
+  1996): ``volume_loss`` V_L [%], ``diameter`` D, ``depth`` z0 of its axis,
+  ``trough_width_factor`` K (default 0.5), ``center``, ``horizontal`` (default
+  true): ``i = K z0`` and ``S_max = V_L / 100 pi D^2 / 4 / (sqrt(2 pi) i)``, which
+  the model records as its ``settlement_target`` (t is S_max);
 - ``linear``: a tilt, ``r = (x - start) / (end - start)``, 0 before ``start``
   (defaults: the wall's left end and its right end, so r = 1 at the right end);
 - ``table``: measured rates ``points = [[x, r], ...]``, linearly interpolated,
@@ -30,22 +35,29 @@ it (under a door) gets no block.
 """
 from __future__ import annotations
 
+import json
 import math
-from dataclasses import dataclass
+from dataclasses import asdict, dataclass
 
 import numpy as np
+import xarray as xr
 
 from .errors import SpecError
+from .schema import variable_attrs
 from .spec import SpecTable
 
-PROFILES = ("gaussian", "linear", "table")
-SETTLEMENT_KEYS = ("profile", "center", "width", "start", "end", "points", "segment", "cutoff", "depth")
+PROFILES = ("gaussian", "tunnel", "linear", "table")
+SETTLEMENT_KEYS = ("profile", "center", "width", "start", "end", "points", "segment", "cutoff", "depth",
+                   "volume_loss", "diameter", "trough_width_factor", "horizontal")
 #: A segment whose rate is at most this stays fixed unless ``cutoff`` says otherwise.
 DEFAULT_CUTOFF = 0.01
 #: The default segment length in unit lengths (the convergence study of docs/settlements.md).
 DEFAULT_SEGMENT_UNITS = 0.25
-_ONLY = {"center": ("gaussian",), "width": ("gaussian",), "depth": ("gaussian",),
-         "start": ("linear",), "end": ("linear",), "points": ("table",)}
+#: K, the trough width factor of a tunnel (i = K z0) when the spec does not give it: clays (Mair et al. 1996).
+DEFAULT_TROUGH_WIDTH_FACTOR = 0.5
+_TUNNEL_ONLY = ("volume_loss", "diameter", "trough_width_factor", "horizontal")
+_ONLY = {"center": ("gaussian", "tunnel"), "width": ("gaussian",), "depth": ("gaussian", "tunnel"),
+         "start": ("linear",), "end": ("linear",), "points": ("table",), **{k: ("tunnel",) for k in _TUNNEL_ONLY}}
 
 
 @dataclass(frozen=True)
@@ -56,16 +68,21 @@ class Profile:
     segment: float
     cutoff: float
     center: float = 0.0
-    width: float = 1.0
-    depth: float | None = None
+    width: float = 1.0  # i
+    depth: float | None = None  # z0: with it (and ``sideways``), the ground also moves towards the axis
     start: float = 0.0
     end: float = 1.0
     points: tuple[tuple[float, float], ...] = ()
+    sideways: bool = True
+    target: float | None = None  # the settlement expected [m] (a tunnel's S_max)
+    volume_loss: float | None = None  # a tunnel's V_L [%], D [m] and K, as given
+    diameter: float | None = None
+    trough_width_factor: float | None = None
 
     def rate(self, x: np.ndarray) -> np.ndarray:
         """Vertical settlement rate at ``x`` (per unit of the settlement parameter)."""
         x = np.asarray(x, dtype=float)
-        if self.kind == "gaussian":
+        if self.kind in ("gaussian", "tunnel"):
             return np.exp(-0.5 * ((x - self.center) / self.width) ** 2)
         if self.kind == "linear":
             return np.maximum((x - self.start) / (self.end - self.start), 0.0)
@@ -75,7 +92,7 @@ class Profile:
     def horizontal(self, x: np.ndarray) -> np.ndarray:
         """Horizontal ground motion per unit of the settlement parameter (towards the trough's axis)."""
         x = np.asarray(x, dtype=float)
-        if self.depth is None:
+        if self.depth is None or not self.sideways:
             return np.zeros_like(x)
         return -(x - self.center) / self.depth * self.rate(x)
 
@@ -110,6 +127,8 @@ def read_profile(top: SpecTable, wall_width: float, unit_length: float) -> Profi
         return Profile(kind, segment, cutoff, center=table.number("center", length=True),
                        width=table.number("width", length=True, positive=True),
                        depth=table.number("depth", None, length=True, positive=True))
+    if kind == "tunnel":
+        return _tunnel(table, segment, cutoff)
     if kind == "linear":
         start = table.number("start", 0.0, length=True)
         end = table.number("end", wall_width / top.scale, length=True)
@@ -118,6 +137,22 @@ def read_profile(top: SpecTable, wall_width: float, unit_length: float) -> Profi
                             "(the rate grows from 0 at start to 1 at end)")
         return Profile(kind, segment, cutoff, start=start, end=end)
     return Profile(kind, segment, cutoff, points=_table_points(table))
+
+
+def _tunnel(table: SpecTable, segment: float, cutoff: float) -> Profile:
+    """A tunnel's greenfield trough (module docstring): i = K z0, S_max from the volume loss."""
+    volume_loss = table.number("volume_loss", positive=True)
+    diameter = table.number("diameter", length=True, positive=True)
+    depth = table.number("depth", length=True, positive=True)
+    if depth <= 0.5 * diameter:
+        raise SpecError(f"spec key {table.key('depth')!r} = {table.raw('depth')!r}: the tunnel's crown would be above "
+                        f"the ground (the depth of its axis must exceed half its diameter, {table.raw('diameter')!r})")
+    factor = table.number("trough_width_factor", DEFAULT_TROUGH_WIDTH_FACTOR, positive=True)
+    width = factor * depth
+    s_max = volume_loss / 100.0 * math.pi * diameter**2 / 4.0 / (math.sqrt(2.0 * math.pi) * width)
+    return Profile("tunnel", segment, cutoff, center=table.number("center", length=True), width=width, depth=depth,
+                   sideways=table.flag("horizontal", True), target=s_max, volume_loss=volume_loss, diameter=diameter,
+                   trough_width_factor=factor)
 
 
 def _table_points(table: SpecTable) -> tuple[tuple[float, float], ...]:
@@ -158,11 +193,12 @@ def node_motion(profile: Profile, x: np.ndarray) -> tuple[np.ndarray, np.ndarray
     return down, profile.horizontal(x) * share
 
 
-def profile_segments(profile: Profile, width: float, base: np.ndarray) -> list[Segment]:
-    """The support segments of a profile under a wall of ``width`` whose masonry rests on the ``base``
+def profile_segments(profile: Profile, x0: float, x1: float, base: np.ndarray) -> list[Segment]:
+    """The support segments of a profile under a wall from ``x0`` to ``x1`` whose masonry rests on the ``base``
     intervals (module docstring): moving segments one by one, adjacent fixed ones merged."""
+    width = x1 - x0
     count = max(1, round(width / profile.segment))
-    edges = np.linspace(0.0, width, count + 1)
+    edges = np.linspace(x0, x1, count + 1)
     down, horizontal = node_motion(profile, edges)
     bare = contact_lengths(edges, base) <= 1e-9 * width
     segments: list[Segment] = []
@@ -179,3 +215,26 @@ def profile_segments(profile: Profile, width: float, base: np.ndarray) -> list[S
                         "S_max under every segment: nothing settles under the wall (move the profile under it "
                         "or lower the cutoff)")
     return segments
+
+
+def with_profile(model: xr.Dataset, profile: Profile | None) -> xr.Dataset:
+    """``model`` recording the greenfield ``profile`` it is built over (its ``settlement_profile`` attribute, JSON in
+    SI, what the engineers' assessment reads: :mod:`masonryfw.assessment`) and the settlement it expects
+    (``settlement_target``, a tunnel's S_max), if any."""
+    if profile is None:
+        return model
+    model = model.assign_attrs(settlement_profile=json.dumps(
+        {k: v for k, v in asdict(profile).items() if v is not None}, sort_keys=True))
+    if profile.target is None:
+        return model
+    return model.assign(settlement_target=((), profile.target, variable_attrs("settlement_target")))
+
+
+def model_profile(model: xr.Dataset) -> Profile | None:
+    """The greenfield profile a model was built over (its ``settlement_profile`` attribute), None without one."""
+    text = model.attrs.get("settlement_profile")
+    if not text:
+        return None
+    fields = json.loads(text)
+    fields["points"] = tuple(tuple(p) for p in fields.get("points", ()))
+    return Profile(**fields)

@@ -35,6 +35,7 @@ from dataclasses import dataclass
 import numpy as np
 import xarray as xr
 
+from .assessment import assess
 from .dofs import block_loads
 from .errors import ModelError
 from .geometry import block_offsets, model_scale, node_block
@@ -455,6 +456,31 @@ def _crack_numbers(result: xr.Dataset) -> list[KeyNumber]:
     return numbers
 
 
+def _assessment_numbers(result: xr.Dataset) -> list[KeyNumber]:
+    """The engineers' stages 1 and 2 (:mod:`masonryfw.assessment`) at the last record's settlement, or at the
+    model's ``settlement_target`` for a result without a history (limit analysis)."""
+    if "step_settlement" in result and result.step_settlement.size:
+        settlement = float(result.step_settlement.values[-1])
+    elif "settlement_target" in result:
+        settlement = float(result.settlement_target.values)
+    else:
+        return []
+    stages = assess(result, settlement)
+    if stages is None:
+        return []
+    return [
+        KeyNumber("assessed_settlement", settlement, "m", "settlement parameter of the stage 1 and 2 assessment"),
+        KeyNumber("greenfield_slope", stages.slope, "1", "stage 1: largest greenfield slope under the wall"),
+        KeyNumber("greenfield_settlement", stages.greenfield_settlement, "m",
+                  "stage 1: largest greenfield settlement under the wall"),
+        KeyNumber("screened_out", float(stages.screened_out), "1",
+                  "stage 1: 1 if the slope stays under 1/500 and the settlement under 10 mm (negligible risk)"),
+        KeyNumber("ltsm_strain", stages.strain, "1", "stage 2: the limiting tensile strain method's governing strain"),
+        KeyNumber("ltsm_category", float(stages.category), "1",
+                  "stage 2: LTSM damage category (0 negligible .. 4 severe to very severe)"),
+    ]
+
+
 def key_numbers(result: xr.Dataset) -> list[KeyNumber]:
     """The numbers a user came for, whatever the solver.
 
@@ -489,6 +515,7 @@ def key_numbers(result: xr.Dataset) -> list[KeyNumber]:
         if f"step_{name}" in result and result[f"step_{name}"].size:
             numbers.append(KeyNumber(name, float(result[f"step_{name}"].values[-1]), "1" if "ratio" in name else "rad",
                                      what))
+    numbers += _assessment_numbers(result)
     if "macro_block" in result:
         masonry = masonry_blocks(result.block_role.values)
         count = np.unique(result.macro_block.values[masonry]).size

@@ -103,6 +103,12 @@ class SpecTable:
             raise SpecError(f"spec key {self.key(name)!r} = {value!r}: must be less than {below}")
         return float(value) * (self.scale if length else 1.0)
 
+    def flag(self, name: str, default=_REQUIRED) -> bool:
+        value = self.raw(name, default)
+        if not isinstance(value, bool):
+            raise SpecError(f"spec key {self.key(name)!r} = {value!r}: must be true or false")
+        return value
+
     def choice(self, name: str, choices: tuple[str, ...], default=_REQUIRED) -> str:
         value = self.raw(name, default)
         if value not in choices:

@@ -32,9 +32,9 @@ COMPARATOR = mf.Comparator(
 
 
 def _plotter(name: str, summary: str, options: tuple = (), table: bool = False,
-             side_by_side: bool = False) -> mf.Plotter:
-    return mf.Plotter(name, summary, mf.lazy(f"masonryfw_compare.plotting:draw_{name}"), options=options,
-                      table=mf.lazy(f"masonryfw_compare.plotting:{name}_table") if table else None,
+             side_by_side: bool = False, module: str = "plotting") -> mf.Plotter:
+    return mf.Plotter(name, summary, mf.lazy(f"masonryfw_compare.{module}:draw_{name}"), options=options,
+                      table=mf.lazy(f"masonryfw_compare.{module}:{name}_table") if table else None,
                       side_by_side=side_by_side)
 
 
@@ -63,5 +63,8 @@ PLOTTERS = {
                  table=True),
         _plotter("compare", "two or more results side by side with their scores",
                  (AMPLIFICATION_OPTION, THRESHOLD_OPTION), side_by_side=True),
+        _plotter("ltsm", "the engineers' stage 2 over a settlement profile: the trough under the wall and the LTSM "
+                 "interaction chart (deflection ratio against horizontal strain, the category zones, the wall's "
+                 "sagging and hogging parts)", module="ltsm_plot"),
     )
 }

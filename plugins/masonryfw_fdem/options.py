@@ -11,7 +11,8 @@ OPTIONS = (
               ("rigid", "deformable")),
     mf.Option("settlement", float, None,
               "target settlement of the moving support [m] along settlement_direction (0: gravity only); "
-              "auto: settlement_ratio x masonry height", at_least=0.0),
+              "auto: the model's settlement_target (a tunnel's S_max) if it has one, else settlement_ratio x "
+              "masonry height", at_least=0.0),
     mf.Option("settlement_ratio", float, 0.02,
               "target settlement as a share of the masonry height when settlement is auto (0: gravity only)",
               at_least=0.0),
@@ -57,9 +58,10 @@ OPTIONS = (
               above=0.0),
     mf.Option("max_steps", int, 20_000_000, "hard limit on the number of time steps", above=0),
     mf.Option("records", int, 400, "history records over the target settlement", above=0),
-    mf.Option("plateau_tolerance", float, 0.005,
+    mf.Option("plateau_tolerance", float, None,
               "stop when the reaction varies less than this share of the dead reaction over "
-              "plateau_window of the target settlement; 0 = always run to the target", at_least=0.0),
+              "plateau_window of the target settlement; 0 = always run to the target; auto: 0 when the target "
+              "is the model's settlement_target, else 0.005", at_least=0.0),
     mf.Option("plateau_window", float, 0.25, "share of the target settlement over which the plateau is judged",
               above=0.0, at_most=1.0),
     mf.Option("buffer_ratio", float, 0.1,

@@ -42,6 +42,28 @@ def masonry_height(scene: Scene) -> float:
     return float(np.ptp(y[free_nodes]))
 
 
+#: The reaction plateau that stops a run when the target is not the model's own (share of the dead reaction).
+PLATEAU_TOLERANCE = 0.005
+
+
+def target_settlement(scene: Scene, options: Mapping[str, Any]) -> float:
+    """The settlement a run goes to [m]: the option, else the model's settlement_target, else a share of the
+    masonry height."""
+    if options["settlement"] is not None:
+        return options["settlement"]
+    if "settlement_target" in scene.model:
+        return float(scene.model.settlement_target.values)
+    return options["settlement_ratio"] * masonry_height(scene) * scene.scales.length
+
+
+def plateau_tolerance(scene: Scene, options: Mapping[str, Any]) -> float:
+    """The option, else none when the run goes to the model's settlement_target (the damage there is the
+    answer), else :data:`PLATEAU_TOLERANCE`."""
+    if options["plateau_tolerance"] is not None:
+        return options["plateau_tolerance"]
+    return 0.0 if options["settlement"] is None and "settlement_target" in scene.model else PLATEAU_TOLERANCE
+
+
 def make_controls(scene: Scene, options: Mapping[str, Any]) -> Controls:
     length, force = scene.scales.length, scene.scales.force
     if options["contact_stiffness"] is not None:
@@ -52,7 +74,7 @@ def make_controls(scene: Scene, options: Mapping[str, Any]) -> Controls:
     dt_critical = critical_time_step(scene, kn)
     dt = options["dt_safety"] * dt_critical
     height = masonry_height(scene)
-    target = options["settlement"] / length if options["settlement"] is not None else options["settlement_ratio"] * height
+    target = target_settlement(scene, options) / length
     rate = options["loading_rate"] * np.sqrt(height)
     target_time = target / rate if rate > 0 else 0.0
     record_steps = max(1, int(target_time / dt / options["records"])) if target > 0 else 2000
@@ -78,7 +100,7 @@ def make_controls(scene: Scene, options: Mapping[str, Any]) -> Controls:
         sleep_speed=options["sleep"] * rate,
         sleep_steps=options["sleep_steps"],
         wake_force=options["wake_force"],
-        plateau_tolerance=options["plateau_tolerance"],
+        plateau_tolerance=plateau_tolerance(scene, options),
         plateau_window=options["plateau_window"],
         snapshots=tuple(v / length for v in options["snapshots"]),
         search=searches(scene, options),

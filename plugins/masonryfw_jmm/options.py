@@ -40,16 +40,19 @@ INCREMENTAL_OPTIONS = (
     mf.Option("target_iterations", int, 3,
               "increments grow by 1.5 after steps of at most this many Newton iterations, halve after twice as many",
               above=0),
-    mf.Option("max_settlement", float, None, "stop at this settlement [m]; auto: 30 elastic unloading settlements",
+    mf.Option("settlement", float, None, "target settlement [m]: the run stops there (or earlier, at the reaction "
+              "plateau); auto: the model's settlement_target (a tunnel's S_max) if it has one, else 30 elastic "
+              "unloading settlements",
               above=0.0),
     mf.Option("max_steps", int, 200, "largest number of settlement (or load-factor) steps", above=0),
     mf.Option("load_increment", float, 0.05,
               "without a moving support: the first increment of the live load's factor", above=0.0),
     mf.Option("load_tolerance", float, 1e-3,
               "without a moving support: the run ends when a halved load increment falls below this", above=0.0),
-    mf.Option("plateau_slope", float, 0.01, "plateau: |dR/ds| (or, without a moving support, the load factor's "
+    mf.Option("plateau_slope", float, None, "plateau: |dR/ds| (or, without a moving support, the load factor's "
               "rate per unit displacement) below this fraction of the elastic (first step's) one ... "
-              "(0: no plateau stop, run to max_settlement)", at_least=0.0),
+              "(0: no plateau stop, run to the target settlement); auto: 0 when the target is the model's "
+              "settlement_target, else 0.01", at_least=0.0),
     mf.Option("plateau_steps", int, 3, "... over this many consecutive steps", above=0),
 )
 

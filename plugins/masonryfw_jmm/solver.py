@@ -164,7 +164,7 @@ def run(problem: Problem, options, progress) -> tuple[State, History, dict]:
             return state, history, info
         unloading, slope = elastic_unloading_settlement(newton, state)
         info["jmm_elastic_unloading_settlement_m"] = unloading * problem.displacement
-        limit = (options["max_settlement"] / problem.displacement if options["max_settlement"] is not None
+        limit = (options["settlement"] / problem.displacement if options["settlement"] is not None
                  else 30 * unloading)
         increment, settlement = options["first_increment"] * unloading, 0.0
         largest = options["max_increment"] * unloading
@@ -195,7 +195,7 @@ def run(problem: Problem, options, progress) -> tuple[State, History, dict]:
                 info["stop_reason"] = "reaction plateau"
                 break
             if settlement >= limit:
-                info["stop_reason"] = "max_settlement reached"
+                info["stop_reason"] = "target settlement reached"
                 break
             if report.iterations <= options["target_iterations"]:
                 increment = min(1.5 * increment, largest)
@@ -342,9 +342,24 @@ def result_dataset(problem: Problem, model: xr.Dataset, state: State, history: H
     return xr.Dataset(variables, attrs=attrs)
 
 
+#: The plateau slope when the target is not the model's own (share of the elastic slope).
+PLATEAU_SLOPE = 0.01
+
+
+def with_targets(model: xr.Dataset, options) -> dict:
+    """The options with the automatic target and plateau resolved: the settlement, else the model's
+    settlement_target (None: 30 elastic unloading settlements); no plateau stop when the run goes to the
+    model's target (the damage there is the answer), else :data:`PLATEAU_SLOPE`."""
+    own_target = options["settlement"] is None and "settlement_target" in model
+    settlement = float(model.settlement_target.values) if own_target else options["settlement"]
+    slope = options["plateau_slope"] if options["plateau_slope"] is not None else 0.0 if own_target else PLATEAU_SLOPE
+    return {**options, "settlement": settlement, "plateau_slope": slope}
+
+
 def solve(model: xr.Dataset, options, progress) -> xr.Dataset:
     """Solve ``model`` with the Jointed Masonry Model, settlement (or load factor) step by step: the ``jmm``
     solver entry point."""
+    options = with_targets(model, options)
     problem = build_problem(model, options)
     state, history, info = (run_load_factor if problem.searches_load else run)(problem, options, progress)
     if info["interrupted"] and len(history.iterations) == 0:

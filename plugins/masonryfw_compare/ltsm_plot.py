@@ -1,0 +1,117 @@
+"""The ``ltsm`` plot: the engineers' stage 2 of a result over a settlement profile.
+
+Above, the greenfield trough under the wall with its sagging and hogging parts; below, the classic
+interaction chart (Burland 1995; Boscardin & Cording 1989): the deflection ratio against the horizontal
+strain, the zones of the LTSM categories for the governing part's length over height and neutral axis, and
+every part of the wall as a point at the assessed settlement. The numbers are :mod:`masonryfw.assessment`'s.
+"""
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+import numpy as np
+import xarray as xr
+from matplotlib.patches import Rectangle
+
+import masonryfw as mf
+from masonryfw.assessment import LTSM_LIMITS, POISSON, Part, assess, deep_beam_strains, wall_extent
+
+from .plotting import DAMAGE_COLOURS, _single, title_of
+
+ZONE_NAMES = ("0 negligible", "1 very slight", "2 slight", "3 moderate", "4-5 severe to very severe")
+
+
+def assessed_settlement(ds: xr.Dataset) -> float:
+    """The settlement parameter the plot assesses: the last record's, else the model's settlement_target."""
+    if "step_settlement" in ds and ds.step_settlement.size:
+        return float(ds.step_settlement.values[-1])
+    if "settlement_target" in ds:
+        return float(ds.settlement_target.values)
+    raise mf.MasonryError("the ltsm plot needs a settlement: a result with a history (fdem, jmm) or a model with "
+                          "a settlement_target (a tunnel's S_max)")
+
+
+def zone_boundary(limit: float, strain: np.ndarray, part: Part, height: float) -> np.ndarray:
+    """The deflection ratio at which a part like ``part`` (its length, height and neutral axis) reaches the
+    LTSM strain ``limit`` at the horizontal strains ``strain``: the smaller of the bending and the diagonal
+    route; nan where the horizontal strain alone reaches it."""
+    length = part.end - part.start
+    per_bending, per_diagonal = deep_beam_strains(1.0, length, height, part.sagging)
+    bending = (limit - strain) / per_bending
+    nu = POISSON
+    square = (limit - strain * (1 - nu) / 2) ** 2 - (strain * (1 + nu) / 2) ** 2
+    diagonal = np.sqrt(np.where(square > 0, square, np.nan)) / per_diagonal
+    ratio = np.fmin(bending, diagonal)
+    return np.where((ratio >= 0) & (limit - strain * (1 - nu) / 2 > 0), ratio, np.nan)
+
+
+def draw_ltsm(datasets: Sequence[xr.Dataset], ax, options: Mapping[str, Any]) -> None:
+    """The trough under the wall and the interaction chart with the wall's parts (module docstring)."""
+    ds = _single(datasets, "ltsm")
+    settlement = assessed_settlement(ds)
+    stages = assess(ds, settlement)
+    if stages is None:
+        raise mf.MasonryError("the ltsm plot needs a model built over a settlement profile ([settlement] in its spec)")
+    profile = mf.model_profile(ds)
+    x_a, x_b, height = wall_extent(ds)
+    figure, spec = ax.figure, ax.get_subplotspec()
+    ax.set_axis_off()
+    trough, chart = (figure.add_subplot(g) for g in spec.subgridspec(2, 1, height_ratios=(1, 2), hspace=0.08))
+    _draw_trough(trough, profile, stages, settlement, x_a, x_b, height)
+    _draw_chart(chart, stages, settlement, height)
+    trough.set_title(f"{title_of(ds)}: stage 2 (LTSM) at S_max = {1e3 * settlement:.3g} mm\n"
+                     f"LTSM strain {100 * stages.strain:.3g} %, category {ZONE_NAMES[stages.category]}; stage 1: slope "
+                     f"1/{1 / max(stages.slope, 1e-12):.0f}, settlement {1e3 * stages.greenfield_settlement:.3g} mm"
+                     f"{' (screened out)' if stages.screened_out else ''}", fontsize="medium")
+
+
+def _draw_trough(ax, profile, stages, settlement: float, x_a: float, x_b: float, height: float) -> None:
+    """The greenfield settlement below the wall, drawn as a box, its parts shaded by kind."""
+    margin = 0.5 * (x_b - x_a)
+    x = np.linspace(x_a - margin, x_b + margin, 400)
+    ax.plot(x, -1e3 * settlement * profile.rate(x), color="0.2", lw=1.4, label="greenfield settlement")
+    depth = 1e3 * settlement
+    for part in stages.parts:
+        colour = "#4575b4" if part.sagging else "#d73027"
+        ax.add_patch(Rectangle((part.start, 0.15 * depth), part.end - part.start, 0.5 * depth, facecolor=colour,
+                               alpha=0.35, edgecolor=colour))
+        ax.text(0.5 * (part.start + part.end), 0.4 * depth, "sagging" if part.sagging else "hogging", ha="center",
+                va="center", fontsize="small")
+    ax.axhline(0.0, color="0.6", lw=0.6)
+    ax.set_xlim(x[0], x[-1])
+    ax.set_ylim(-1.15 * depth, 0.8 * depth)
+    ax.set_ylabel("settlement [mm]")
+    ax.set_xlabel(f"x [m]; the wall from {x_a:.3g} to {x_b:.3g} m, {height:.3g} m high (boxes: its parts)")
+    ax.grid(alpha=0.3)
+
+
+def _draw_chart(ax, stages, settlement: float, height: float) -> None:
+    """Deflection ratio against horizontal strain [%]: the zones for the governing part, the parts as points."""
+    governing = max(stages.parts, key=lambda p: p.strain)
+    points = [(100 * settlement * p.horizontal_strain, 100 * settlement * p.deflection_ratio) for p in stages.parts]
+    top_strain = max(0.35, 1.15 * max(s for s, _ in points))
+    low_strain = min(0.0, 1.15 * min(s for s, _ in points))
+    strain = np.linspace(low_strain, top_strain, 600)
+    boundaries = [100 * zone_boundary(limit, strain / 100, governing, height) for limit in LTSM_LIMITS]
+    ceiling = max(1.15 * max(r for _, r in points), 1.2 * float(np.nanmax(boundaries[-1])))
+    lower = np.zeros_like(strain)
+    for category, upper in enumerate([*boundaries, np.full_like(strain, ceiling)]):
+        upper = np.where(np.isnan(upper), 0.0, np.minimum(upper, ceiling))
+        ax.fill_between(strain, lower, np.maximum(upper, lower), color=DAMAGE_COLOURS[category], alpha=0.35, lw=0,
+                        label=ZONE_NAMES[category])
+        lower = np.maximum(upper, lower)
+    for part, (x, y) in zip(stages.parts, points):
+        ax.plot(x, y, "o" if part.sagging else "s", ms=7, color="k", mfc="#4575b4" if part.sagging else "#d73027")
+        ax.annotate(f"{'sagging' if part.sagging else 'hogging'} {part.start:.3g}..{part.end:.3g} m "
+                    f"(L/H {(part.end - part.start) / height:.2g}): {100 * settlement * part.strain:.3g} %",
+                    (x, y), textcoords="offset points", xytext=(6, 4), fontsize="small")
+    ax.set_xlim(low_strain, top_strain)
+    ax.set_ylim(0.0, ceiling)
+    ax.set_xlabel("horizontal strain [%] (tension positive)")
+    ax.set_ylabel("deflection ratio [%]")
+    kind = "sagging" if governing.sagging else "hogging"
+    ax.legend(loc="upper right", fontsize="small",
+              title=f"zones for the governing part: {kind}, L/H = {(governing.end - governing.start) / height:.2g}",
+              title_fontsize="small")
+    ax.grid(alpha=0.3)
