@@ -101,6 +101,16 @@ from .semantics import (
     support_blocks,
 )
 from .spec import dump_toml
-from .summary import Row, csv_text, headline_rows, headline_text, result_label, result_options, score_rows, text_table
+from .summary import (
+    Row,
+    csv_text,
+    headline_rows,
+    headline_text,
+    result_label,
+    result_options,
+    score_rows,
+    stages_text,
+    text_table,
+)
 
 __all__ = [name for name in dir() if not name.startswith("_")]

@@ -45,7 +45,7 @@ from .errors import SpecError
 from .imported import build_drawn, is_drawn, parse_drawn_spec, resolved_drawing
 from .model import checked_model
 from .plausibility import warn_implausible
-from .profiles import Profile, profile_segments, read_profile, with_profile
+from .profiles import SETTLEMENT_KEYS, Profile, profile_segments, read_profile, with_profile
 from .schema import flags
 from .spec import (
     LENGTH_UNITS,
@@ -186,7 +186,8 @@ def parse_spec(spec: dict) -> Wall:
     )
     result = replace(result, openings=_openings(top, result))
     if top.has("settlement"):
-        result = replace(result, profile=read_profile(top, result.width, result.unit_length))
+        table = top.sub("settlement", SETTLEMENT_KEYS)
+        result = replace(result, profile=read_profile(table, 0.0, result.width, result.unit_length))
         result = replace(result, supports=_profile_supports(result))
     return result
 

@@ -65,7 +65,7 @@ class _MasonryGroup(click.Group):
         try:
             with warnings.catch_warnings():
                 warnings.showwarning = _show_warning
-                warnings.simplefilter("default")
+                warnings.simplefilter("default", mf.PlausibilityWarning)  # each shown, whoever catches warnings
                 return super().invoke(ctx)
         except Interrupted as exc:
             click.echo(str(exc), err=True)
@@ -339,6 +339,9 @@ def solve(model: str, solver: str, output: str | None, options: dict[str, str], 
     stop = f"; {result.attrs['stop_reason']}" if result.attrs.get("stop_reason") else ""
     click.echo(f"result: {out}")
     click.echo(f"{solver}: {numbers + stop + '; ' if numbers else ''}wall time {result.attrs['wall_time_s']:.3g} s")
+    stages = mf.stages_text(result)
+    if stages:
+        click.echo(f"stages {stages}")
 
 
 def _last_settlement(result) -> str:

@@ -117,7 +117,8 @@ def _read_dxf(path: Path, drawing_unit: str | None, chord_tolerance: float | Non
     import ezdxf  # here, not at the top: only a drawing needs it
     from ezdxf import recover
 
-    binary = path.open("rb").read(len(BINARY_DXF)) == BINARY_DXF
+    with path.open("rb") as handle:
+        binary = handle.read(len(BINARY_DXF)) == BINARY_DXF
     ezdxf_log = logging.getLogger("ezdxf")
     level = ezdxf_log.level
     ezdxf_log.setLevel(logging.CRITICAL)  # its repairs would print lines of the file; a failure is ours to say

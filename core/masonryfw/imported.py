@@ -42,21 +42,23 @@ from .drawing import DRAWING_UNITS, Drawing, read_drawing
 from .errors import ModelError, SpecError
 from .geometry import block_bounds, polygon_area_centroid
 from .model import checked_model
+from .profiles import SETTLEMENT_KEYS, profile_segments, read_profile, with_profile
 from .schema import flags
 from .spec import LENGTH_UNITS, SpecTable, check_pivot, read_loading, read_material, read_motion
 
 LAYER_ROLES = ("unit", "lintel", "ignore")
 _BLOCK = re.compile(r"\bblock (\d+)\b")
 SELECTIONS = ("lowest", "leftmost", "rightmost")
-_TOP_KEYS = ("title", "description", "length_unit", "geometry", "wall", "material", "supports", "loading")
+_TOP_KEYS = ("title", "description", "length_unit", "geometry", "wall", "material", "supports", "settlement",
+             "loading")
+#: The keys a drawn wall's ``[settlement]`` takes beside a profile's: which drawn blocks are the ground.
+GROUND_KEYS = ("ground_layer", "ground_select")
 _GEOMETRY_KEYS = ("dxf", "polygons", "drawing_unit", "chord_tolerance", "snap_tolerance", "layers")
 _SUPPORT_KEYS = ("kind", "select", "layer", "at", "motion", "pivot", "rate")
 _PARAMETRIC = {
     "unit": "the drawing gives the blocks",
     "bond": "the drawing gives the blocks",
     "openings": "openings are drawn (left empty) in the drawing",
-    "settlement": "its supports are drawn: give each moving support its rate, or cut the drawn base into "
-                  "segments with the rates of the profile",
 }
 
 
@@ -91,6 +93,7 @@ class DrawnSpec:
     supports: tuple[DrawnSupport, ...]
     loading: str
     tilt_direction: int
+    settlement: SpecTable | None = None  # the [settlement] table, read once the drawing gives the wall's extent
 
 
 def is_drawn(spec: dict) -> bool:
@@ -131,8 +134,12 @@ def parse_drawn_spec(spec: dict) -> DrawnSpec:
                             "(the drawing gives its size)")
     wall = top.sub("wall", ("thickness",))
     material = read_material(top)
-    supports = _drawn_supports(top, layers)
-    loading, direction = read_loading(top, any(s.kind == "moving" for s in supports))
+    settlement = top.sub("settlement", SETTLEMENT_KEYS + GROUND_KEYS) if top.has("settlement") else None
+    if settlement is not None and top.has("supports"):
+        raise SpecError("spec tables 'settlement' and 'supports': give one of them (the profile makes the supports; "
+                        "drawn ground blocks are chosen by settlement.ground_layer or settlement.ground_select)")
+    supports = () if settlement is not None else _drawn_supports(top, layers)
+    loading, direction = read_loading(top, settlement is not None or any(s.kind == "moving" for s in supports))
     return DrawnSpec(
         title=top.text("title"),
         description=top.text("description", ""),
@@ -147,6 +154,7 @@ def parse_drawn_spec(spec: dict) -> DrawnSpec:
         supports=supports,
         loading=loading,
         tilt_direction=direction,
+        settlement=settlement,
     )
 
 
@@ -196,22 +204,6 @@ def build_drawn(spec_dict: dict, text: str, base_dir: Path | None, validate: boo
         raise SpecError(f"spec key {spec.drawing_key!r} = {spec.drawing!r}: no such file ({path})")
     drawing = read_drawing(path, spec.drawing_unit, spec.chord_tolerance, spec.snap_tolerance)
     kept = np.array([spec.layers.get(layer, "unit") != "ignore" for layer in drawing.layers])
-    chosen = _support_blocks(spec, drawing, kept)
-    role_flag = flags("block_role")
-    supports_of = np.full(len(drawing.layers), -1)
-    for index, members in enumerate(chosen):
-        supports_of[members] = index
-    masonry = np.flatnonzero(kept & (supports_of < 0))
-    if masonry.size == 0:
-        raise SpecError(f"drawing {path.name!r}: every block is a support or ignored; nothing to analyse")
-    support_order = np.concatenate([members for members in chosen])
-    order = np.concatenate((masonry, support_order))
-    roles = np.array([role_flag["lintel"] if spec.layers.get(drawing.layers[b]) == "lintel" else role_flag["unit"]
-                      for b in masonry] + [role_flag["fixed_support"]] * support_order.size, dtype=np.int8)
-    described = [blocks.Support(f"spec key 'supports.{s.name}'", s.kind, s.motion, s.pivot, s.rate)
-                 for s, members in zip(spec.supports, chosen) for _ in members]
-    node_x, node_y, counts = _reordered(drawing, order)
-    _check_pivots(spec, chosen, drawing)
     attrs = {
         "title": spec.title,
         "source_spec": text,
@@ -220,10 +212,10 @@ def build_drawn(spec_dict: dict, text: str, base_dir: Path | None, validate: boo
     }
     if spec.description:
         attrs["comment"] = spec.description
-    labels = [drawing.label(b) for b in order]
-    ds = blocks.model_from_blocks(node_x, node_y, counts, roles, spec.thickness, spec.material, described,
-                                  spec.loading, spec.tilt_direction, attrs)
-    _refuse_lonely_supports(ds, spec, chosen, masonry.size, labels)
+    if spec.settlement is None:
+        ds, labels = _drawn_supports_model(spec, drawing, kept, path, attrs)
+    else:
+        ds, labels = _ground_model(spec, drawing, kept, path, attrs)
     if not validate:
         return ds
     try:
@@ -232,6 +224,123 @@ def build_drawn(spec_dict: dict, text: str, base_dir: Path | None, validate: boo
         raise ModelError(f"model {spec.title!r} from drawing {path.name!r} is invalid "
                          f"({len(exc.problems)} problem(s))",
                          [_labelled(p, labels) for p in exc.problems]) from None
+
+
+def _masonry_roles(spec: DrawnSpec, drawing: Drawing, masonry: np.ndarray) -> list[int]:
+    role_flag = flags("block_role")
+    return [role_flag["lintel"] if spec.layers.get(drawing.layers[b]) == "lintel" else role_flag["unit"]
+            for b in masonry]
+
+
+def _drawn_supports_model(spec: DrawnSpec, drawing: Drawing, kept: np.ndarray, path: Path,
+                          attrs: dict) -> tuple[xr.Dataset, list[str]]:
+    """The model of a wall on its drawn supports (``[supports.*]``) and the drawing entity of every block."""
+    chosen = _support_blocks(spec, drawing, kept)
+    supports_of = np.full(len(drawing.layers), -1)
+    for index, members in enumerate(chosen):
+        supports_of[members] = index
+    masonry = np.flatnonzero(kept & (supports_of < 0))
+    if masonry.size == 0:
+        raise SpecError(f"drawing {path.name!r}: every block is a support or ignored; nothing to analyse")
+    support_order = np.concatenate([members for members in chosen])
+    order = np.concatenate((masonry, support_order))
+    roles = np.array(_masonry_roles(spec, drawing, masonry) + [flags("block_role")["fixed_support"]] * support_order.size,
+                     dtype=np.int8)
+    described = [blocks.Support(f"spec key 'supports.{s.name}'", s.kind, s.motion, s.pivot, s.rate)
+                 for s, members in zip(spec.supports, chosen) for _ in members]
+    node_x, node_y, counts = _reordered(drawing, order)
+    _check_pivots(spec, chosen, drawing)
+    labels = [drawing.label(b) for b in order]
+    ds = blocks.model_from_blocks(node_x, node_y, counts, roles, spec.thickness, spec.material, described,
+                                  spec.loading, spec.tilt_direction, attrs)
+    _refuse_lonely_supports(ds, spec, chosen, masonry.size, labels)
+    return ds, labels
+
+
+def _ground_model(spec: DrawnSpec, drawing: Drawing, kept: np.ndarray, path: Path,
+                  attrs: dict) -> tuple[xr.Dataset, list[str]]:
+    """The model of a drawn wall over a ``[settlement]`` profile: its ground (the drawn blocks chosen by
+    ``ground_layer`` or ``ground_select``, else a ground one median block high under the masonry's lowest
+    edges) cut into the segments of a continuous ground (:mod:`masonryfw.profiles`), the pieces that carry
+    masonry kept."""
+    import shapely
+
+    ground = _ground_blocks(spec.settlement, drawing, kept)
+    masonry = np.flatnonzero(kept & ~np.isin(np.arange(kept.size), ground))
+    if masonry.size == 0:
+        raise SpecError(f"drawing {path.name!r}: every block is ground or ignored; nothing to analyse")
+    polygons = _polygons(drawing)
+    xmin, xmax, ymin, ymax = block_bounds(drawing.node_x, drawing.node_y, drawing.block_node_count)
+    length = float(np.median(xmax[masonry] - xmin[masonry]))
+    if ground.size:
+        areas = list(polygons[ground])
+    else:
+        base = float(ymin[masonry].min())
+        depth = float(np.median(ymax[masonry] - ymin[masonry]))
+        areas = [shapely.box(float(xmin[masonry].min()), base - depth, float(xmax[masonry].max()), base)]
+    x0, x1 = (float(f(shapely.bounds(areas)[:, k])) for f, k in ((np.min, 0), (np.max, 2)))
+    profile = read_profile(spec.settlement, x0, x1, length)
+    touching = shapely.union_all(polygons[masonry]).boundary
+    tol = 1e-6 * float(np.hypot(np.ptp(drawing.node_x), np.ptp(drawing.node_y)))
+    low, high = float(shapely.bounds(areas)[:, 1].min()) - 1.0, float(ymax.max()) + 1.0
+    pieces, described, labels = [], [], []
+    for k, segment in enumerate(profile_segments(profile, x0, x1, np.array([[x0, x1]]))):
+        strip = shapely.box(segment.start, low, segment.end, high)
+        for area in areas:
+            for piece in shapely.get_parts(shapely.intersection(area, strip)):
+                if piece.geom_type != "Polygon" or shapely.length(shapely.intersection(piece.boundary, touching)) <= tol:
+                    continue
+                name = f"settlement segment {k} [{segment.start:.6g}, {segment.end:.6g}] m"
+                top = float(shapely.bounds(piece)[3])
+                edge = blocks.GroundEdge((segment.start, segment.end), top, segment.down, segment.horizontal)
+                pieces.append(shapely.orient_polygons(piece))
+                described.append(blocks.Support(name, "moving", "ground", ground=edge) if segment.moving
+                                 else blocks.Support(name, "fixed"))
+                labels.append(name)
+    node_x, node_y, counts = _reordered(drawing, masonry)
+    rings = [np.asarray(p.exterior.coords)[:-1] for p in pieces]
+    node_x = np.concatenate([node_x, *(r[:, 0] for r in rings)])
+    node_y = np.concatenate([node_y, *(r[:, 1] for r in rings)])
+    counts = np.concatenate([counts, [r.shape[0] for r in rings]]).astype(np.int32)
+    roles = np.array(_masonry_roles(spec, drawing, masonry) + [flags("block_role")["fixed_support"]] * len(rings),
+                     dtype=np.int8)
+    ds = blocks.model_from_blocks(node_x, node_y, counts, roles, spec.thickness, spec.material, described,
+                                  spec.loading, spec.tilt_direction, attrs)
+    return with_profile(ds, profile), [drawing.label(b) for b in masonry] + labels
+
+
+def _ground_blocks(table: SpecTable, drawing: Drawing, kept: np.ndarray) -> np.ndarray:
+    """The drawing's blocks that are the ground under a ``[settlement]`` (``ground_layer`` or
+    ``ground_select``); empty when the ground is made under the masonry."""
+    if table.has("ground_layer") and table.has("ground_select"):
+        raise SpecError(f"spec keys {table.key('ground_layer')!r} and {table.key('ground_select')!r}: give one of them")
+    if table.has("ground_layer"):
+        layer = table.text("ground_layer")
+        members = np.flatnonzero(kept & (np.array(drawing.layers) == layer))
+        if members.size == 0:
+            raise SpecError(f"spec key {table.key('ground_layer')!r} = {layer!r}: no block of the drawing (left) on "
+                            f"this layer; the drawing's layers: {', '.join(sorted(set(drawing.layers)))}")
+        return members
+    if not table.has("ground_select"):
+        return np.zeros(0, dtype=np.int64)
+    table.choice("ground_select", ("lowest",))
+    _, _, ymin, _ = block_bounds(drawing.node_x, drawing.node_y, drawing.block_node_count)
+    value = np.where(kept, ymin, np.inf)
+    tol = 1e-6 * float(np.hypot(np.ptp(drawing.node_x), np.ptp(drawing.node_y)))
+    best = np.flatnonzero(value <= value.min() + tol)
+    if best.size > 1:
+        raise SpecError(f"spec key {table.key('ground_select')!r} = 'lowest': {best.size} blocks tie "
+                        f"({'; '.join(drawing.label(b) for b in best[:3])}); choose them by ground_layer")
+    return best
+
+
+def _polygons(drawing: Drawing):
+    """The drawing's blocks as shapely polygons."""
+    import shapely
+
+    return shapely.polygons(shapely.linearrings(
+        np.c_[drawing.node_x, drawing.node_y],
+        indices=np.repeat(np.arange(drawing.block_node_count.size), drawing.block_node_count)))
 
 
 def _support_blocks(spec: DrawnSpec, drawing: Drawing, kept: np.ndarray) -> list[np.ndarray]:
@@ -275,9 +384,7 @@ def _support_blocks(spec: DrawnSpec, drawing: Drawing, kept: np.ndarray) -> list
 def _blocks_containing(drawing: Drawing, point, candidates: np.ndarray) -> np.ndarray:
     import shapely
 
-    polygons = shapely.polygons(
-        shapely.linearrings(np.c_[drawing.node_x, drawing.node_y],
-                            indices=np.repeat(np.arange(drawing.block_node_count.size), drawing.block_node_count)))
+    polygons = _polygons(drawing)
     inside = shapely.contains_xy(polygons, point[0], point[1]) | shapely.touches(polygons, shapely.points(point))
     return np.flatnonzero(inside & candidates)
 

@@ -112,16 +112,15 @@ class Segment:
         return max(self.down) > 0
 
 
-def read_profile(top: SpecTable, wall_width: float, unit_length: float) -> Profile:
-    """The ``[settlement]`` table of a spec (``top``: the whole spec, with its length scale); ``segment``
+def read_profile(table: SpecTable, x0: float, x1: float, unit_length: float) -> Profile:
+    """A spec's ``[settlement]`` table (with its length scale) under a wall from ``x0`` to ``x1`` [m]; ``segment``
     defaults to :data:`DEFAULT_SEGMENT_UNITS` unit lengths."""
-    table = top.sub("settlement", SETTLEMENT_KEYS)
     kind = table.choice("profile", PROFILES)
     for key, kinds in _ONLY.items():
         if table.has(key) and kind not in kinds:
             raise SpecError(f"spec key {table.key(key)!r} only applies to profile = "
                             f"{' or '.join(map(repr, kinds))}")
-    segment = table.number("segment", DEFAULT_SEGMENT_UNITS * unit_length / top.scale, length=True, positive=True)
+    segment = table.number("segment", DEFAULT_SEGMENT_UNITS * unit_length / table.scale, length=True, positive=True)
     cutoff = table.number("cutoff", DEFAULT_CUTOFF, minimum=0.0, below=1.0)
     if kind == "gaussian":
         return Profile(kind, segment, cutoff, center=table.number("center", length=True),
@@ -130,9 +129,9 @@ def read_profile(top: SpecTable, wall_width: float, unit_length: float) -> Profi
     if kind == "tunnel":
         return _tunnel(table, segment, cutoff)
     if kind == "linear":
-        start = table.number("start", 0.0, length=True)
-        end = table.number("end", wall_width / top.scale, length=True)
-        if abs(end - start) <= 1e-9 * wall_width:
+        start = table.number("start", x0 / table.scale, length=True)
+        end = table.number("end", x1 / table.scale, length=True)
+        if abs(end - start) <= 1e-9 * (x1 - x0):
             raise SpecError(f"spec keys {table.key('start')!r} and {table.key('end')!r}: must differ "
                             "(the rate grows from 0 at start to 1 at end)")
         return Profile(kind, segment, cutoff, start=start, end=end)

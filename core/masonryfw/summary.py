@@ -53,6 +53,32 @@ def _crack_text(numbers: dict) -> str:
     return _mm(numbers["crack_width"]) + (f" ({'; '.join(where)})" if where else "")
 
 
+def _stage_1(numbers: dict) -> str:
+    verdict = "screened out" if numbers["screened_out"] else "to assess"
+    return (f"slope {_slope(numbers['greenfield_slope'])}, settlement {_mm(numbers['greenfield_settlement'])}: "
+            f"{verdict}")
+
+
+def _stage_2(numbers: dict) -> str:
+    names = {value: name.replace("_", " ") for name, value in flags("step_ltsm_category").items()}
+    return f"{int(numbers['ltsm_category'])} {names[int(numbers['ltsm_category'])]}, strain {100 * numbers['ltsm_strain']:.3g} %"
+
+
+def stages_text(result: xr.Dataset) -> str:
+    """The engineers' three stages side by side in one line (empty for a result without a profile): the
+    greenfield screen, the LTSM, and the model's own answer (its damage category and widest crack, or alpha and
+    the collapse reaction)."""
+    numbers = {n.name: n.value for n in key_numbers(result)}
+    if "ltsm_category" not in numbers:
+        return ""
+    if "damage_category" in numbers:
+        own = f"{_damage_name(numbers['damage_category'])}, widest crack {_crack_text(numbers)}"
+    else:
+        own = f"alpha {numbers['alpha']:.4f}, collapse reaction {numbers.get('collapse_reaction', float('nan')):.4g} N"
+    return (f"at S = {_mm(numbers['assessed_settlement'])}: stage 1 {_stage_1(numbers)}; stage 2 (LTSM) "
+            f"{_stage_2(numbers)}; stage 3 ({result_label(result)}) {own}")
+
+
 def _slope(radians: float) -> str:
     """``1/830`` (the engineers' way of writing a small slope), ``0`` for none."""
     return f"1/{1 / abs(radians):.0f}" if radians else "0"
@@ -83,6 +109,12 @@ _HEADLINES = (
      "largest over the run, Burland et al. (1977) by crack width: 0 negligible .. 5 very severe"),
     ("base_gap", "base gap", lambda n: _mm(n["base_gap"]),
      "widest gap between the wall and the ground over the run (not a crack in the masonry)"),
+    ("greenfield_slope", "stage 1: greenfield", lambda n: _stage_1(n),
+     "the screen at the assessed settlement: the largest greenfield slope and settlement under the wall; under "
+     "1/500 and 10 mm the risk is negligible (Mair, Taylor & Burland 1996)"),
+    ("ltsm_category", "stage 2: LTSM", lambda n: _stage_2(n),
+     "the limiting tensile strain method on the greenfield trough at the assessed settlement: the wall as a deep "
+     "beam (Burland & Wroth 1974; Boscardin & Cording 1989; Burland 1995)"),
     ("deflection_ratio", "deflection ratio", lambda n: f"{n['deflection_ratio']:.3g}",
      "of the imposed ground at the last record: its largest distance from the chord over the chord's length "
      "(sagging positive)"),

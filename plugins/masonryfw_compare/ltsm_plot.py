@@ -87,31 +87,33 @@ def _draw_trough(ax, profile, stages, settlement: float, x_a: float, x_b: float,
 
 
 def _draw_chart(ax, stages, settlement: float, height: float) -> None:
-    """Deflection ratio against horizontal strain [%]: the zones for the governing part, the parts as points."""
+    """Deflection ratio against horizontal strain [%]: the zones for the governing part up to one category above
+    the worst part's (so the parts are not lost in the corner of a chart of every zone), the parts as points."""
     governing = max(stages.parts, key=lambda p: p.strain)
     points = [(100 * settlement * p.horizontal_strain, 100 * settlement * p.deflection_ratio) for p in stages.parts]
-    top_strain = max(0.35, 1.15 * max(s for s, _ in points))
-    low_strain = min(0.0, 1.15 * min(s for s, _ in points))
+    shown = min(stages.category, len(LTSM_LIMITS) - 1)  # the limit above the worst category (the last: itself)
+    top_strain = max(1.15 * 100 * LTSM_LIMITS[shown], 1.3 * max(s for s, _ in points))
+    low_strain = min(0.0, 1.3 * min(s for s, _ in points))
     strain = np.linspace(low_strain, top_strain, 600)
     boundaries = [100 * zone_boundary(limit, strain / 100, governing, height) for limit in LTSM_LIMITS]
-    ceiling = max(1.15 * max(r for _, r in points), 1.2 * float(np.nanmax(boundaries[-1])))
+    ceiling = max(1.15 * float(np.nanmax(boundaries[shown])), 1.3 * max(r for _, r in points))
     lower = np.zeros_like(strain)
     for category, upper in enumerate([*boundaries, np.full_like(strain, ceiling)]):
         upper = np.where(np.isnan(upper), 0.0, np.minimum(upper, ceiling))
         ax.fill_between(strain, lower, np.maximum(upper, lower), color=DAMAGE_COLOURS[category], alpha=0.35, lw=0,
                         label=ZONE_NAMES[category])
         lower = np.maximum(upper, lower)
-    for part, (x, y) in zip(stages.parts, points):
-        ax.plot(x, y, "o" if part.sagging else "s", ms=7, color="k", mfc="#4575b4" if part.sagging else "#d73027")
-        ax.annotate(f"{'sagging' if part.sagging else 'hogging'} {part.start:.3g}..{part.end:.3g} m "
-                    f"(L/H {(part.end - part.start) / height:.2g}): {100 * settlement * part.strain:.3g} %",
-                    (x, y), textcoords="offset points", xytext=(6, 4), fontsize="small")
+    zones = ax.legend(loc="upper right", fontsize="small", title_fontsize="small",
+                      title=f"zones for the governing part: {'sagging' if governing.sagging else 'hogging'}, "
+                            f"L/H = {(governing.end - governing.start) / height:.2g}")
+    parts = [ax.plot(x, y, "o" if part.sagging else "s", ms=7, color="k", mfc="#4575b4" if part.sagging else "#d73027",
+                     label=f"{'sagging' if part.sagging else 'hogging'} {part.start:.3g}..{part.end:.3g} m (L/H "
+                           f"{(part.end - part.start) / height:.2g}): strain {100 * settlement * part.strain:.3g} %")[0]
+             for part, (x, y) in zip(stages.parts, points)]
+    ax.add_artist(zones)
+    ax.legend(handles=parts, loc="upper center", bbox_to_anchor=(0.5, -0.2), ncol=2, fontsize="small", frameon=False)
     ax.set_xlim(low_strain, top_strain)
     ax.set_ylim(0.0, ceiling)
     ax.set_xlabel("horizontal strain [%] (tension positive)")
     ax.set_ylabel("deflection ratio [%]")
-    kind = "sagging" if governing.sagging else "hogging"
-    ax.legend(loc="upper right", fontsize="small",
-              title=f"zones for the governing part: {kind}, L/H = {(governing.end - governing.start) / height:.2g}",
-              title_fontsize="small")
     ax.grid(alpha=0.3)

@@ -650,8 +650,11 @@ SINGLE_RESULT_KINDS = {"mechanism": "block_displacement", "cracks": "interface_o
 
 
 def drawable_kinds(ds: xr.Dataset) -> list[str]:
-    """The one-result kinds ``ds`` can be drawn as, in the order of :data:`SINGLE_RESULT_KINDS`."""
-    return [kind for kind, needs in SINGLE_RESULT_KINDS.items() if needs in ds]
+    """The one-result kinds ``ds`` can be drawn as, in the order of :data:`SINGLE_RESULT_KINDS`; then ``ltsm``
+    for a result over a settlement profile with a settlement to assess."""
+    kinds = [kind for kind, needs in SINGLE_RESULT_KINDS.items() if needs in ds]
+    assessed = ("step_settlement" in ds and ds.step_settlement.size) or "settlement_target" in ds
+    return kinds + (["ltsm"] if ds.attrs.get("settlement_profile") and assessed else [])
 
 
 def panel_kind(ds: xr.Dataset) -> str:

@@ -123,6 +123,9 @@ def _result_figures(ds: xr.Dataset, label: str) -> list[str]:
         "cracks": "joints that open, slide or both.",
         "forces": f"joint resultants {_forces_state(ds)}; colour: the share of the friction used.",
         "plastic": "plastic quadrature points of the continuum.",
+        "ltsm": "the engineers' stages 1 and 2 beside the model: the greenfield trough under the wall, its sagging "
+                "and hogging parts, and the LTSM chart (deflection ratio against horizontal strain, the category "
+                "zones for the governing part) at the assessed settlement.",
     }
     return [_figure([ds], kind, f"{label}: {captions[kind]}") for kind in drawable_kinds(ds)]
 

@@ -36,7 +36,8 @@ INCREMENTAL_OPTIONS = (
     mf.Option("first_increment", float, 0.05,
               "first settlement increment, as a fraction of the elastic settlement that would unload the support",
               above=0.0),
-    mf.Option("max_increment", float, 1.0, "largest settlement increment, same unit as first_increment", above=0.0),
+    mf.Option("max_increment", float, 1.0, "largest settlement increment, same unit as first_increment (with a "
+              "target settlement: at least the target over 50)", above=0.0),
     mf.Option("target_iterations", int, 3,
               "increments grow by 1.5 after steps of at most this many Newton iterations, halve after twice as many",
               above=0),

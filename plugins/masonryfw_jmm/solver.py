@@ -21,6 +21,9 @@ from .output import block_mechanism, mesh_variables, point_variables, variable, 
 from .problem import Problem, build_problem
 
 MIN_INCREMENT = 1e-4  # of the elastic unloading settlement: below it a failing step stops the run
+#: The increments may grow to the target settlement over this many (a tunnel's S_max is often hundreds of
+#: elastic unloading settlements away; without it max_steps ends the run first).
+TARGET_STEPS = 50
 
 
 @dataclass(frozen=True)
@@ -168,6 +171,8 @@ def run(problem: Problem, options, progress) -> tuple[State, History, dict]:
                  else 30 * unloading)
         increment, settlement = options["first_increment"] * unloading, 0.0
         largest = options["max_increment"] * unloading
+        if options["settlement"] is not None:  # a target far away: reachable in TARGET_STEPS full increments
+            largest = max(largest, limit / TARGET_STEPS)
         last_increment = None  # (du, ds) of the last converged step, extrapolated as a second predictor
         while True:
             if history.steps >= options["max_steps"]:

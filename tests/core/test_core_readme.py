@@ -112,3 +112,23 @@ def test_the_tour_ends_with_a_report_and_its_last_step_runs_as_written(tmp_path)
     text = (tmp_path / "test-12c.html").read_text()
     assert text.count("<img ") >= 10 and (tmp_path / "history.pdf").stat().st_size > 1000
     assert (tmp_path / "history.csv").read_text().startswith("result,record,stage,settlement_m,reaction_N")
+
+
+def test_the_tunnel_step_of_the_tour_runs_as_written(tmp_path):
+    """Step 1d: fdem runs the bundled facade to its trough's S_max (15 mm: V_L 1 %, D 6 m, z0 15 m, K 0.5) and
+    prints the three stages; the ltsm chart is drawn; la assesses stages 1 and 2 at S_max."""
+    step = README[README.index("**1d. Or ask what a planned tunnel does to it.**"):README.index("**2. Solve, look")]
+    commands = [line.strip().split("#")[0].split() for line in step.splitlines() if line.startswith("    masonryfw ")]
+    assert len(commands) == 3
+    outputs = []
+    for words in commands:
+        done = subprocess.run([sys.executable, "-m", "masonryfw", *words[1:], "--no-progress"]
+                              if words[1] == "solve" else [sys.executable, "-m", "masonryfw", *words[1:]],
+                              cwd=tmp_path, capture_output=True, text=True, timeout=300)
+        assert done.returncode == 0, (words, done.stderr)
+        outputs.append(done.stdout)
+    assert "stages at S = 15 mm: stage 1" in outputs[0] and "stage 2 (LTSM)" in outputs[0] and "stage 3 (fdem)" in outputs[0]
+    assert "stage 3 (la" in outputs[2]
+    fdem = mf.open_dataset(tmp_path / "tunnel-facade.fdem.nc")
+    assert float(fdem.step_settlement.values[-1]) >= 0.999 * float(fdem.settlement_target.values)
+    assert (tmp_path / "ltsm.png").stat().st_size > 20_000

@@ -131,13 +131,6 @@ def test_rate_keys_are_checked():
         mf.build(spec)
 
 
-def test_a_drawn_wall_refuses_a_settlement_table_and_says_why():
-    spec = mf.load_spec(mf.bundled_spec_path("arch-settlement"))
-    spec["settlement"] = TROUGH
-    with pytest.raises(mf.SpecError, match="'settlement' does not apply to a wall drawn in \\[geometry\\]"):
-        mf.build(spec)
-
-
 @pytest.mark.parametrize(("width_mm", "category"), [
     (0.0, 0), (0.05, 0), (0.1, 0), (0.11, 1), (1.0, 1), (1.2, 2), (5.0, 2), (7.0, 3), (15.0, 3), (20.0, 4),
     (25.0, 4), (30.0, 5),

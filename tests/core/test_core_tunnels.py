@@ -120,3 +120,115 @@ def test_tunnel_trough_is_the_closed_form():
 def test_bad_tunnels_are_named(change, message):
     with pytest.raises(mf.SpecError, match=message.replace("(", r"\(").replace(")", r"\)")):
         mf.build({**FACADE, "settlement": {**TUNNEL, **change}})
+
+
+def drawn_copy(model, path) -> dict:
+    """The masonry of a built model written as a GeoJSON drawing (in metres), and a spec for it."""
+    import json
+
+    role = model.block_role.values
+    starts = np.r_[0, np.cumsum(model.block_node_count.values)]
+    features = []
+    for b in np.flatnonzero(mf.masonry_blocks(role)):
+        ring = np.c_[model.node_x.values[starts[b]:starts[b + 1]], model.node_y.values[starts[b]:starts[b + 1]]]
+        features.append({"type": "Feature", "properties": {"layer": "0"},
+                         "geometry": {"type": "Polygon", "coordinates": [ring.tolist() + [ring[0].tolist()]]}})
+    path.write_text(json.dumps({"type": "FeatureCollection", "features": features}))
+    return {"title": "drawn", "geometry": {"polygons": str(path), "drawing_unit": "m"}, "wall": {"thickness": 0.25},
+            "material": FACADE["material"], "loading": {"type": "settlement"}}
+
+
+def test_a_drawn_facade_goes_over_a_tunnel_like_a_parametric_one(tmp_path):
+    """The facade's blocks drawn as polygons and given the same [settlement]: the ground is made under the
+    lowest masonry and cut into the same segments, so the model is the same (blocks, interfaces, supports'
+    motions, S_max) and la's alpha and R0 agree to 1e-12."""
+    parametric = mf.build({**FACADE, "settlement": TUNNEL})
+    drawn = mf.build({**drawn_copy(parametric, tmp_path / "f.geojson"), "settlement": TUNNEL})
+    assert drawn.sizes == parametric.sizes
+    np.testing.assert_allclose(drawn.settlement_direction.values, parametric.settlement_direction.values, atol=1e-12)
+    assert float(drawn.settlement_target) == float(parametric.settlement_target)
+    a, b = (mf.solve(m, "la") for m in (parametric, drawn))
+    assert float(b.collapse_multiplier) == pytest.approx(float(a.collapse_multiplier), abs=1e-12)
+    assert mf.dead_reaction(drawn) == pytest.approx(mf.dead_reaction(parametric), rel=1e-12)
+
+
+def test_a_drawn_ground_block_is_cut_into_the_continuous_ground():
+    """LACT3's wall over a trough, its drawn base block chosen as the ground: the base is cut into segments
+    whose tops follow the ground (neighbours meet), every piece carries masonry, and la solves it."""
+    spec = mf.load_spec(mf.bundled_spec_path("lact3-wall"))
+    del spec["supports"]
+    spec["loading"] = {"type": "settlement"}
+    spec["settlement"] = {"profile": "gaussian", "center": 1.0, "width": 0.5, "ground_select": "lowest"}
+    model = mf.build(spec)
+    moving = np.flatnonzero(model.block_role.values == mf.flags("block_role")["moving_support"])
+    assert moving.size > 20
+    x0 = model.node_x.values[np.r_[0, np.cumsum(model.block_node_count.values)][moving]]
+    order = moving[np.argsort(x0)]
+    d = model.settlement_direction.values[order]
+    cx = model.block_centroid_x.values[order]
+    xmin, xmax, _, _ = mf.block_bounds(model.node_x.values, model.node_y.values, model.block_node_count.values)
+    left = d[:, 1] + d[:, 2] * (xmin[order] - cx)
+    right = d[:, 1] + d[:, 2] * (xmax[order] - cx)
+    np.testing.assert_allclose(left[1:], right[:-1], atol=1e-12)  # the ground has no steps
+    assert 0 < float(mf.solve(model, "la").collapse_multiplier) < 1
+
+
+@pytest.mark.parametrize(("change", "message"), [
+    ({"supports": {"base": {"kind": "fixed", "select": "lowest"}}}, "spec tables 'settlement' and 'supports': give one"),
+    ({"settlement": {**TUNNEL, "ground_layer": "NOPE"}}, "'settlement.ground_layer' = 'NOPE': no block of the drawing"),
+    ({"settlement": {**TUNNEL, "ground_select": "highest"}}, "'settlement.ground_select' = 'highest': must be one of"),
+])
+def test_bad_drawn_grounds_are_named(tmp_path, change, message):
+    spec = {**drawn_copy(mf.build({**FACADE, "settlement": TUNNEL}), tmp_path / "f.geojson"), "settlement": TUNNEL}
+    with pytest.raises(mf.SpecError, match=message.replace("(", r"\(").replace(")", r"\)")):
+        mf.build({**spec, **change})
+
+
+@pytest.fixture(scope="module")
+def small_tunnel():
+    """A 4 m x 1.2 m wall of 0.4 m units over a tunnel trough (i = 5 m, axis 6 m: the wall sags and hogs)."""
+    spec = {"title": "small", "length_unit": "m", "wall": {"width": 4.0, "height": 1.2, "thickness": 0.1},
+            "unit": {"length": 0.4, "height": 0.1}, "material": {"unit_weight": 12000.0, "friction_angle": 30.0},
+            "settlement": {"profile": "tunnel", "volume_loss": 1.5, "diameter": 6.0, "depth": 10.0, "center": 6.0},
+            "loading": {"type": "settlement"}}
+    return mf.build(spec)
+
+
+def test_every_result_over_a_tunnel_carries_stages_1_and_2(small_tunnel):
+    """fdem runs to S_max by default and derives step_ltsm_* at every record, linear in the settlement; la's key
+    numbers assess at S_max; both equal masonryfw.assessment at that settlement (one definition)."""
+    from masonryfw.assessment import assess
+
+    s_max = float(small_tunnel.settlement_target)
+    fdem = mf.solve(small_tunnel, "fdem")
+    assert fdem.step_settlement.values[-1] == pytest.approx(s_max, rel=1e-3)
+    assert fdem.attrs["stop_reason"] == "target settlement"
+    unit = assess(small_tunnel, 1.0)
+    np.testing.assert_allclose(fdem.step_ltsm_strain.values, np.abs(fdem.step_settlement.values) * unit.strain,
+                               rtol=1e-12)
+    np.testing.assert_array_equal(fdem.step_ltsm_category.values, ltsm_category(fdem.step_ltsm_strain.values))
+    la = mf.solve(small_tunnel, "la")
+    numbers = {k.name: k.value for k in mf.key_numbers(la)}
+    stages = assess(small_tunnel, s_max)
+    assert numbers["assessed_settlement"] == s_max
+    assert numbers["ltsm_strain"] == pytest.approx(stages.strain, rel=1e-12)
+    assert numbers["greenfield_settlement"] == pytest.approx(s_max * np.exp(-0.5 * ((4.0 - 6.0) / 5.0) ** 2), rel=1e-6)
+    assert numbers["screened_out"] == 0.0  # 34 mm of settlement
+
+
+def test_jmm_runs_to_the_models_target_too(small_tunnel):
+    """At 0.3 % volume loss (S_max 6.8 mm): no plateau stop, the last step at S_max."""
+    spec = mf.load_spec(small_tunnel.attrs["source_spec"])
+    spec["settlement"]["volume_loss"] = 0.3
+    model = mf.build(spec)
+    result = mf.solve(model, "jmm", {"mesh_size": 0.1})
+    assert result.attrs["stop_reason"] == "target settlement reached"
+    assert float(result.step_settlement.values[-1]) == pytest.approx(float(model.settlement_target), rel=1e-9)
+    assert "step_ltsm_category" in result
+
+
+def test_the_ltsm_chart_is_drawn_and_refused_without_a_profile(small_tunnel, tmp_path):
+    figure = mf.render([mf.solve(small_tunnel, "la")], "ltsm")
+    assert len(figure.axes) == 3  # the frame, the trough and the chart
+    with pytest.raises(mf.MasonryError, match="the ltsm plot needs a"):
+        mf.render([mf.solve(mf.open_model("test-12c"), "la")], "ltsm")
