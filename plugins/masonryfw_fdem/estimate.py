@@ -1,28 +1,32 @@
 """The ``fdem`` solve's time and peak memory, known before it starts (``Solver.estimate``).
 
 The number of time steps to the target settlement is known from the controls (target /
-(rate x dt)); a step costs about ``STEP_SECONDS_PER_BLOCK`` a block on one thread (2-core
-AMD EPYC, docs/benchmarks.md, section "scale"), ``PARALLEL_EFFICIENCY`` of that less per added
-thread, times ``DEFORMABLE_FACTOR`` in the (serial) CST mode. A reaction plateau often stops
-the run earlier: the estimate is the longest.
+(rate x dt)); the gravity phase lasts about ``GRAVITY_TIME`` times sqrt(H / g) of simulated
+time (H the masonry's height; measured 0.23-0.68 on six bundled walls, from the 0.6 m Test 12C
+to the 6 m tunnel facade: a fixed share of the settlement steps was 5 % where it is 25-80 % for a
+short target); a step costs about ``STEP_SECONDS_PER_BLOCK`` a block on one thread (2-core AMD
+EPYC: 0.346 us on the 1,000-unit scale wall, median of three, 2026-11-26), ``PARALLEL_EFFICIENCY``
+of that less per added thread, times ``DEFORMABLE_FACTOR`` in the (serial) CST mode. A reaction
+plateau often stops the run earlier: the estimate is the longest.
 """
 from __future__ import annotations
 
 from collections.abc import Mapping
 from typing import Any
 
+import numpy as np
 import xarray as xr
 
 import masonryfw as mf
 
 from .scene import build_scene
 
-STEP_SECONDS_PER_BLOCK = 0.29e-6  # 2,432 blocks: 0.69 ms a step on one thread, 0.36 ms on two
+STEP_SECONDS_PER_BLOCK = 0.35e-6  # 1,035 blocks: 0.36 ms a step on one thread (0.29e-6 measured 2026-11-25)
 PARALLEL_EFFICIENCY = 0.95
 # two threads add ~20 us a step of start-up and save ~0.145 us a block: whole processes in alternating pairs,
 # Test 12C (72 blocks) 0.86x on two threads, Facade 3 (480 blocks) 1.59x (docs/benchmarks.md, fdem)
 PARALLEL_MIN_BLOCKS = 300
-GRAVITY_SHARE = 0.05  # gravity steps, as a share of the settlement's
+GRAVITY_TIME = 0.4  # the gravity phase in units of sqrt(masonry height / g)
 DEFORMABLE_FACTOR = 6.0  # Test 12C: 14.4 s against 2.3 s (docs/benchmarks.md, fdem-deformable)
 BASE_MEMORY = 250 * 2**20
 MEMORY_PER_BLOCK = 20e3
@@ -40,12 +44,13 @@ def threads(options: Mapping[str, Any], blocks: int) -> int:
 
 
 def estimate(model: xr.Dataset, options: Mapping[str, Any]) -> mf.Estimate:
-    from .solver import make_controls
+    from .solver import make_controls, masonry_height
 
     scene = build_scene(model)
     controls = make_controls(scene, options)
     blocks = model.sizes["block"]
-    steps = (1 + GRAVITY_SHARE) * controls.target / (controls.rate * controls.dt) if controls.rate > 0 else 0.0
+    gravity = GRAVITY_TIME * np.sqrt(masonry_height(scene)) / controls.dt  # scaled time: sqrt(length / g)
+    steps = gravity + (controls.target / (controls.rate * controls.dt) if controls.rate > 0 else 0.0)
     if options["mode"] == "deformable":
         seconds = steps * blocks * STEP_SECONDS_PER_BLOCK * DEFORMABLE_FACTOR
     else:

@@ -116,3 +116,17 @@ def test_the_threads_do_not_change_a_single_bit(small_wall):
     assert one.attrs["fdem_threads"] == 1
     assert np.array_equal(one.block_displacement.values, two.block_displacement.values)
     assert np.array_equal(one.step_reaction.values, two.step_reaction.values)
+
+
+@pytest.mark.parametrize("name", ["test-12c", "panel-5", "facade-1-trough"])
+def test_the_estimate_counts_the_gravity_phase(name):
+    """A short target is mostly gravity phase (the wall coming to rest): the estimate's step count is within a
+    factor 2 of the steps the run took (it assumed 5 % of the settlement's steps, 20 to 50 times too few)."""
+    import re
+
+    model = mf.open_model(name)
+    options = {"settlement": 1e-4, "plateau_tolerance": 0.0}
+    expected = mf.estimate(model, "fdem", options)
+    estimated = int(re.search(r"at most ([\d,]+) time steps", expected.basis).group(1).replace(",", ""))
+    steps = int(mf.solve(model, "fdem", options).attrs["fdem_steps"])
+    assert 0.5 * steps <= estimated <= 2.0 * steps
