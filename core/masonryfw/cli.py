@@ -188,6 +188,20 @@ def _support_lines(model) -> list[str]:
     return lines
 
 
+def _profile_text(profile) -> str:
+    """A settlement profile in a line: its kind and parameters, a tunnel's trough and S_max."""
+    if profile.kind == "tunnel":
+        return (f"tunnel, V_L {profile.volume_loss:g} %, D {profile.diameter:g} m, axis {profile.depth:g} m deep at "
+                f"x {profile.center:g} m, K {profile.trough_width_factor:g}: i {profile.width:.4g} m, S_max "
+                f"{1e3 * profile.target:.4g} mm (settlement_target); segments {profile.segment:.4g} m")
+    if profile.kind == "gaussian":
+        sideways = f", ground moving towards the axis (z0 {profile.depth:g} m)" if profile.depth else ""
+        return f"gaussian trough, axis x {profile.center:g} m, i {profile.width:.4g} m{sideways}; segments {profile.segment:.4g} m"
+    if profile.kind == "linear":
+        return f"tilt from x {profile.start:g} m (rate 0) to x {profile.end:g} m (rate 1); segments {profile.segment:.4g} m"
+    return f"table of {len(profile.points)} rates; segments {profile.segment:.4g} m"
+
+
 def _support_motion(direction, x0: float, x1: float, centre_x: float) -> str:
     """What a moving support does per unit settlement parameter t, in words: its settlement (at its two ends
     when it turns), sideways motion and rotation, then the settlement direction itself."""
@@ -231,6 +245,9 @@ def info(model: str) -> None:
             f"(x {x.min():.6g}..{x.max():.6g}, y {y.min():.6g}..{y.max():.6g})"
         )
         click.echo(f"thickness: {_span(ds.block_thickness.values[masonry])}")
+    profile = mf.model_profile(ds)
+    if profile is not None:
+        click.echo(f"settlement profile: {_profile_text(profile)}")
     click.echo("supports:")
     for line in _support_lines(ds):
         click.echo(line)

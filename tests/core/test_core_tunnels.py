@@ -232,3 +232,15 @@ def test_the_ltsm_chart_is_drawn_and_refused_without_a_profile(small_tunnel, tmp
     assert len(figure.axes) == 3  # the frame, the trough and the chart
     with pytest.raises(mf.MasonryError, match="the ltsm plot needs a"):
         mf.render([mf.solve(mf.open_model("test-12c"), "la")], "ltsm")
+
+
+def test_info_shows_the_tunnel_and_its_trough():
+    from click.testing import CliRunner
+
+    from masonryfw.cli import cli
+
+    run = CliRunner().invoke(cli, ["info", "tunnel-facade"])
+    assert run.exit_code == 0
+    s_max = 0.01 * math.pi * 36.0 / 4.0 / (math.sqrt(2.0 * math.pi) * 7.5)
+    assert (f"settlement profile: tunnel, V_L 1 %, D 6 m, axis 15 m deep at x 10 m, K 0.5: i 7.5 m, "
+            f"S_max {1e3 * s_max:.4g} mm (settlement_target)") in run.output
