@@ -23,13 +23,13 @@ Writes docs/img/settlements/*.png and prints the tables of the doc.
 """
 from __future__ import annotations
 
-import argparse
 from pathlib import Path
 
+from _studies import arguments, run_plan, values
 from matplotlib.figure import Figure
 
 import masonryfw as mf
-from masonryfw_sweep import dask_client, failed_points, plan_sweep, run_sweep
+from masonryfw_sweep import dask_client, plan_sweep
 
 ROOT = Path(__file__).resolve().parents[2]
 IMAGES = ROOT / "docs" / "img" / "settlements"
@@ -47,18 +47,7 @@ def trough_spec() -> dict:
 
 
 def sweep(client, store: Path, solver: str, params: list[str], options: dict):
-    plan = plan_sweep(trough_spec(), solver, params, options)
-    path = store / f"{solver}.store"
-    path.mkdir(parents=True, exist_ok=True)
-    result = run_sweep(plan, client, path, store)
-    for where, message in failed_points(result):
-        print(f"{solver} failed: {where}: {message}")
-    print(f"{solver}: {result.status.size} points, wall time of the solves {float(result.wall_time_s.sum()):.1f} s")
-    return result
-
-
-def values(items) -> str:
-    return ",".join(f"{v:g}" for v in items)
+    return run_plan(client, store, solver, plan_sweep(trough_spec(), solver, params, options))
 
 
 def reaction_minimum(store: Path, fdem, x0: float) -> float:
@@ -148,9 +137,7 @@ def segment_table(client, store: Path) -> str:
     plan = plan_sweep(trough_spec(), "fdem", [f"settlement.center={values(AXES[::3])}",
                                               f"settlement.segment={values(UNIT * u for u in SEGMENTS)}"],
                       {"plateau_tolerance": 0.0, "settlement": S_MAX[-1]})
-    path = store / "segments.store"
-    path.mkdir(parents=True, exist_ok=True)
-    result = run_sweep(plan, client, path, store)
+    result = run_plan(client, store, "segments", plan)
     lines = ["| trough | segment [units] | widest crack [mm] | off the finest | at (x, y) [m] | category | "
              "base gap [mm] | R0 [N] | smallest reaction [N] |", "|---|---:|---:|---:|---|---:|---:|---:|---:|"]
     for x0, name in zip(AXES[::3], ("sagging", "hogging")):
@@ -182,11 +169,7 @@ def facade_table() -> str:
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--workers", type=int, default=None)
-    parser.add_argument("--store", type=Path, default=ROOT / "build" / "sweeps" / "settlements")
-    args = parser.parse_args()
-    args.store.mkdir(parents=True, exist_ok=True)
+    args = arguments(__doc__.splitlines()[0], ROOT / "build" / "sweeps" / "settlements")
     IMAGES.mkdir(parents=True, exist_ok=True)
     with dask_client(workers=args.workers) as client:
         fdem = sweep(client, args.store, "fdem", [f"settlement.center={values(AXES)}",

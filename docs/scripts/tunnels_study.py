@@ -13,15 +13,15 @@ Writes docs/img/tunnels/*.png and prints the tables of the doc.
 """
 from __future__ import annotations
 
-import argparse
 from pathlib import Path
 
 import numpy as np
+from _studies import arguments, run_plan, values
 from matplotlib.colors import BoundaryNorm, ListedColormap
 from matplotlib.figure import Figure
 
 import masonryfw as mf
-from masonryfw_sweep import dask_client, failed_points, plan_sweep, run_sweep
+from masonryfw_sweep import dask_client, plan_sweep
 
 ROOT = Path(__file__).resolve().parents[2]
 IMAGES = ROOT / "docs" / "img" / "tunnels"
@@ -38,20 +38,9 @@ def facade(openings: bool = True) -> dict:
     return spec
 
 
-def values(items) -> str:
-    return ",".join(f"{v:g}" for v in items)
-
-
 def sweep(client, store: Path, name: str, spec: dict, losses) -> object:
-    plan = plan_sweep(spec, "fdem", [f"settlement.center={values(CENTERS)}",
-                                     f"settlement.volume_loss={values(losses)}"], {})
-    path = store / f"{name}.store"
-    path.mkdir(parents=True, exist_ok=True)
-    result = run_sweep(plan, client, path, store)
-    for where, message in failed_points(result):
-        print(f"{name} failed: {where}: {message}")
-    print(f"{name}: {result.status.size} points, wall time of the solves {float(result.wall_time_s.sum()):.1f} s")
-    return result
+    return run_plan(client, store, name, plan_sweep(spec, "fdem", [f"settlement.center={values(CENTERS)}",
+                                                                   f"settlement.volume_loss={values(losses)}"], {}))
 
 
 def draw_chart(result, path: Path, title: str) -> None:
@@ -94,11 +83,7 @@ def table(result) -> str:
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--workers", type=int, default=None)
-    parser.add_argument("--store", type=Path, default=ROOT / "build" / "sweeps" / "tunnels")
-    args = parser.parse_args()
-    args.store.mkdir(parents=True, exist_ok=True)
+    args = arguments(__doc__.splitlines()[0], ROOT / "build" / "sweeps" / "tunnels")
     IMAGES.mkdir(parents=True, exist_ok=True)
     with dask_client(workers=args.workers) as client:
         route = sweep(client, args.store, "route", facade(), VOLUME_LOSSES)
