@@ -16,11 +16,12 @@ try:
 except PackageNotFoundError:  # running from a source tree that is not installed
     __version__ = "0+unknown"
 
-from .builder import build, load_spec
+from .builder import STAND_IN_GROUND, build, load_spec, load_wall
 from .checks import Problem, check
 from .damage import DAMAGE_LIMITS, Cracks, damage_category, distortion, support_profile, widest_crack
 from .datasets import BUNDLED_NAMES, CASE_NAMES, DRAWN_NAMES, PROFILE_NAMES, bundled_cases, bundled_spec_path
 from .dofs import block_loads, block_motion, load_variables, motion_variables, upgrade
+from .drawing import DxfLines, read_dxf_lines
 from .errors import MasonryError, ModelError, PluginError, SolveError, SpecError, listed
 from .geometry import (
     DERIVED_GEOMETRY_VARIABLES,
@@ -36,6 +37,7 @@ from .geometry import (
     polygon_area_centroid,
     triangulated,
 )
+from .ground import ground_model, over_profile
 from .hookspecs import (
     AUTO,
     Comparator,
@@ -70,7 +72,7 @@ from .plugins import (
     solve,
     solver_version,
 )
-from .profiles import model_profile
+from .profiles import Profile, model_profile, settlement_profile
 from .progress import ProgressCallback, StderrBar, interruptible, no_progress, progress_bar
 from .resources import available_memory, duration_text, size_text
 from .schema import FORMAT_VERSION, flags, load_schema, variable_attrs
@@ -102,8 +104,10 @@ from .semantics import (
 )
 from .spec import dump_toml
 from .summary import (
+    DIAGNOSIS_COLUMNS,
     Row,
     csv_text,
+    diagnosis_rows,
     headline_rows,
     headline_text,
     result_label,

@@ -31,7 +31,7 @@ from dataclasses import dataclass
 import numpy as np
 import xarray as xr
 
-from .dofs import load_variables
+from .dofs import block_loads, load_variables
 from .errors import SpecError
 from .geometry import polygon_area_centroid
 from .interfaces import detect_interfaces
@@ -258,6 +258,42 @@ def model_from_blocks(
         attrs={"Conventions": "CF-1.11", "masonryfw_format": "model", "masonryfw_format_version": FORMAT_VERSION,
                "title": "", **(attrs or {})},
     )
+
+
+def with_supports(model: xr.Dataset, supports) -> xr.Dataset:
+    """``model`` under the settlement loading with its support blocks (in block order) moving as ``supports``
+    say: their roles, held components, settlement directions and the paper's dead and live loads made anew,
+    every other variable kept (the geometry, the interfaces, the masonry's weight). Cheaper than building the
+    model again: a settlement diagnosis tries hundreds of profiles on one wall."""
+    flag = flags("block_role")
+    role = model.block_role.values.copy()
+    support_blocks = np.flatnonzero(np.isin(role, (flag["fixed_support"], flag["moving_support"])))
+    if len(supports) != support_blocks.size:
+        raise SpecError(f"{support_blocks.size} support blocks but {len(supports)} support descriptions")
+    centres = np.c_[model.block_centroid_x.values, model.block_centroid_y.values][support_blocks]
+    s_fixed, s_direction, role[support_blocks] = support_kinematics(supports, centres, "settlement")
+    support_index = np.full(role.size, -1)
+    support_index[support_blocks] = np.arange(support_blocks.size)
+    contact = support_contact(model.interface_blocks.values.astype(np.int64), model.interface_length.values,
+                              support_index, support_blocks.size)
+    dead = block_loads(model, "dead").copy()
+    masonry = np.ones(role.size, dtype=bool)
+    masonry[support_blocks] = False
+    reaction = support_reactions(supports, contact, -dead[masonry, 1].sum(), "settlement")
+    live = np.zeros_like(dead)
+    dead[support_blocks, 1] = reaction
+    live[support_blocks, 1] = -reaction
+    fixed = model.block_fixed.values.copy()
+    fixed[support_blocks] = s_fixed
+    direction = np.zeros((role.size, 3))
+    direction[support_blocks] = s_direction
+    return model.assign({
+        "block_role": model.block_role.copy(data=role),
+        "block_fixed": model.block_fixed.copy(data=fixed),
+        "settlement_direction": model.settlement_direction.copy(data=direction),
+        **{name: (dims, values, model[name].attrs) for name, (dims, values, _) in
+           {**load_variables("dead", dead), **load_variables("live", live)}.items()},
+    })
 
 
 def rectangle_nodes(x0, x1, y0, y1):

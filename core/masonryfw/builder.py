@@ -73,6 +73,27 @@ def load_spec(path_or_text) -> dict:
     sweep) and passed to :func:`build`.
     """
     spec, _, base_dir = read_spec(path_or_text)
+    return _validated(spec, base_dir)
+
+
+#: What a wall read by :func:`load_wall` stands on when its spec gives no supports and no profile: every
+#: support block moving (a tilt so gentle and wide that nothing is still), for a command that makes its own
+#: ground from the wall's (``masonryfw diagnose``).
+STAND_IN_GROUND = {"settlement": {"profile": "linear", "start": -1.0e6, "end": 1.0e6},
+                   "loading": {"type": "settlement"}}
+
+
+def load_wall(path_or_text) -> dict:
+    """Read and validate a spec for its wall alone: its ``[supports.*]``, ``[settlement]`` and ``[loading]`` may
+    be left out (:data:`STAND_IN_GROUND` stands in for them; a command that reads walls this way sets their
+    supports aside and makes its own ground)."""
+    spec, _, base_dir = read_spec(path_or_text)
+    if "supports" not in spec and "settlement" not in spec:
+        spec = {**spec, **STAND_IN_GROUND}
+    return _validated({**spec, "loading": spec.get("loading", STAND_IN_GROUND["loading"])}, base_dir)
+
+
+def _validated(spec: dict, base_dir) -> dict:
     if is_drawn(spec):
         drawn = parse_drawn_spec(spec)
         key = drawn.drawing_key.split(".")[1]

@@ -113,7 +113,9 @@ def _counted(ignored: dict[str, int]) -> str:
 
 # ---------------------------------------------------------------- readers
 
-def _read_dxf(path: Path, drawing_unit: str | None, chord_tolerance: float | None):
+def _open_dxf(path: Path):
+    """The ezdxf document of a DXF file, text (repaired where it can be) or binary; ezdxf's own repair
+    messages are not printed (they quote the file's lines), a failure is ours to say."""
     import ezdxf  # here, not at the top: only a drawing needs it
     from ezdxf import recover
 
@@ -121,13 +123,49 @@ def _read_dxf(path: Path, drawing_unit: str | None, chord_tolerance: float | Non
         binary = handle.read(len(BINARY_DXF)) == BINARY_DXF
     ezdxf_log = logging.getLogger("ezdxf")
     level = ezdxf_log.level
-    ezdxf_log.setLevel(logging.CRITICAL)  # its repairs would print lines of the file; a failure is ours to say
-    try:  # recover repairs damaged text files; a binary DXF (DXB-like, "AutoCAD Binary DXF") reads as it is
-        doc = ezdxf.readfile(str(path)) if binary else recover.readfile(str(path))[0]
+    ezdxf_log.setLevel(logging.CRITICAL)
+    try:  # recover repairs damaged text files; a binary DXF ("AutoCAD Binary DXF") reads as it is
+        return ezdxf.readfile(str(path)) if binary else recover.readfile(str(path))[0]
     except (OSError, ezdxf.DXFError, UnicodeDecodeError) as exc:
         raise SpecError(f"drawing {str(path)!r}: not a readable DXF file ({type(exc).__name__})") from None
     finally:
         ezdxf_log.setLevel(level)
+
+
+@dataclass(frozen=True)
+class DxfLines:
+    """The open lines of a DXF drawing, in drawing units, with their entities and the drawing's $INSUNITS."""
+
+    lines: tuple[np.ndarray, ...]  # (n, 2) each
+    sources: tuple[tuple[str, str], ...]  # (entity type, handle)
+    insunits: int
+
+
+def read_dxf_lines(path: str | Path, layer: str | None = None) -> DxfLines:
+    """Every ``LINE``, ``LWPOLYLINE`` and 2D ``POLYLINE`` of a DXF drawing (on ``layer`` when given) as a
+    polyline in drawing units (arcs flattened to 1e-3 drawing units): a crack map drawn over a wall."""
+    from ezdxf import path as dxf_path
+
+    path = Path(path)
+    if not path.is_file():
+        raise SpecError(f"drawing {str(path)!r}: no such file")
+    doc = _open_dxf(path)
+    lines, sources = [], []
+    for entity in _flat_entities(doc.modelspace()):
+        kind = entity.dxftype()
+        if kind not in ("LINE", "LWPOLYLINE", "POLYLINE") or (layer is not None and entity.dxf.get("layer") != layer):
+            continue
+        if kind == "POLYLINE" and not entity.is_2d_polyline:
+            continue
+        points = np.array([(v.x, v.y) for v in dxf_path.make_path(entity).flattening(distance=1e-3)])
+        if points.shape[0] >= 2:
+            lines.append(points)
+            sources.append((kind, str(entity.dxf.get("handle", "?"))))
+    return DxfLines(tuple(lines), tuple(sources), int(doc.header.get("$INSUNITS", 0)))
+
+
+def _read_dxf(path: Path, drawing_unit: str | None, chord_tolerance: float | None):
+    doc = _open_dxf(path)
     unit = drawing_unit
     if unit is None:
         code = int(doc.header.get("$INSUNITS", 0))

@@ -41,6 +41,7 @@ from . import blocks
 from .drawing import DRAWING_UNITS, Drawing, read_drawing
 from .errors import ModelError, SpecError
 from .geometry import block_bounds, polygon_area_centroid
+from .ground import ground_pieces, made_ground, polygons
 from .model import checked_model
 from .profiles import SETTLEMENT_KEYS, profile_segments, read_profile, with_profile
 from .schema import flags
@@ -262,43 +263,35 @@ def _ground_model(spec: DrawnSpec, drawing: Drawing, kept: np.ndarray, path: Pat
     """The model of a drawn wall over a ``[settlement]`` profile: its ground (the drawn blocks chosen by
     ``ground_layer`` or ``ground_select``, else a ground one median block high under the masonry's lowest
     edges) cut into the segments of a continuous ground (:mod:`masonryfw.profiles`), the pieces that carry
-    masonry kept."""
+    masonry kept (:func:`masonryfw.ground.ground_pieces`)."""
     import shapely
 
     ground = _ground_blocks(spec.settlement, drawing, kept)
     masonry = np.flatnonzero(kept & ~np.isin(np.arange(kept.size), ground))
     if masonry.size == 0:
         raise SpecError(f"drawing {path.name!r}: every block is ground or ignored; nothing to analyse")
-    polygons = _polygons(drawing)
-    xmin, xmax, ymin, ymax = block_bounds(drawing.node_x, drawing.node_y, drawing.block_node_count)
-    length = float(np.median(xmax[masonry] - xmin[masonry]))
-    if ground.size:
-        areas = list(polygons[ground])
-    else:
-        base = float(ymin[masonry].min())
-        depth = float(np.median(ymax[masonry] - ymin[masonry]))
-        areas = [shapely.box(float(xmin[masonry].min()), base - depth, float(xmax[masonry].max()), base)]
+    drawn = polygons(drawing.node_x, drawing.node_y, drawing.block_node_count)
+    xmin, xmax, _, _ = block_bounds(drawing.node_x, drawing.node_y, drawing.block_node_count)
+    is_masonry = np.isin(np.arange(kept.size), masonry)
+    areas = list(drawn[ground]) if ground.size else [
+        made_ground(drawing.node_x, drawing.node_y, drawing.block_node_count, is_masonry)]
     x0, x1 = (float(f(shapely.bounds(areas)[:, k])) for f, k in ((np.min, 0), (np.max, 2)))
-    profile = read_profile(spec.settlement, x0, x1, length)
-    touching = shapely.union_all(polygons[masonry]).boundary
+    profile = read_profile(spec.settlement, x0, x1, float(np.median(xmax[masonry] - xmin[masonry])))
+    segments = profile_segments(profile, x0, x1, np.array([[x0, x1]]))
     tol = 1e-6 * float(np.hypot(np.ptp(drawing.node_x), np.ptp(drawing.node_y)))
-    low, high = float(shapely.bounds(areas)[:, 1].min()) - 1.0, float(ymax.max()) + 1.0
-    pieces, described, labels = [], [], []
-    for k, segment in enumerate(profile_segments(profile, x0, x1, np.array([[x0, x1]]))):
-        strip = shapely.box(segment.start, low, segment.end, high)
-        for area in areas:
-            for piece in shapely.get_parts(shapely.intersection(area, strip)):
-                if piece.geom_type != "Polygon" or shapely.length(shapely.intersection(piece.boundary, touching)) <= tol:
-                    continue
-                name = f"settlement segment {k} [{segment.start:.6g}, {segment.end:.6g}] m"
-                top = float(shapely.bounds(piece)[3])
-                edge = blocks.GroundEdge((segment.start, segment.end), top, segment.down, segment.horizontal)
-                pieces.append(shapely.orient_polygons(piece))
-                described.append(blocks.Support(name, "moving", "ground", ground=edge) if segment.moving
-                                 else blocks.Support(name, "fixed"))
-                labels.append(name)
+    pieces = ground_pieces(areas, shapely.union_all(drawn[masonry]).boundary,
+                           np.array([s.start for s in segments] + [segments[-1].end]), tol)
+    described, labels = [], []
+    for piece, k in pieces:
+        segment = segments[k]
+        name = f"settlement segment {k} [{segment.start:.6g}, {segment.end:.6g}] m"
+        edge = blocks.GroundEdge((segment.start, segment.end), float(shapely.bounds(piece)[3]), segment.down,
+                                 segment.horizontal)
+        described.append(blocks.Support(name, "moving", "ground", ground=edge) if segment.moving
+                         else blocks.Support(name, "fixed"))
+        labels.append(name)
     node_x, node_y, counts = _reordered(drawing, masonry)
-    rings = [np.asarray(p.exterior.coords)[:-1] for p in pieces]
+    rings = [np.asarray(piece.exterior.coords)[:-1] for piece, _ in pieces]
     node_x = np.concatenate([node_x, *(r[:, 0] for r in rings)])
     node_y = np.concatenate([node_y, *(r[:, 1] for r in rings)])
     counts = np.concatenate([counts, [r.shape[0] for r in rings]]).astype(np.int32)
@@ -332,15 +325,6 @@ def _ground_blocks(table: SpecTable, drawing: Drawing, kept: np.ndarray) -> np.n
         raise SpecError(f"spec key {table.key('ground_select')!r} = 'lowest': {best.size} blocks tie "
                         f"({'; '.join(drawing.label(b) for b in best[:3])}); choose them by ground_layer")
     return best
-
-
-def _polygons(drawing: Drawing):
-    """The drawing's blocks as shapely polygons."""
-    import shapely
-
-    return shapely.polygons(shapely.linearrings(
-        np.c_[drawing.node_x, drawing.node_y],
-        indices=np.repeat(np.arange(drawing.block_node_count.size), drawing.block_node_count)))
 
 
 def _support_blocks(spec: DrawnSpec, drawing: Drawing, kept: np.ndarray) -> list[np.ndarray]:
@@ -384,8 +368,8 @@ def _support_blocks(spec: DrawnSpec, drawing: Drawing, kept: np.ndarray) -> list
 def _blocks_containing(drawing: Drawing, point, candidates: np.ndarray) -> np.ndarray:
     import shapely
 
-    polygons = _polygons(drawing)
-    inside = shapely.contains_xy(polygons, point[0], point[1]) | shapely.touches(polygons, shapely.points(point))
+    drawn = polygons(drawing.node_x, drawing.node_y, drawing.block_node_count)
+    inside = shapely.contains_xy(drawn, point[0], point[1]) | shapely.touches(drawn, shapely.points(point))
     return np.flatnonzero(inside & candidates)
 
 

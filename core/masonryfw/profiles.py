@@ -15,7 +15,10 @@ per unit of the settlement parameter ``t`` (for a trough, ``t`` is ``S_max``):
 - ``linear``: a tilt, ``r = (x - start) / (end - start)``, 0 before ``start``
   (defaults: the wall's left end and its right end, so r = 1 at the right end);
 - ``table``: measured rates ``points = [[x, r], ...]``, linearly interpolated,
-  constant beyond the first and last points.
+  constant beyond the first and last points;
+- ``step``: the ground under ``[start, end]`` drops at rate 1 and the rest stays
+  (the paper's loading): not continuous but a step at each end; a segment settles,
+  translating, when its middle lies in ``[start, end]``.
 
 **The ground is continuous.** The base ``[0, wall width]`` is cut into
 ``round(width / segment)`` equal segments (at least one); ``segment`` defaults to
@@ -46,7 +49,7 @@ from .errors import SpecError
 from .schema import variable_attrs
 from .spec import SpecTable
 
-PROFILES = ("gaussian", "tunnel", "linear", "table")
+PROFILES = ("gaussian", "tunnel", "linear", "table", "step")
 SETTLEMENT_KEYS = ("profile", "center", "width", "start", "end", "points", "segment", "cutoff", "depth",
                    "volume_loss", "diameter", "trough_width_factor", "horizontal")
 #: A segment whose rate is at most this stays fixed unless ``cutoff`` says otherwise.
@@ -57,7 +60,8 @@ DEFAULT_SEGMENT_UNITS = 0.25
 DEFAULT_TROUGH_WIDTH_FACTOR = 0.5
 _TUNNEL_ONLY = ("volume_loss", "diameter", "trough_width_factor", "horizontal")
 _ONLY = {"center": ("gaussian", "tunnel"), "width": ("gaussian",), "depth": ("gaussian", "tunnel"),
-         "start": ("linear",), "end": ("linear",), "points": ("table",), **{k: ("tunnel",) for k in _TUNNEL_ONLY}}
+         "start": ("linear", "step"), "end": ("linear", "step"), "points": ("table",),
+         **{k: ("tunnel",) for k in _TUNNEL_ONLY}}
 
 
 @dataclass(frozen=True)
@@ -86,6 +90,8 @@ class Profile:
             return np.exp(-0.5 * ((x - self.center) / self.width) ** 2)
         if self.kind == "linear":
             return np.maximum((x - self.start) / (self.end - self.start), 0.0)
+        if self.kind == "step":
+            return ((x >= self.start) & (x <= self.end)).astype(float)
         px, pr = np.array(self.points).T
         return np.interp(x, px, pr)
 
@@ -128,6 +134,12 @@ def read_profile(table: SpecTable, x0: float, x1: float, unit_length: float) -> 
                        depth=table.number("depth", None, length=True, positive=True))
     if kind == "tunnel":
         return _tunnel(table, segment, cutoff)
+    if kind == "step":
+        start, end = table.number("start", length=True), table.number("end", length=True)
+        if not end > start:
+            raise SpecError(f"spec key {table.key('end')!r} = {table.raw('end')!r}: must exceed "
+                            f"{table.key('start')!r} = {table.raw('start')!r}")
+        return Profile(kind, segment, cutoff, start=start, end=end)
     if kind == "linear":
         start = table.number("start", x0 / table.scale, length=True)
         end = table.number("end", x1 / table.scale, length=True)
@@ -136,6 +148,12 @@ def read_profile(table: SpecTable, x0: float, x1: float, unit_length: float) -> 
                             "(the rate grows from 0 at start to 1 at end)")
         return Profile(kind, segment, cutoff, start=start, end=end)
     return Profile(kind, segment, cutoff, points=_table_points(table))
+
+
+def settlement_profile(table: dict, x0: float, x1: float, unit_length: float) -> Profile:
+    """A ``[settlement]`` table given as a dict in metres (what a spec holds, what a diagnosis proposes) under a
+    wall from ``x0`` to ``x1``, checked like a spec's (a :class:`SpecError` names the key)."""
+    return read_profile(SpecTable(table, "settlement", SETTLEMENT_KEYS), x0, x1, unit_length)
 
 
 def _tunnel(table: SpecTable, segment: float, cutoff: float) -> Profile:
@@ -192,18 +210,32 @@ def node_motion(profile: Profile, x: np.ndarray) -> tuple[np.ndarray, np.ndarray
     return down, profile.horizontal(x) * share
 
 
+def segment_edges(profile: Profile, x0: float, x1: float) -> np.ndarray:
+    """The ends of the ``round((x1 - x0) / segment)`` equal segments from ``x0`` to ``x1`` (at least one)."""
+    return np.linspace(x0, x1, max(1, round((x1 - x0) / profile.segment)) + 1)
+
+
+def segment_motions(profile: Profile, edges: np.ndarray) -> list[Segment]:
+    """Every segment between consecutive ``edges``, moving with the ground: a continuous ground's segment follows
+    its two nodes (:func:`node_motion`), a step's translates if its middle lies under the step."""
+    if profile.kind == "step":
+        down = profile.rate(0.5 * (edges[:-1] + edges[1:]))
+        return [Segment(float(a), float(b), (float(d), float(d)), (0.0, 0.0))
+                for a, b, d in zip(edges[:-1], edges[1:], down)]
+    down, horizontal = node_motion(profile, edges)
+    return [Segment(float(edges[k]), float(edges[k + 1]), (float(down[k]), float(down[k + 1])),
+                    (float(horizontal[k]), float(horizontal[k + 1]))) for k in range(edges.size - 1)]
+
+
 def profile_segments(profile: Profile, x0: float, x1: float, base: np.ndarray) -> list[Segment]:
     """The support segments of a profile under a wall from ``x0`` to ``x1`` whose masonry rests on the ``base``
     intervals (module docstring): moving segments one by one, adjacent fixed ones merged."""
-    width = x1 - x0
-    count = max(1, round(width / profile.segment))
-    edges = np.linspace(x0, x1, count + 1)
-    down, horizontal = node_motion(profile, edges)
-    bare = contact_lengths(edges, base) <= 1e-9 * width
+    edges = segment_edges(profile, x0, x1)
+    bare = contact_lengths(edges, base) <= 1e-9 * (x1 - x0)
+    motions = segment_motions(profile, edges)
     segments: list[Segment] = []
     for k in np.flatnonzero(~bare):
-        segment = Segment(float(edges[k]), float(edges[k + 1]), (float(down[k]), float(down[k + 1])),
-                          (float(horizontal[k]), float(horizontal[k + 1])))
+        segment = motions[k]
         last = segments[-1] if segments else None
         if not segment.moving and last is not None and not last.moving and last.end == segment.start:
             segment = Segment(last.start, segment.end, (0.0, 0.0), (0.0, 0.0))

@@ -14,7 +14,7 @@ from .errors import ModelError
 FORMAT_VERSION = 2
 #: Versions this code reads: older ones are upgraded in memory on reading (:func:`masonryfw.dofs.upgrade`).
 READABLE_VERSIONS = (1, 2)
-KINDS = ("model", "result", "comparison", "sweep")
+KINDS = ("model", "result", "comparison", "sweep", "diagnosis")
 
 
 @cache
@@ -45,9 +45,9 @@ def flags(variable: str) -> dict[str, int]:
     return dict(zip(spec["flag_meanings"].split(), spec["flag_values"]))
 
 
-def variable_attrs(variable: str) -> dict[str, object]:
-    """CF attributes (units, long_name and flags where present) of a format variable."""
-    spec = load_schema("result")["variables"][variable]
+def variable_attrs(variable: str, kind: str = "result") -> dict[str, object]:
+    """CF attributes (units, long_name and flags where present) of a variable of the dataset ``kind``."""
+    spec = load_schema(kind)["variables"][variable]
     attrs = {"units": spec["units"], "long_name": spec["long_name"]}
     if "flag_values" in spec:
         attrs["flag_values"] = list(spec["flag_values"])

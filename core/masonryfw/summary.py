@@ -13,6 +13,7 @@ import json
 from collections.abc import Sequence
 from dataclasses import dataclass
 
+import numpy as np
 import xarray as xr
 
 from .schema import flags
@@ -186,6 +187,47 @@ def score_rows(comparisons: Sequence[xr.Dataset]) -> list[Row]:
         rows.append(Row(name, tuple(MISSING if v is None else f"{v:.4g}" for v in values),
                         str(present[0][name].attrs.get("comment", present[0][name].attrs.get("long_name", ""))),
                         values))
+    return rows
+
+
+DIAGNOSIS_COLUMNS = ("scenario", "score", "cracks", "levelling", "settlement", "plausible", "unexplained",
+                     "unobserved", "verified")
+
+
+def _scenario_text(ds: xr.Dataset, k: int) -> str:
+    profile = str(ds.candidate_profile.values[k])
+    if profile == "gaussian":
+        return f"gaussian trough at {float(ds.candidate_center[k]):.4g} m, i {float(ds.candidate_width[k]):.4g} m"
+    start, end = float(ds.candidate_start[k]), float(ds.candidate_end[k])
+    return f"step {start:.4g}..{end:.4g} m" if profile == "step" else f"tilt from {start:.4g} m down to {end:.4g} m"
+
+
+def _finite(value: float) -> float | None:
+    return value if np.isfinite(value) else None
+
+
+def diagnosis_rows(diagnosis: xr.Dataset, count: int) -> list[Row]:
+    """The best ``count`` candidates of a ``diagnosis`` dataset (and every plausible one), one row each
+    (:data:`DIAGNOSIS_COLUMNS`); the note says what the candidate leaves out."""
+    shown = max(count, int(diagnosis.candidate_plausible.values.sum()))
+    levelled = "candidate_levelling_score" in diagnosis
+    verified = "candidate_verified_crack_width" in diagnosis
+    rows = []
+    for k in range(min(shown, diagnosis.sizes["candidate"])):
+        score, crack = float(diagnosis.candidate_score[k]), float(diagnosis.candidate_crack_score[k])
+        level = float(diagnosis.candidate_levelling_score[k]) if levelled else float("nan")
+        magnitude = float(diagnosis.candidate_magnitude[k])
+        width = float(diagnosis.candidate_verified_crack_width[k]) if verified else float("nan")
+        unexplained, unobserved = (int(diagnosis[f"candidate_{n}"][k]) for n in ("unexplained_cracks",
+                                                                                   "unobserved_joints"))
+        cells = (_scenario_text(diagnosis, k), f"{score:.3f}", f"{crack:.3f}",
+                 f"{level:.3f}" if np.isfinite(level) else MISSING, _mm(magnitude) if np.isfinite(magnitude) else MISSING,
+                 "yes" if diagnosis.candidate_plausible.values[k] else "no", str(unexplained), str(unobserved),
+                 _mm(width) if np.isfinite(width) else MISSING)
+        note = (f"leaves {unexplained} surveyed crack(s) unexplained, cracks {unobserved} joint(s) nobody surveyed"
+                if unexplained or unobserved else "explains every surveyed crack and cracks nothing else")
+        rows.append(Row(str(k + 1), cells, note, (None, score, crack, _finite(level), _finite(magnitude), None,
+                                                  float(unexplained), float(unobserved), _finite(width))))
     return rows
 
 

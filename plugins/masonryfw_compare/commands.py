@@ -58,7 +58,8 @@ def export_command(result: str, file_format: str, output: str | None) -> None:
               help="Draw a progress bar on stderr [default: when stderr is a terminal].")
 def report_command(results: tuple[str, ...], output: str, progress: bool | None) -> None:
     """Write one self-contained HTML report of RESULTS (one model): the wall, its spec, the key numbers,
-    every figure, the agreement of the results and their provenance."""
+    every figure, the agreement of the results and their provenance; a diagnosis file (`masonryfw diagnose`)
+    among them adds its verdict, ranked candidates and figure."""
     from .report import report_html  # imported here: the CLI starts without matplotlib
 
     mf.check_output_path(output, list(results), (".html", ".htm"))

@@ -194,32 +194,59 @@ def _provenance_section(paths: Sequence[str], datasets: Sequence[xr.Dataset], le
             f"<table>{versions}</table>"]
 
 
+def _diagnosis_section(path: str, ds: xr.Dataset) -> list[str]:
+    """A settlement diagnosis (a ``diagnosis`` dataset): its verdict, the ranked candidates and its figure."""
+    columns = list(mf.DIAGNOSIS_COLUMNS)
+    source = ", ".join(f"{k} <code>{html.escape(str(ds.attrs[a]))}</code>" for k, a in
+                       (("cracks", "source_cracks"), ("levelling", "source_levelling")) if ds.attrs.get(a))
+    facts = (f"{ds.sizes['candidate']} scenarios solved by {ds.attrs.get('solver', '?')} on ground segments of "
+             f"{float(ds.attrs.get('segment', 'nan')):.4g} m ({int(ds.attrs.get('failed_candidates', 0))} could not be "
+             f"solved), scored against the survey ({source}); a surveyed line follows a joint within "
+             f"{float(ds.attrs.get('tolerance', 'nan')):.3g} m. The plausible set: every candidate within "
+             f"{float(ds.attrs.get('plausible_margin', 'nan')):g} of the best score. File sha256 "
+             f"{mf.sha256_file(path)}; made by: {(str(ds.attrs.get('history', '')).splitlines() or [''])[-1]}")
+    return [f"<h2>Diagnosis: {html.escape(path)}</h2>",
+            f"<p><strong>{html.escape(str(ds.attrs.get('verdict', '')))}</strong></p>", f"<p>{facts}</p>",
+            _table(["rank", *columns], mf.diagnosis_rows(ds, 10), "diagnosis", columns),
+            _figure([ds], "diagnosis", "The surveyed cracks (red) over the wall, the best candidates' mechanisms "
+                    "with the joints they crack (blue), every candidate's score by rank, and the Gaussian troughs' "
+                    "scores over their centre and width.")]
+
+
 def report_html(paths: Sequence[str], command: str, progress: Callable[[float, str], None] | None = None) -> str:
-    """The report of the results at ``paths`` (one model) as one HTML document."""
+    """The report of the results at ``paths`` (one model), and of any diagnosis among them, as one HTML
+    document."""
     step = progress or (lambda fraction, message: None)
-    datasets = [mf.open_dataset(p) for p in paths]
-    for path, ds in zip(paths, datasets):
-        if ds.attrs.get("masonryfw_format") != "result":
-            raise mf.MasonryError(f"{path}: not a result file (masonryfw_format = "
-                                  f"{ds.attrs.get('masonryfw_format')!r}); the report reads results")
+    opened = [mf.open_dataset(p) for p in paths]
+    for path, ds in zip(paths, opened):
+        if ds.attrs.get("masonryfw_format") not in ("result", "diagnosis"):
+            raise mf.MasonryError(f"{path}: not a result or diagnosis file (masonryfw_format = "
+                                  f"{ds.attrs.get('masonryfw_format')!r}); the report reads those")
+    diagnoses = [(p, ds) for p, ds in zip(paths, opened) if ds.attrs.get("masonryfw_format") == "diagnosis"]
+    paths = [p for p, ds in zip(paths, opened) if ds.attrs.get("masonryfw_format") == "result"]
+    datasets = [ds for ds in opened if ds.attrs.get("masonryfw_format") == "result"]
     for ds in datasets[1:]:
         ensure_same_model(datasets[0], ds)
     letters = [chr(ord("A") + i) for i in range(len(datasets))]
     labels = [f"{letter}: {mf.result_label(ds)}" for letter, ds in zip(letters, datasets)]
-    title = str(datasets[0].attrs.get("title", "untitled"))
+    first = datasets[0] if datasets else diagnoses[0][1]
+    title = str(first.attrs.get("title", "untitled"))
     step(0.05, "the wall")
     parts = [f"<h1>{html.escape(title)}</h1>",
              '<p class="meta">' + " &middot; ".join(
-                 f"{html.escape(label)} (<code>{html.escape(path)}</code>)" for label, path in zip(labels, paths))
-             + "</p>",
-             _model_section(datasets[0]),
-             "<h2>Key numbers</h2>",
-             _table(["", *letters], mf.headline_rows(datasets), "key-numbers", letters)]
+                 f"{html.escape(label)} (<code>{html.escape(path)}</code>)" for label, path in
+                 [*zip(labels, paths), *(("diagnosis", p) for p, _ in diagnoses)]) + "</p>",
+             _model_section(first)]
+    if datasets:
+        parts += ["<h2>Key numbers</h2>", _table(["", *letters], mf.headline_rows(datasets), "key-numbers", letters)]
     step(0.2, "figures")
     parts += _history_section(datasets)
     for i, (label, ds) in enumerate(zip(labels, datasets)):
         step(0.2 + 0.5 * i / len(datasets), f"figures of {label}")
         parts += [f"<h2>{html.escape(label)}</h2>", *_result_figures(ds, label)]
+    step(0.7, "diagnoses")
+    for path, ds in diagnoses:
+        parts += _diagnosis_section(path, ds)
     step(0.75, "agreement")
     parts += _agreement_section(datasets, letters)
     parts += _provenance_section(paths, datasets, letters, command)

@@ -1,6 +1,7 @@
 """The README's examples run as written (examples double as tests)."""
 from __future__ import annotations
 
+import json
 import os
 import re
 import subprocess
@@ -13,6 +14,7 @@ except ModuleNotFoundError:  # pragma: no cover - Python 3.10
     import tomli as tomllib
 
 import numpy as np
+import pytest
 
 import masonryfw as mf
 
@@ -117,7 +119,7 @@ def test_the_tour_ends_with_a_report_and_its_last_step_runs_as_written(tmp_path)
 def test_the_tunnel_step_of_the_tour_runs_as_written(tmp_path):
     """Step 1d: fdem runs the bundled facade to its trough's S_max (15 mm: V_L 1 %, D 6 m, z0 15 m, K 0.5) and
     prints the three stages; the ltsm chart is drawn; la assesses stages 1 and 2 at S_max."""
-    step = README[README.index("**1d. Or ask what a planned tunnel does to it.**"):README.index("**2. Solve, look")]
+    step = README[README.index("**1d. Or ask what a planned tunnel does to it.**"):README.index("**1e. Or ask the reverse")]
     commands = [line.strip().split("#")[0].split() for line in step.splitlines() if line.startswith("    masonryfw ")]
     assert len(commands) == 3
     outputs = []
@@ -132,3 +134,25 @@ def test_the_tunnel_step_of_the_tour_runs_as_written(tmp_path):
     fdem = mf.open_dataset(tmp_path / "tunnel-facade.fdem.nc")
     assert float(fdem.step_settlement.values[-1]) >= 0.999 * float(fdem.settlement_target.values)
     assert (tmp_path / "ltsm.png").stat().st_size > 20_000
+
+
+def test_the_diagnosis_step_of_the_tour_runs_as_written(tmp_path):
+    """Step 1e: the bundled survey (drawn from fdem's run of facade-1 settling under x = 1.2 .. 1.5 m, stopped at
+    6.65 mm: datasets/surveys/README.md) points back to that step, and its levelling to that settlement."""
+    step = README[README.index("**1e. Or ask the reverse"):README.index("**2. Solve, look")]
+    commands = [line.strip().split() for line in step.splitlines() if line.startswith("    masonryfw ")]
+    assert len(commands) == 3
+    root = Path(__file__).resolve().parents[2]
+    outputs = []
+    for words in commands:
+        words = [str(root / w) if w.startswith("datasets/") else w for w in words]
+        extra = ["--no-progress", "--json"] if words[1] == "diagnose" else []
+        done = subprocess.run([sys.executable, "-m", "masonryfw", *words[1:], *extra], cwd=tmp_path,
+                              capture_output=True, text=True, timeout=300)
+        assert done.returncode == 0, (words, done.stderr)
+        outputs.append(done.stdout)
+    best = json.loads(outputs[0])["candidates"][0]
+    assert best["settlement"] == {"profile": "step", "start": 1.2, "end": 1.5, "segment": 0.1}
+    assert best["magnitude"] == pytest.approx(6.65e-3, rel=0.15)
+    assert (tmp_path / "diagnosis.png").stat().st_size > 20_000
+    assert "Diagnosis" in (tmp_path / "diagnosis.html").read_text()

@@ -32,7 +32,7 @@ def _names(cell: str) -> list[str]:
 
 @pytest.mark.parametrize(
     "section, kind",
-    [("## Model variables", "model"), ("## Result variables", "result")],
+    [("## Model variables", "model"), ("## Result variables", "result"), ("## Diagnosis variables", "diagnosis")],
 )
 def test_every_documented_variable_is_in_the_schema(section, kind):
     schema = mf.load_schema(kind)
@@ -44,7 +44,7 @@ def test_every_documented_variable_is_in_the_schema(section, kind):
 
 @pytest.mark.parametrize(
     "section, kind",
-    [("## Model variables", "model"), ("## Result variables", "result")],
+    [("## Model variables", "model"), ("## Result variables", "result"), ("## Diagnosis variables", "diagnosis")],
 )
 def test_documented_dims_match_the_schema(section, kind):
     schema = mf.load_schema(kind)
@@ -70,7 +70,7 @@ def test_documented_flags_match_the_schema():
 
 
 def test_global_attributes_are_required_by_every_kind():
-    for kind in ("model", "result", "comparison", "sweep"):
+    for kind in mf.schema.KINDS:
         attrs = mf.load_schema(kind)["global_attributes"]
         assert attrs["Conventions"]["contains"] == "CF-1.11"
         assert attrs["masonryfw_format"]["value"] == kind
@@ -86,3 +86,9 @@ def test_unknown_kind_and_version_are_clear_errors():
         mf.load_schema("mesh")
     with pytest.raises(mf.ModelError, match="unknown format version 7"):
         mf.load_schema("model", 7)
+
+
+def test_every_diagnosis_variable_is_documented():
+    own = set(mf.load_schema("diagnosis")["variables"]) - set(mf.load_schema("model")["variables"])
+    documented = {n for row in _table_rows("## Diagnosis variables") for n in _names(row[0])}
+    assert own == documented

@@ -197,3 +197,24 @@ def test_cli_builds_solves_and_draws_a_trough_wall(tmp_path):
     assert failed.exit_code == 1
     assert "'settlement.segment' = -0.1: must be positive" in failed.output
     assert "Traceback" not in failed.output
+
+
+def test_a_step_profile_is_the_papers_settling_support():
+    """``profile = "step"`` over [1.6, 4.0] m is the same loading as a moving support range there: the segments
+    under it translate down at rate 1, the rest hold, and la's alpha and collapse reaction agree with the
+    support-range wall's to the solver's tolerance."""
+    step = mf.build({**BASE, "settlement": {"profile": "step", "start": 1.6, "end": 4.0, "segment": 0.4}})
+    ranges = mf.build({**BASE, "supports": {"left": {"kind": "fixed", "start": 0.0, "end": 1.6},
+                                            "right": {"kind": "moving", "start": 1.6, "end": 4.0}}})
+    moving, x0 = moving_supports(step)
+    assert np.allclose(np.sort(x0), np.arange(1.6, 4.0 - 1e-9, 0.4))
+    assert np.allclose(step.settlement_direction.values[moving], [0.0, -1.0, 0.0])
+    a, b = mf.solve(step, "la", {}), mf.solve(ranges, "la", {})
+    assert float(a.collapse_multiplier) == pytest.approx(float(b.collapse_multiplier), abs=1e-6)
+    numbers = [{n.name: n.value for n in mf.key_numbers(r)} for r in (a, b)]
+    assert numbers[0]["collapse_reaction"] == pytest.approx(numbers[1]["collapse_reaction"], rel=1e-5)
+
+
+def test_a_step_must_end_after_it_starts():
+    with pytest.raises(mf.SpecError, match="'settlement.end' = 1.0: must exceed 'settlement.start' = 2.0"):
+        mf.build({**BASE, "settlement": {"profile": "step", "start": 2.0, "end": 1.0}})

@@ -129,7 +129,7 @@ def test_a_report_refuses_models_and_results_of_different_walls(test_12c_files, 
     model = tmp_path / "model.nc"
     mf.save(mf.open_model("test-12c"), model)
     run = CliRunner().invoke(cli, ["report", str(model), "-o", str(tmp_path / "r.html")])
-    assert run.exit_code == 1 and "not a result file" in run.stderr
+    assert run.exit_code == 1 and "not a result or diagnosis file" in run.stderr
     run = CliRunner().invoke(cli, ["report", str(test_12c_files["la"]), "-o", str(test_12c_files["la"])])
     assert run.exit_code == 1
 

@@ -1,0 +1,50 @@
+"""``diagnose``: from a crack survey (and a levelling) back to the settlement that caused it.
+
+Registration only (cheap to import); the work lives in :mod:`.survey` (reading crack maps and levellings),
+:mod:`.scenarios` (the ``[settlement]`` tables tried), :mod:`.scoring` (how well a mechanism explains a
+survey), :mod:`.diagnosis` (the search and the ranking), :mod:`.dataset` (the ``diagnosis`` dataset and the
+``--json`` contract), :mod:`.plotting` (the ``diagnosis`` plot) and :mod:`.commands` (the CLI command).
+docs/diagnose.md says what the scores mean and where the method stops.
+
+From Python::
+
+    from masonryfw_diagnose import diagnose, read_cracks, wall_model
+    diagnosis = diagnose(wall_model("facade-1"), read_cracks("cracks.geojson"))
+    diagnosis.best.table  # a [settlement] table, best first: diagnosis.candidates
+"""
+from __future__ import annotations
+
+import importlib
+
+import masonryfw as mf
+
+from .commands import COMMANDS
+
+_PUBLIC = {"diagnose": "diagnosis", "verify": "diagnosis", "wall_model": "diagnosis", "read_cracks": "survey",
+           "read_levelling": "survey", "to_dataset": "dataset", "to_json": "dataset"}
+__all__ = sorted(_PUBLIC)
+
+PLOTTER = mf.Plotter(
+    "diagnosis",
+    "a settlement diagnosis: the surveyed cracks over the wall beside the best candidates' mechanisms and cracks, "
+    "the scores of every candidate (and of the Gaussian troughs over their centre and width)",
+    mf.lazy("masonryfw_diagnose.plotting:draw_diagnosis"),
+    options=(mf.Option("amplification", float, None, "displacement amplification; auto: the largest motion drawn "
+                       "as 8 % of the wall's size", above=0.0),),
+)
+
+
+def __getattr__(name: str):
+    if name in _PUBLIC:
+        return getattr(importlib.import_module(f".{_PUBLIC[name]}", __name__), name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+@mf.hookimpl
+def masonryfw_commands():
+    return list(COMMANDS)
+
+
+@mf.hookimpl
+def masonryfw_plotters():
+    return [PLOTTER]

@@ -1,0 +1,190 @@
+"""The ``diagnose`` command this plugin adds to the ``masonryfw`` CLI."""
+from __future__ import annotations
+
+import json
+import shlex
+import sys
+import time
+from pathlib import Path
+
+import click
+
+import masonryfw as mf
+
+#: Exit status of a diagnosis stopped by Ctrl-C (what was ranked so far is written).
+INTERRUPTED = 130
+
+
+def _command_line() -> str:
+    obj = click.get_current_context().find_root().obj
+    if isinstance(obj, dict) and obj.get("command_line"):
+        return obj["command_line"]
+    return shlex.join(["masonryfw", *sys.argv[1:]])
+
+
+def _families(ctx, param, value: str) -> tuple[str, ...]:
+    from .scenarios import FAMILIES
+
+    names = tuple(dict.fromkeys(v.strip() for v in value.split(",") if v.strip()))
+    unknown = [n for n in names if n not in FAMILIES]
+    if unknown or not names:
+        raise click.BadParameter(f"{', '.join(unknown) or 'none given'}: choose among {', '.join(FAMILIES)}")
+    return names
+
+
+def _default_output(wall: str) -> Path:
+    return Path(f"{Path(wall).stem if Path(wall).is_file() else wall}.diagnosis.nc")
+
+
+def _echo(text: str, as_json: bool) -> None:
+    """The human lines: on stdout, or on stderr when stdout carries the JSON."""
+    click.echo(text, err=as_json)
+
+
+def _ranking_lines(diagnosis, top: int) -> list[str]:
+    from . import scenarios
+
+    x_a, x_b = diagnosis.extent
+    levelled = diagnosis.survey.levelling is not None
+    header = f"{'rank':>4}  {'score':>5}  {'cracks':>6}  {'level':>5}  {'t [mm]':>7}  {'':1}  scenario"
+    lines = [header]
+    shown = max(top, 1)
+    for c in diagnosis.candidates[:shown]:
+        level = f"{c.score.levelling:5.2f}" if levelled and c.score.levelling is not None else f"{'-':>5}"
+        magnitude = f"{1e3 * c.score.magnitude:7.3g}" if c.score.magnitude is not None else f"{'-':>7}"
+        shape = scenarios.shape(c.table, x_a, x_b)
+        lines.append(f"{c.rank:>4}  {c.score.total:5.2f}  {c.score.crack:6.2f}  {level}  {magnitude}  "
+                     f"{'*' if c.plausible else ' '}  {scenarios.describe(c.table)}{f' ({shape})' if shape else ''}")
+    plausible = len(diagnosis.plausible)
+    if plausible > shown:
+        lines.append(f"   ... {plausible - shown} more plausible candidate(s) (* marks the plausible set; all in the "
+                     "output file)")
+    return lines
+
+
+def _table_lines(table: dict) -> list[str]:
+    from .dataset import settlement_table
+
+    values = settlement_table(table)
+    return ["[settlement]", *(f"{k} = {json.dumps(v)}" if isinstance(v, str) else f"{k} = {v:g}" for k, v in
+                              values.items())]
+
+
+@click.command("diagnose")
+@click.argument("wall")
+@click.option("--cracks", "cracks", required=True, type=click.Path(dir_okay=False),
+              help="The surveyed cracks: GeoJSON (LineString, MultiLineString; properties.width_mm), CSV "
+                   "(crack, x, y[, width_mm]) or DXF (LINE, LWPOLYLINE, POLYLINE).")
+@click.option("--cracks-layer", help="The DXF layer holding the cracks [default: every layer].")
+@click.option("--levelling", type=click.Path(dir_okay=False),
+              help="CSV x, y, dy of a course laid level (dy from level, negative down).")
+@click.option("--unit", type=click.Choice(["m", "cm", "mm"]),
+              help="Unit of the crack and levelling coordinates and dy [default: m, or the DXF's own]; widths "
+                   "are always mm.")
+@click.option("--profiles", "families", default="step,gaussian,linear", show_default=True, callback=_families,
+              help="The scenario families to try, comma separated.")
+@click.option("--segment", type=click.FloatRange(min=0.0, min_open=True),
+              help="Length of the ground segments [m] [default: the median unit length].")
+@click.option("--tolerance", type=click.FloatRange(min=0.0, min_open=True),
+              help="How far a surveyed line may lie from the joint it follows [m] [default: half the median unit "
+                   "height].")
+@click.option("--plugin", "solver", default="la", show_default=True,
+              help="The solver whose cracks are matched (la: its collapse mechanism).")
+@click.option("--option", "options", multiple=True, metavar="KEY=VALUE", help="A solver option (repeatable).")
+@click.option("--verify", "verify_with", metavar="SOLVER",
+              help="Run the best candidates (at most 3, at most --top) forward with SOLVER (e.g. fdem) to their "
+                   "estimated settlement.")
+@click.option("--top", type=click.IntRange(min=1), default=5, show_default=True,
+              help="Candidates listed (the JSON also lists every plausible one).")
+@click.option("--json", "as_json", is_flag=True, help="Print the diagnosis as one JSON object on stdout.")
+@click.option("-o", "--output", type=click.Path(dir_okay=False), help="[default: <wall>.diagnosis.nc]")
+@click.option("--progress/--no-progress", default=None,
+              help="Draw a progress bar on stderr [default: when stderr is a terminal].")
+def diagnose_command(wall: str, cracks: str, cracks_layer: str | None, levelling: str | None, unit: str | None,
+                     families: tuple[str, ...], segment: float | None, tolerance: float | None, solver: str,
+                     options: tuple[str, ...], verify_with: str | None, top: int, as_json: bool,
+                     output: str | None, progress: bool | None) -> None:
+    """Which settlement of the ground under WALL explains the surveyed cracks?
+
+    WALL is a bundled case, a spec (parametric or drawn; its supports, [settlement] and [loading] may be left
+    out) or a model file. Its ground is cut into segments and every scenario of the chosen families (a step,
+    a Gaussian trough, a tilt) is solved and scored against the cracks (and the levelling); the candidates
+    are ranked best first, with the plausible set (within 0.05 of the best score) marked. Writes the
+    diagnosis dataset (`masonryfw plot OUT --kind diagnosis`, `masonryfw report OUT`). Ctrl-C writes what
+    was ranked so far (exit status 130).
+    """
+    from . import dataset
+    from .diagnosis import KEPT, diagnose, verify, wall_model
+    from .survey import read_cracks, read_levelling
+
+    inputs = [Path(p) for p in (wall, cracks, levelling) if p and Path(p).is_file()]
+    out = Path(output) if output else _default_output(wall)
+    mf.check_output_path(out, inputs)
+    survey = read_cracks(cracks, unit, cracks_layer)
+    if levelling:
+        survey = survey.with_levelling(read_levelling(levelling, survey.sources["unit"]), Path(levelling).name)
+    solver_options = mf.parse_option_pairs(options)
+    mf.get_solver(solver)  # an unknown solver named before the wall is built
+    if verify_with:
+        mf.get_solver(verify_with)
+    model = wall_model(wall)
+    bar = mf.progress_bar(progress)
+    started = time.perf_counter()
+    try:
+        diagnosis = diagnose(model, survey, families, segment, solver, solver_options, tolerance,
+                             progress=bar or mf.no_progress)
+        if verify_with:
+            verify(diagnosis, verify_with, min(top, KEPT), progress=bar or mf.no_progress)
+    finally:
+        if bar is not None:
+            bar.close()
+    seconds = time.perf_counter() - started
+    mf.save(dataset.to_dataset(diagnosis, wall), out, command=_command_line(), protect=inputs)
+    _report(diagnosis, wall, top, as_json, seconds, out)
+    if diagnosis.interrupted:
+        click.echo(f"interrupted after {len(diagnosis.candidates) + len(diagnosis.failed)} scenario(s): the ranking "
+                   f"of those is written to {out}", err=True)
+        click.get_current_context().exit(INTERRUPTED)
+
+
+def _report(diagnosis, wall: str, top: int, as_json: bool, seconds: float, out: Path) -> None:
+    from . import dataset, scenarios
+
+    survey = diagnosis.survey
+    ground = int(mf.support_blocks(diagnosis.model.block_role.values).sum())
+    _echo(f"diagnose {wall}: {ground} ground segments of {diagnosis.segment:.4g} m "
+          f"({'given' if diagnosis.segment_given else 'the median unit length'}); {len(survey.cracks)} surveyed "
+          f"line(s) run along {diagnosis.observed.joints.size} joints within {diagnosis.wall.tolerance:.3g} m, "
+          f"{len(diagnosis.observed.unmatched)} match no joint", as_json)
+    for k in diagnosis.observed.unmatched:
+        _echo(f"  no joint near crack {survey.names[k]!r}: drawn across units, or off the wall's joints", as_json)
+    failed = f", {len(diagnosis.failed)} could not be solved" if diagnosis.failed else ""
+    _echo(f"tried {len(diagnosis.candidates) + len(diagnosis.failed)} scenarios with {diagnosis.solver}{failed} "
+          f"in {seconds:.3g} s", as_json)
+    for line in _ranking_lines(diagnosis, top):
+        _echo(line, as_json)
+    _echo(diagnosis.verdict(), as_json)
+    best = diagnosis.best
+    if best.score.unexplained:
+        names = ", ".join(repr(survey.names[k]) for k in best.score.unexplained[:8])
+        more = f" and {len(best.score.unexplained) - 8} more" if len(best.score.unexplained) > 8 else ""
+        _echo(f"the best leaves {len(best.score.unexplained)} surveyed line(s) unexplained: {names}{more}", as_json)
+    if best.score.unobserved:
+        _echo(f"the best cracks {best.score.unobserved} joint(s) nobody surveyed", as_json)
+    for candidate in diagnosis.candidates[:top]:
+        if candidate.verified:
+            v = candidate.verified
+            width = "-" if v.get("crack_width") is None else f"{1e3 * v['crack_width']:.3g} mm"
+            category = "-" if v.get("damage_category") is None else f"{v['damage_category']:.0f}"
+            _echo(f"verified with {diagnosis.verified_with}: {scenarios.describe(candidate.table)} at "
+                  f"{1e3 * candidate.score.magnitude:.3g} mm: widest crack {width}, damage category {category}",
+                  as_json)
+    _echo("the best candidate, to paste into a spec:", as_json)
+    for line in _table_lines(best.table):
+        _echo(f"  {line}", as_json)
+    _echo(f"result: {out}", as_json)
+    if as_json:
+        click.echo(dataset.json_text(diagnosis, top))
+
+
+COMMANDS = (diagnose_command,)

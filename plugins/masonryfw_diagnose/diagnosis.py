@@ -1,0 +1,227 @@
+"""From a crack survey back to the settlement that caused it: scenarios tried, scored and ranked.
+
+The wall (a bundled case, a spec, parametric or drawn, or a model file) is put on its ground (its support
+blocks merged, or one made under its lowest masonry) cut into segments (``mf.ground_model``; its own support
+kinematics, profile and loading set aside).
+Every scenario (:mod:`.scenarios`) moves that ground (``mf.over_profile``) and is solved by the chosen
+solver, la by default: la's collapse mechanism is where a dry-joint wall opens as soon as the ground moves,
+so its cracks are the pattern to match (docs/diagnose.md states this assumption and its limits). Each is
+scored against the survey (:mod:`.scoring`); the candidates are ranked best first, and every candidate within
+``PLAUSIBLE_MARGIN`` of the best's score is in the *plausible set*, the honest uncertainty.
+"""
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import xarray as xr
+
+import masonryfw as mf
+
+from . import scenarios, scoring
+from .survey import Survey
+
+#: A candidate within this score of the best is plausible.
+PLAUSIBLE_MARGIN = 0.05
+#: A best score under this explains the survey poorly: the diagnosis says so.
+EXPLAINED = 0.5
+#: The best candidates whose mechanisms are kept (and drawn, and verified).
+KEPT = 3
+
+
+@dataclass
+class Candidate:
+    table: dict
+    score: scoring.Score
+    rank: int = 0
+    plausible: bool = False
+    result: xr.Dataset | None = None  # kept for the best few
+    verified: dict | None = None  # the forward run of --verify: its numbers
+
+
+@dataclass
+class Diagnosis:
+    model: xr.Dataset  # the wall on its ground segments, every segment held
+    survey: Survey
+    wall: scoring.Wall
+    observed: scoring.Observed
+    candidates: list[Candidate]  # ranked, best first
+    solver: str
+    segment: float
+    families: tuple[str, ...]
+    extent: tuple[float, float]  # the ground's ends x_a, x_b [m]
+    unit_length: float  # the median masonry block length [m]
+    segment_given: bool = False
+    failed: list[tuple[dict, str]] = field(default_factory=list)
+    verified_with: str = ""
+    interrupted: bool = False  # Ctrl-C stopped the search: the candidates are those tried before
+
+    @property
+    def best(self) -> Candidate:
+        return self.candidates[0]
+
+    @property
+    def plausible(self) -> list[Candidate]:
+        return [c for c in self.candidates if c.plausible]
+
+    @property
+    def explained(self) -> bool:
+        return self.best.score.total >= EXPLAINED
+
+    def either_end(self) -> bool:
+        """Whether the plausible candidates disagree on which end of the wall settles most (cracks alone
+        cannot tell a part that went down from the rest going up: a levelling can)."""
+        middle = 0.5 * sum(self.extent)
+        sides = {np.sign(settled_middle(c.table, self.extent) - middle) for c in self.plausible}
+        return {-1.0, 1.0} <= sides
+
+    def verdict(self) -> str:
+        count = len(self.plausible)
+        if not self.explained:
+            return (f"nothing tried explains these cracks well: the best score is {self.best.score.total:.2f} "
+                    f"(under {EXPLAINED}), and {count} candidates are within {PLAUSIBLE_MARGIN} of it")
+        text = (f"best: {scenarios.describe(self.best.table)} (score {self.best.score.total:.2f}); {count} "
+                f"candidate(s) within {PLAUSIBLE_MARGIN} of it")
+        if self.either_end() and self.survey.levelling is None:
+            text += ("; they settle either end of the wall: the cracks alone do not say which part went down, "
+                     "a levelling would (--levelling)")
+        return text
+
+
+def settled_middle(table: dict, extent: tuple[float, float]) -> float:
+    """The rate-weighted mean x of the ground a ``[settlement]`` table moves under the wall."""
+    x = np.linspace(extent[0], extent[1], 201)
+    profile = mf.settlement_profile(table, extent[0], extent[1], 1.0)
+    rate = profile.rate(x)
+    return float(np.average(x, weights=rate)) if rate.sum() > 0 else 0.5 * sum(extent)
+
+
+def wall_model(source: str) -> xr.Dataset:
+    """The wall to diagnose: a bundled case, a model file or a spec (parametric or drawn), which may leave out
+    its supports, ``[settlement]`` and ``[loading]`` (:func:`masonryfw.load_wall`): the diagnosis sets them aside
+    and makes its ground."""
+    path = Path(source)
+    if path.is_file() and path.suffix.lower() in mf.model.SPEC_SUFFIXES:
+        return mf.build(mf.load_wall(path))
+    return mf.open_model(source)
+
+
+def check_survey(survey: Survey, model: xr.Dataset, margin: float) -> None:
+    """Refuse cracks and levelling points further than ``margin`` off the wall's masonry (a wrong unit, another
+    drawing's coordinates), naming the item, the wall's extent and the unit."""
+    masonry = mf.masonry_blocks(model.block_role.values)
+    xmin, xmax, ymin, ymax = mf.block_bounds(model.node_x.values, model.node_y.values, model.block_node_count.values)
+    wall = (xmin[masonry].min(), xmax[masonry].max(), ymin[masonry].min(), ymax[masonry].max())
+    unit = survey.sources.get("unit", "m")
+    scale = {"m": 1.0, "cm": 0.01, "mm": 0.001}[unit]
+    extent = f"x {wall[0] / scale:.6g}..{wall[1] / scale:.6g}, y {wall[2] / scale:.6g}..{wall[3] / scale:.6g} {unit}"
+
+    def off(points: np.ndarray) -> np.ndarray:
+        return ((points[:, 0] < wall[0] - margin) | (points[:, 0] > wall[1] + margin)
+                | (points[:, 1] < wall[2] - margin) | (points[:, 1] > wall[3] + margin))
+
+    for name, line in zip(survey.names, survey.cracks):
+        outside = off(line)
+        if outside.any():
+            x, y = line[np.argmax(outside)] / scale
+            raise mf.SpecError(f"crack map {survey.sources.get('cracks', '')!r}: crack {name!r} passes ({x:.6g}, "
+                               f"{y:.6g}) {unit}, off the wall ({extent}); a wrong --unit or another drawing's "
+                               "coordinates?")
+    if survey.levelling is not None and off(survey.levelling).any():
+        row = int(np.argmax(off(survey.levelling)))
+        x, y = survey.levelling[row, :2] / scale
+        raise mf.SpecError(f"levelling {survey.sources.get('levelling', '')!r} row {row + 2}: the point ({x:.6g}, "
+                           f"{y:.6g}) {unit} is off the wall ({extent})")
+
+
+def ground_pieces(model: xr.Dataset) -> np.ndarray:
+    """``(n, 2)``: the x-extent of every ground piece (support block), left to right."""
+    ground = mf.support_blocks(model.block_role.values)
+    xmin, xmax, _, _ = mf.block_bounds(model.node_x.values, model.node_y.values, model.block_node_count.values)
+    pieces = np.round(np.c_[xmin[ground], xmax[ground]], 12)
+    return pieces[np.lexsort(pieces.T[::-1])]
+
+
+def diagnose(model: xr.Dataset, survey: Survey, families=scenarios.FAMILIES, segment: float | None = None,
+             solver: str = "la", options: dict | None = None, tolerance: float | None = None,
+             progress=mf.no_progress) -> Diagnosis:
+    """Try every scenario of ``families`` on ``model``'s wall and rank them against ``survey`` (module docstring).
+
+    ``segment`` defaults to the median masonry block length (about a unit length); ``tolerance`` (how far a
+    surveyed line may lie from the joint it follows) to half the median block height.
+    """
+    masonry = mf.masonry_blocks(model.block_role.values)
+    xmin, xmax, _, _ = mf.block_bounds(model.node_x.values, model.node_y.values, model.block_node_count.values)
+    unit_length = float(np.median(xmax[masonry] - xmin[masonry]))
+    segment_given = segment is not None
+    segment = unit_length if segment is None else segment
+    ground = mf.ground_model(model, segment)
+    wall = scoring.wall_joints(ground, tolerance)
+    check_survey(survey, ground, max(wall.tolerance, wall.unit_height))
+    observed = scoring.observe(wall, survey.cracks)
+    pieces = ground_pieces(ground)
+    diagnosis = Diagnosis(ground, survey, wall, observed, [], solver, segment, tuple(families),
+                          (float(pieces.min()), float(pieces.max())), unit_length, segment_given)
+    tables = scenarios.candidates(pieces, diagnosis.families, segment)
+    try:
+        for k, table in enumerate(tables):
+            progress(k / len(tables), f"diagnose: {scenarios.describe(table)} ({k + 1} of {len(tables)})")
+            try:
+                result = solved(diagnosis, table, options)
+            except mf.MasonryError as exc:
+                diagnosis.failed.append((table, str(exc).splitlines()[0]))
+                continue
+            diagnosis.candidates.append(
+                Candidate(table, scoring.score(wall, observed, result, survey.widths_mm, survey.levelling)))
+    except KeyboardInterrupt:
+        if not diagnosis.candidates:
+            raise
+        diagnosis.interrupted = True
+    if not diagnosis.candidates:
+        raise mf.SolveError(f"diagnose: no scenario could be solved ({diagnosis.failed[0][1]})")
+    rank(diagnosis.candidates)
+    for candidate in diagnosis.candidates[:KEPT]:
+        candidate.result = solved(diagnosis, candidate.table, options)
+    progress(1.0, "diagnose: ranked")
+    return diagnosis
+
+
+def rank(candidates: list[Candidate]) -> None:
+    """Sort best first (ties: step before gaussian before linear, then as tried) and mark the plausible set."""
+    order = {family: i for i, family in enumerate(scenarios.FAMILIES)}
+    candidates.sort(key=lambda c: (-round(c.score.total, 12), order[c.table["profile"]]))
+    best = candidates[0].score.total
+    for number, candidate in enumerate(candidates, start=1):
+        candidate.rank = number
+        candidate.plausible = candidate.score.total >= best - PLAUSIBLE_MARGIN
+
+
+def profile_of(diagnosis: Diagnosis, table: dict) -> mf.Profile:
+    """The profile a candidate's ``[settlement]`` table describes under the diagnosed wall."""
+    return mf.settlement_profile(table, *diagnosis.extent, diagnosis.unit_length)
+
+
+def solved(diagnosis: Diagnosis, table: dict, options: dict | None) -> xr.Dataset:
+    """The wall on its ground moved as the ``[settlement]`` ``table`` says, solved by the diagnosis's solver."""
+    return mf.solve(mf.over_profile(diagnosis.model, profile_of(diagnosis, table)), diagnosis.solver, options or {})
+
+
+def verify(diagnosis: Diagnosis, solver: str = "fdem", count: int = KEPT, progress=mf.no_progress) -> None:
+    """Run the best ``count`` candidates that have a magnitude forward with ``solver`` to that settlement (the
+    model's ``settlement_target``): their widest crack, damage category and smallest reaction go into
+    ``candidate.verified``."""
+    diagnosis.verified_with = solver
+    for k, candidate in enumerate(diagnosis.candidates[:count]):
+        magnitude = candidate.score.magnitude
+        if magnitude is None or not magnitude > 0 or not math.isfinite(magnitude):
+            continue
+        progress(k / count, f"verify: {scenarios.describe(candidate.table)} with {solver} to {1e3 * magnitude:.3g} mm")
+        profile = dataclasses.replace(profile_of(diagnosis, candidate.table), target=magnitude)
+        result = mf.solve(mf.over_profile(diagnosis.model, profile), solver, {})
+        numbers = {n.name: n.value for n in mf.key_numbers(result)}
+        candidate.verified = {key: numbers.get(key) for key in ("crack_width", "damage_category", "minimum_reaction",
+                                                                "dead_reaction", "final_settlement")}
+    progress(1.0, "verify: done")

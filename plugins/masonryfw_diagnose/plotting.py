@@ -1,0 +1,199 @@
+"""The ``diagnosis`` plot: what was surveyed, what the best candidates crack, how every candidate scored.
+
+Top row: the survey over the wall (surveyed lines red, the joints they run along heavy, lines that match no
+joint dashed), then the best candidates' mechanisms (amplified, blocks that move tinted) with their cracked
+joints in blue under the surveyed lines. Bottom row: every candidate's score by rank (the plausible set
+shaded), the Gaussian troughs' scores over their centre and width when they were tried, and with a levelling
+the measured points beside the best candidates' fits.
+"""
+from __future__ import annotations
+
+import numpy as np
+import xarray as xr
+
+import masonryfw as mf
+
+FAMILY_COLOURS = {"step": "tab:blue", "gaussian": "tab:orange", "linear": "tab:green"}
+SURVEY_COLOUR = "tab:red"
+CRACK_COLOUR = "tab:blue"
+#: The largest motion drawn as this share of the wall's size (amplification auto).
+DRAWN_MOTION = 0.08
+
+
+def _rings(ds: xr.Dataset, x: np.ndarray, y: np.ndarray, blocks: np.ndarray) -> list[np.ndarray]:
+    starts = np.r_[0, np.cumsum(ds.block_node_count.values)[:-1]]
+    counts = ds.block_node_count.values
+    return [np.c_[x[starts[b]:starts[b] + counts[b]], y[starts[b]:starts[b] + counts[b]]] for b in blocks]
+
+
+def _describe(ds: xr.Dataset, k: int) -> str:
+    profile = str(ds.candidate_profile.values[k])
+    if profile == "gaussian":
+        return f"gaussian at {float(ds.candidate_center[k]):.4g} m, i {float(ds.candidate_width[k]):.4g} m"
+    start, end = float(ds.candidate_start[k]), float(ds.candidate_end[k])
+    return f"step {start:.4g}..{end:.4g} m" if profile == "step" else f"tilt from {start:.4g} m down to {end:.4g} m"
+
+
+def _survey_lines(ax, ds: xr.Dataset, style: str = "-", width: float = 1.6) -> None:
+    owner = ds.survey_point_crack.values
+    matched = ds.survey_crack_matched.values
+    for k in range(ds.sizes["survey_crack"]):
+        points = owner == k
+        ax.plot(ds.survey_point_x.values[points], ds.survey_point_y.values[points], style if matched[k] else "--",
+                color=SURVEY_COLOUR, lw=width, solid_capstyle="round", zorder=4)
+
+
+def _joints(ax, ds: xr.Dataset, joints: np.ndarray, colour: str, widths) -> None:
+    from matplotlib.collections import LineCollection
+
+    if joints.size:
+        segments = np.stack([ds.interface_x.values[joints], ds.interface_y.values[joints]], axis=-1)
+        ax.add_collection(LineCollection(segments, colors=colour, linewidths=widths, zorder=3, capstyle="round"))
+
+
+def _wall(ax, ds: xr.Dataset, x: np.ndarray, y: np.ndarray, moving: np.ndarray | None = None) -> None:
+    from matplotlib.collections import PolyCollection
+
+    blocks = np.arange(ds.sizes["block"])
+    support = mf.support_blocks(ds.block_role.values)
+    face = np.where(support, "#b9b9b9", "#f1ece4").astype(object)
+    if moving is not None:
+        face[moving & ~support] = "#e8cfa6"
+    ax.add_collection(PolyCollection(_rings(ds, x, y, blocks), facecolors=list(face), edgecolors="#8c8c8c",
+                                     linewidths=0.3, zorder=1))
+    ax.set_aspect("equal")
+    ax.autoscale_view()
+    ax.set_xticks([])
+    ax.set_yticks([])
+
+
+def _deformed(ds: xr.Dataset, kept: int, amplification: float | None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Node positions of the ``kept`` mechanism amplified, and which blocks move (over 2 % of the largest)."""
+    u = ds.kept_block_displacement.values[kept]
+    theta = ds.kept_block_rotation.values[kept]
+    block = np.repeat(np.arange(ds.sizes["block"]), ds.block_node_count.values)
+    dx = ds.node_x.values - ds.block_centroid_x.values[block]
+    dy = ds.node_y.values - ds.block_centroid_y.values[block]
+    mx = u[block, 0] - theta[block] * dy
+    my = u[block, 1] + theta[block] * dx
+    largest = float(np.hypot(mx, my).max())
+    size = float(np.hypot(np.ptp(ds.node_x.values), np.ptp(ds.node_y.values)))
+    scale = amplification if amplification is not None else (DRAWN_MOTION * size / largest if largest > 0 else 0.0)
+    speed = np.hypot(u[:, 0], u[:, 1])
+    return ds.node_x.values + scale * mx, ds.node_y.values + scale * my, speed > 0.02 * speed.max(initial=0.0)
+
+
+def _survey_panel(ax, ds: xr.Dataset) -> None:
+    _wall(ax, ds, ds.node_x.values, ds.node_y.values)
+    _joints(ax, ds, np.flatnonzero(ds.observed_joint.values), "#6b0000", 2.4)
+    _survey_lines(ax, ds)
+    unmatched = int((ds.survey_crack_matched.values == 0).sum())
+    ax.set_title(f"survey: {ds.sizes['survey_crack']} lines, {int(ds.observed_joint.values.sum())} joints"
+                 + (f", {unmatched} on no joint (dashed)" if unmatched else ""), fontsize=8)
+
+
+def _candidate_panel(ax, ds: xr.Dataset, kept: int, amplification: float | None) -> None:
+    k = int(ds.kept_candidate.values[kept])
+    x, y, moving = _deformed(ds, kept, amplification)
+    _wall(ax, ds, x, y, moving)
+    indicator = ds.kept_crack_indicator.values[kept]
+    masonry = mf.masonry_blocks(ds.block_role.values)
+    inner = masonry[ds.interface_blocks.values.astype(np.int64)].all(axis=1)
+    cracked = np.flatnonzero(inner & (indicator > 0))
+    _joints(ax, ds, cracked, CRACK_COLOUR, 0.6 + 2.4 * indicator[cracked])
+    _survey_lines(ax, ds, width=0.9)
+    magnitude = float(ds.candidate_magnitude.values[k])
+    size = f", t {1e3 * magnitude:.3g} mm" if np.isfinite(magnitude) else ""
+    ax.set_title(f"{k + 1}: {_describe(ds, k)}\nscore {float(ds.candidate_score.values[k]):.2f}{size}"
+                 + (" (plausible)" if ds.candidate_plausible.values[k] else ""), fontsize=8)
+
+
+def _score_panel(ax, ds: xr.Dataset) -> None:
+    score = ds.candidate_score.values
+    rank = np.arange(1, score.size + 1)
+    families = ds.candidate_profile.values.astype(str)
+    best = float(score[0])
+    margin = float(ds.attrs.get("plausible_margin", 0.05))
+    ax.axhspan(best - margin, best, color="#dcdcdc", zorder=0, label=f"plausible (within {margin:g})")
+    for family, colour in FAMILY_COLOURS.items():
+        mine = families == family
+        if mine.any():
+            ax.scatter(rank[mine], score[mine], s=9, color=colour, label=family, zorder=2)
+    ax.axhline(float(ds.attrs.get("explained_threshold", 0.5)), color="k", lw=0.6, ls=":",
+               label="explained well above")
+    ax.set_xscale("log")
+    ax.set_ylim(0.0, 1.02)
+    ax.set_xlabel("rank")
+    ax.set_ylabel("score")
+    ax.set_title(f"{score.size} candidates", fontsize=8)
+    ax.legend(fontsize=7, loc="upper right", frameon=False)
+
+
+def _gaussian_panel(ax, ds: xr.Dataset) -> None:
+    gaussian = ds.candidate_profile.values.astype(str) == "gaussian"
+    centres, widths = ds.candidate_center.values[gaussian], ds.candidate_width.values[gaussian]
+    scores = ds.candidate_score.values[gaussian]
+    xs, ws = np.unique(np.round(centres, 9)), np.unique(np.round(widths, 9))
+    grid = np.full((ws.size, xs.size), np.nan)
+    grid[np.searchsorted(ws, np.round(widths, 9)), np.searchsorted(xs, np.round(centres, 9))] = scores
+    mesh = ax.pcolormesh(np.arange(xs.size + 1) - 0.5, np.arange(ws.size + 1) - 0.5, grid, cmap="viridis",
+                         vmin=0.0, vmax=1.0, shading="flat")
+    ax.figure.colorbar(mesh, ax=ax, label="score", shrink=0.9)
+    step = max(1, xs.size // 8)
+    ax.set_xticks(np.arange(xs.size)[::step], [f"{v:.3g}" for v in xs[::step]], fontsize=7)
+    ax.set_yticks(np.arange(ws.size), [f"{v:.3g}" for v in ws], fontsize=7)
+    masonry = mf.masonry_blocks(ds.block_role.values)
+    xmin, xmax, _, _ = mf.block_bounds(ds.node_x.values, ds.node_y.values, ds.block_node_count.values)
+    for edge in (xmin[masonry].min(), xmax[masonry].max()):
+        ax.axvline(np.interp(edge, xs, np.arange(xs.size)), color="w", lw=0.8, ls="--")
+    ax.set_xlabel("trough centre [m] (dashed: the wall's ends)")
+    ax.set_ylabel("trough width i [m]")
+    ax.set_title("gaussian troughs", fontsize=8)
+
+
+def _levelling_panel(ax, ds: xr.Dataset) -> None:
+    from .scoring import levelling_fit, vertical_motion
+
+    points = np.c_[ds.levelling_x.values, ds.levelling_y.values, ds.levelling_dy.values]
+    order = np.argsort(points[:, 0])
+    ax.plot(points[order, 0], 1e3 * points[order, 2], "o", color=SURVEY_COLOUR, ms=4, label="levelling")
+    for kept in range(ds.sizes.get("kept", 0)):
+        mechanism = ds.assign(block_displacement=(("block", "axis"), ds.kept_block_displacement.values[kept]),
+                              block_rotation=("block", ds.kept_block_rotation.values[kept]))
+        t, fit = levelling_fit(mechanism, points)
+        p = vertical_motion(mechanism, points[order, 0], points[order, 1])
+        datum = float(np.mean(points[:, 2] - t * vertical_motion(mechanism, points[:, 0], points[:, 1])))
+        ax.plot(points[order, 0], 1e3 * (datum + t * p), "-", lw=1.0,
+                label=f"{int(ds.kept_candidate.values[kept]) + 1}: t {1e3 * t:.3g} mm, fit {fit:.2f}")
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("dy [mm] (negative down)")
+    ax.set_title("levelling and the best candidates' fits", fontsize=8)
+    ax.legend(fontsize=7, frameon=False)
+
+
+def draw_diagnosis(datasets, ax, options) -> None:
+    """The plot (module docstring) of one diagnosis dataset, drawn over ``ax``'s figure."""
+    if len(datasets) != 1 or datasets[0].attrs.get("masonryfw_format") != "diagnosis":
+        raise mf.MasonryError("the diagnosis plot draws one diagnosis dataset (written by `masonryfw diagnose`)")
+    ds = mf.derive_geometry(datasets[0])
+    figure = ax.figure
+    figure.delaxes(ax)
+    kept = ds.sizes.get("kept", 0)
+    columns = 1 + kept
+    width = float(np.ptp(ds.node_x.values))
+    height = float(np.ptp(ds.node_y.values))
+    panel = 3.6
+    figure.set_size_inches(panel * columns, panel * height / width + 3.4)
+    grid = figure.add_gridspec(2, columns, height_ratios=[max(height / width, 0.25), 0.9])
+    _survey_panel(figure.add_subplot(grid[0, 0]), ds)
+    for k in range(kept):
+        _candidate_panel(figure.add_subplot(grid[0, 1 + k]), ds, k, options.get("amplification"))
+    panels = [_score_panel]
+    if (ds.candidate_profile.values.astype(str) == "gaussian").any():
+        panels.append(_gaussian_panel)
+    if "levelling_dy" in ds:
+        panels.append(_levelling_panel)
+    bottom = grid[1, :].subgridspec(1, len(panels), wspace=0.25)
+    for k, draw in enumerate(panels):
+        draw(figure.add_subplot(bottom[0, k]), ds)
+    figure.suptitle(str(ds.attrs.get("verdict", "")), fontsize=9)

@@ -1,0 +1,204 @@
+"""A surveyor's crack map drawn from a forward result: the known answer a diagnosis is tested against.
+
+The cracked joints of a result (``crack_indicator`` above a threshold, or an opening wider than a width
+for an incremental result) are joined into cracks (joints sharing an end), then drawn as a surveyor would:
+every line offset sideways (and kept on the wall), some joints left out (gaps), short cracks missed
+altogether, and a few spurious hairlines added where nothing cracked. Used by the tests and docs/diagnose.md's studies.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import xarray as xr
+
+import masonryfw as mf
+
+
+@dataclass(frozen=True)
+class Surveyor:
+    """How a surveyor draws cracks (lengths in unit heights h, shares in [0, 1])."""
+
+    offset: float = 0.0  # standard deviation of each line's sideways offset [h]
+    gaps: float = 0.0  # share of a crack's joints left out
+    missing: float = 0.0  # cracks shorter than this many h are not drawn
+    spurious: int = 0  # hairlines drawn where nothing cracked
+    spurious_length: float = 2.0  # their length [h]
+
+
+def cracked_joints(result: xr.Dataset, threshold: float = 0.1, width: float | None = None) -> np.ndarray:
+    """Joints between masonry blocks that ``result`` cracks: an opening or slip over ``width`` [m] at the last
+    record when given, else ``crack_indicator > threshold``."""
+    masonry = mf.masonry_blocks(result.block_role.values)
+    inner = masonry[result.interface_blocks.values.astype(np.int64)].all(axis=1)
+    if width is not None:
+        motion = np.maximum(np.abs(result.interface_opening.values), np.abs(result.interface_slip.values)).max(axis=1)
+        return np.flatnonzero(inner & (motion > width))
+    return np.flatnonzero(inner & (result.crack_indicator.values > threshold))
+
+
+def chains(result: xr.Dataset, joints: np.ndarray) -> list[np.ndarray]:
+    """``joints`` grouped into cracks: connected through shared ends (to a micrometre)."""
+    if joints.size == 0:
+        return []
+    ends = np.round(np.stack([result.interface_x.values[joints], result.interface_y.values[joints]], axis=-1), 6)
+    keys = {}
+    parent = list(range(joints.size))
+
+    def root(k: int) -> int:
+        while parent[k] != k:
+            parent[k] = parent[parent[k]]
+            k = parent[k]
+        return k
+
+    for k in range(joints.size):
+        for end in map(tuple, ends[k]):
+            if end in keys:
+                parent[root(k)] = root(keys[end])
+            else:
+                keys[end] = k
+    groups: dict[int, list[int]] = {}
+    for k in range(joints.size):
+        groups.setdefault(root(k), []).append(k)
+    return [joints[np.array(members)] for members in groups.values()]
+
+
+def draw(result: xr.Dataset, joints: np.ndarray, surveyor: Surveyor, rng: np.random.Generator,
+         widths_mm: dict[int, float] | None = None) -> dict:
+    """A GeoJSON FeatureCollection of ``joints`` (the cracked ones) drawn by ``surveyor`` (module docstring):
+    one MultiLineString per crack, with its ``width_mm`` when ``widths_mm`` (per joint) is given."""
+    masonry = mf.masonry_blocks(result.block_role.values)
+    xmin, xmax, ymin, ymax = mf.block_bounds(result.node_x.values, result.node_y.values,
+                                             result.block_node_count.values)
+    h = float(np.median(ymax[masonry] - ymin[masonry]))
+    box = (xmin[masonry].min(), xmax[masonry].max(), ymin[masonry].min(), ymax[masonry].max())
+    features = []
+    for chain in chains(result, joints):
+        lengths = result.interface_length.values[chain]
+        if lengths.sum() < surveyor.missing * h:
+            continue
+        drawn = chain[rng.random(chain.size) >= surveyor.gaps] if surveyor.gaps else chain
+        if drawn.size == 0:
+            continue
+        shift = rng.normal(0.0, surveyor.offset * h, 2) if surveyor.offset else np.zeros(2)
+        lines = [np.clip(np.c_[result.interface_x.values[j], result.interface_y.values[j]] + shift,
+                         [box[0], box[2]], [box[1], box[3]]).tolist() for j in drawn]
+        properties = {"name": f"crack {len(features) + 1}"}
+        if widths_mm is not None:
+            properties["width_mm"] = float(max(widths_mm.get(int(j), 0.0) for j in chain))
+        features.append({"type": "Feature", "properties": properties,
+                         "geometry": {"type": "MultiLineString", "coordinates": lines}})
+    for k in range(surveyor.spurious):
+        start = np.array([rng.uniform(box[0], box[1]), rng.uniform(box[2], box[3])])
+        angle = rng.uniform(0.0, np.pi)
+        end = start + surveyor.spurious_length * h * np.array([np.cos(angle), np.sin(angle)])
+        end = np.clip(end, [box[0], box[2]], [box[1], box[3]])
+        features.append({"type": "Feature", "properties": {"name": f"hairline {k + 1}"},
+                         "geometry": {"type": "LineString", "coordinates": [start.tolist(), end.tolist()]}})
+    return {"type": "FeatureCollection", "features": features}
+
+
+def levelling(result: xr.Dataset, y: float, scale: float = 1.0, noise: float = 0.0,
+              rng: np.random.Generator | None = None) -> np.ndarray:
+    """``(m, 3)`` x, y, dy of a levelling along the course at height ``y``: one point at the middle of every
+    masonry block the line crosses, its vertical motion (the block's ``block_displacement`` and
+    ``block_rotation``, times ``scale``: the settlement for a mechanism per unit settlement) plus a normal
+    error of standard deviation ``noise`` [m]."""
+    masonry = np.flatnonzero(mf.masonry_blocks(result.block_role.values))
+    _, _, ymin, ymax = mf.block_bounds(result.node_x.values, result.node_y.values, result.block_node_count.values)
+    crossed = masonry[(ymin[masonry] < y) & (ymax[masonry] > y)]
+    geometry = mf.derive_geometry(result)
+    x = geometry.block_centroid_x.values[crossed]
+    u = result.block_displacement.values[crossed]
+    dy = scale * u[:, 1]  # at the centroid's x the rotation adds nothing
+    if noise:
+        dy = dy + (rng or np.random.default_rng()).normal(0.0, noise, dy.size)
+    order = np.argsort(x)
+    return np.c_[x[order], np.full(x.size, y), dy[order]]
+
+
+#: Units a random wall is built of: (length, height) [m].
+UNITS = ((0.2, 0.05), (0.25, 0.065), (0.3, 0.1))
+
+
+def random_wall(rng: np.random.Generator) -> dict:
+    """A parametric spec of a random dry-joint wall (size, unit, bond, up to two openings with lintels), without
+    supports or a profile: :func:`random_truth` adds the settlement."""
+    length, height = UNITS[rng.integers(len(UNITS))]
+    columns, courses = int(rng.integers(5, 11)), int(rng.integers(6, 15))
+    width = columns * length
+    spec = {"title": f"random wall {columns} x {courses} units", "length_unit": "m",
+            "wall": {"width": width, "height": courses * height, "thickness": 0.1},
+            "unit": {"length": length, "height": height},
+            "bond": {"pattern": "running" if rng.random() < 0.85 else "stack",
+                     "first_course": "full" if rng.random() < 0.5 else "half"},
+            "material": {"unit_weight": 12000.0, "friction_angle": 21.8, "cohesion": 0.0, "tensile_strength": 0.0,
+                         "young_modulus": 1.1448e9, "poisson_ratio": 0.2}}
+    openings = []
+    for _ in range(int(rng.integers(0, 3)) if courses >= 8 and columns >= 6 else 0):
+        wide, tall = int(rng.integers(1, 3)), int(rng.integers(3, max(4, courses // 2)))
+        column, course = int(rng.integers(1, columns - wide)), int(rng.integers(2, max(3, courses - tall - 1)))
+        box = (column, course, column + wide, course + tall)
+        if all(box[2] + 1 <= o[0] or o[2] + 1 <= box[0] or box[3] + 1 <= o[1] or o[3] + 1 <= box[1]
+               for o in openings):
+            openings.append(box)
+    if openings:
+        spec["openings"] = [{"x": a * length, "y": b * height, "width": (c - a) * length, "height": (d - b) * height,
+                             "lintel_bearing": length / 2} for a, b, c, d in openings]
+    return spec
+
+
+def random_truth(spec: dict, rng: np.random.Generator) -> dict:
+    """A random ``[settlement]`` table under a :func:`random_wall`: a step at one end (20 to 50 % of the wall), a
+    Gaussian trough (axis from a quarter wall beyond either end, i from 0.15 to 1 wall length) or a tilt."""
+    width, unit = spec["wall"]["width"], spec["unit"]["length"]
+    family = ("step", "gaussian", "linear")[rng.integers(3)]
+    if family == "gaussian":
+        return {"profile": "gaussian", "center": float(rng.uniform(-0.25, 1.25) * width),
+                "width": float(rng.uniform(0.15, 1.0) * width)}
+    edge = round(float(rng.uniform(0.2, 0.5)) * width / unit) * unit
+    left = rng.random() < 0.5
+    if family == "step":
+        return {"profile": "step", "start": 0.0, "end": edge} if left else {
+            "profile": "step", "start": width - edge, "end": width}
+    return {"profile": "linear", "start": width - edge, "end": 0.0} if left else {
+        "profile": "linear", "start": edge, "end": width}
+
+
+def judged(best_tables: list[dict], plausible: list[dict], truth: dict, extent: tuple[float, float],
+           segment: float) -> dict:
+    """The success criteria of a diagnosis against the ``truth`` it should find (docs/diagnose.md): ``family``,
+    the best candidate's profile right; ``place``, a step's edges inside the wall (where the ground breaks)
+    within two segments, a tilt's hinge (``start``) within two segments, a trough's centre within 10 % of the
+    wall; ``side``, the same end of the wall settling most (steps and tilts: what cracks alone cannot tell);
+    ``shape``, sagging or hogging right (troughs); ``in_plausible``, a plausible candidate of the truth's
+    family in its place."""
+    from .diagnosis import settled_middle
+    from .scenarios import shape
+
+    length = extent[1] - extent[0]
+    tolerance = 2 * segment + 1e-9 * length
+
+    def inner_edges(table: dict) -> list[float]:
+        return [e for e in (table["start"], table["end"]) if extent[0] + 1e-9 * length < e < extent[1] - 1e-9 * length]
+
+    def placed(table: dict) -> bool:
+        if table["profile"] != truth["profile"]:
+            return False
+        if truth["profile"] == "gaussian":
+            return abs(table["center"] - truth["center"]) <= 0.1 * length
+        if truth["profile"] == "linear":
+            return abs(table["start"] - truth["start"]) <= tolerance
+        found = inner_edges(table)
+        return all(any(abs(e - f) <= tolerance for f in found) for e in inner_edges(truth))
+
+    best = best_tables[0]
+    verdict = {"family": best["profile"] == truth["profile"], "place": placed(best),
+               "in_plausible": any(placed(t) for t in plausible)}
+    middle = 0.5 * (extent[0] + extent[1])
+    if truth["profile"] == "gaussian":
+        verdict["shape"] = shape(best, *extent) == shape(truth, *extent)
+    else:
+        verdict["side"] = bool(np.sign(settled_middle(best, extent) - middle) ==
+                               np.sign(settled_middle(truth, extent) - middle))
+    return verdict
