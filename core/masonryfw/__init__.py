@@ -22,7 +22,7 @@ from .damage import DAMAGE_LIMITS, Cracks, damage_category, distortion, support_
 from .datasets import BUNDLED_NAMES, CASE_NAMES, DRAWN_NAMES, PROFILE_NAMES, bundled_cases, bundled_spec_path
 from .dofs import block_loads, block_motion, load_variables, motion_variables, upgrade
 from .drawing import DxfLines, read_dxf_lines
-from .errors import MasonryError, ModelError, PluginError, SolveError, SpecError, listed
+from .errors import Interrupted, MasonryError, ModelError, PluginError, SolveError, SpecError, listed
 from .geometry import (
     DERIVED_GEOMETRY_VARIABLES,
     block_bounds,
@@ -52,9 +52,21 @@ from .hookspecs import (
     resolve_options,
     unknown_name_message,
 )
+from .inputs import InputError, read_text, regular_file
 from .interfaces import detect_interfaces
-from .io import add_history, check_output_path, content_sha256, open_dataset, save, save_figure, save_text, sha256_file
+from .io import (
+    add_history,
+    check_output_path,
+    content_sha256,
+    open_dataset,
+    save,
+    save_figure,
+    save_text,
+    sha256_file,
+    write_atomically,
+)
 from .linalg import cholesky_factor, has_cholmod
+from .locks import BusyError, claim, release
 from .model import checked_model, model_part, open_model
 from .plausibility import PlausibilityWarning, plausibility
 from .plugins import (
@@ -102,10 +114,12 @@ from .semantics import (
     states_at,
     support_blocks,
 )
+from .signals import WriteInterrupted
 from .spec import dump_toml
 from .summary import (
     DIAGNOSIS_COLUMNS,
     Row,
+    candidate_text,
     csv_text,
     diagnosis_rows,
     headline_rows,

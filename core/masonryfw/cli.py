@@ -19,10 +19,25 @@ import click
 import numpy as np
 
 import masonryfw as mf
+from masonryfw.locks import release_all
 from masonryfw.plugins import command_plugin, installed_plugins, plugin_commands, render
 
-#: Exit status of a run stopped by Ctrl-C (128 + SIGINT), as shells report it.
-INTERRUPTED = 130
+#: The signals that stopped this command: the exit status is 128 + the first (130 after Ctrl-C, 143 after SIGTERM),
+#: as shells report it.
+_SIGNALS: list[int] = []
+
+
+class Terminated(KeyboardInterrupt):
+    """SIGTERM, taken as Ctrl-C is: what an interrupted command keeps, it keeps; temporary files are removed."""
+
+
+def _terminate(signum, frame) -> None:
+    _SIGNALS.append(signum)
+    raise Terminated
+
+
+def _interrupted_status() -> int:
+    return 128 + (_SIGNALS[0] if _SIGNALS else signal.SIGINT)
 LONG_RUN = 60.0  # seconds: the solve command prints the estimate of a run longer than this
 
 
@@ -67,14 +82,16 @@ class _MasonryGroup(click.Group):
                 warnings.showwarning = _show_warning
                 warnings.simplefilter("default", mf.PlausibilityWarning)  # each shown, whoever catches warnings
                 return super().invoke(ctx)
-        except Interrupted as exc:
+        except mf.Interrupted as exc:
             click.echo(str(exc), err=True)
-            ctx.exit(INTERRUPTED)
+            ctx.exit(_interrupted_status())
         except (mf.MasonryError, OSError) as exc:
             if ctx.params.get("debug"):
                 raise
             click.echo(f"error: {_error_message(exc)}", err=True)
             ctx.exit(1)
+        finally:
+            release_all()  # the claims of outputs a failed or interrupted command did not write
 
 
 @click.group(cls=_MasonryGroup)
@@ -313,10 +330,6 @@ def _open_input(path_or_name: str, validate: bool = True):
     return mf.open_model(path_or_name, validate=validate)
 
 
-class Interrupted(mf.MasonryError):
-    """Ctrl-C stopped a command: the message says what was kept; exit status 130."""
-
-
 @cli.command()
 @click.argument("model")
 @click.option("--plugin", "solver", required=True, help="Name of the solver (see `masonryfw plugins`).")
@@ -344,13 +357,13 @@ def solve(model: str, solver: str, output: str | None, options: dict[str, str], 
     try:
         result = mf.solve(dataset, solver, options, progress=bar)
     except KeyboardInterrupt:
-        raise Interrupted(f"solve {solver}: interrupted before its first step: nothing written") from None
+        raise mf.Interrupted(f"solve {solver}: interrupted before its first step: nothing written") from None
     finally:
         if bar is not None:
             bar.close()
     mf.save(result, out, command=_command_line(), protect=inputs)
     if int(result.attrs.get("interrupted", 0)):
-        raise Interrupted(f"interrupted at settlement {_last_settlement(result)}: partial result written to {out}")
+        raise mf.Interrupted(f"interrupted at settlement {_last_settlement(result)}: partial result written to {out}")
     numbers = ", ".join(map(str, mf.key_numbers(result))) or _scalar_summary(
         result, [name for name in result.data_vars if name not in dataset.variables])
     stop = f"; {result.attrs['stop_reason']}" if result.attrs.get("stop_reason") else ""
@@ -463,12 +476,18 @@ def main(argv: list[str] | None = None) -> None:
     """
     if hasattr(signal, "SIGPIPE"):
         signal.signal(signal.SIGPIPE, signal.SIG_DFL)
+    signal.signal(signal.SIGTERM, _terminate)
     try:
         code = cli.main(args=argv, prog_name="masonryfw", standalone_mode=False)
     except click.ClickException as exc:  # usage errors: exit 2
         exc.show()
         sys.exit(exc.exit_code)
-    except click.exceptions.Abort:  # click's form of a KeyboardInterrupt outside a solve
-        click.echo("interrupted: nothing written", err=True)
-        sys.exit(INTERRUPTED)
+    except click.exceptions.Abort as exc:  # click's form of a KeyboardInterrupt outside a solve
+        cause = exc.__cause__ or exc.__context__
+        written = cause if isinstance(cause, mf.WriteInterrupted) else None
+        if written is not None and written.signum not in _SIGNALS:
+            _SIGNALS.append(written.signum)
+        click.echo(f"interrupted after writing {written.path} (complete)" if written else "interrupted: nothing written",
+                   err=True)
+        sys.exit(_interrupted_status())
     sys.exit(code if isinstance(code, int) else 0)

@@ -25,8 +25,10 @@ every model. Arcs (DXF bulges) become chords no farther than
 from __future__ import annotations
 
 import csv
+import io
 import json
 import logging
+import re
 from collections import Counter
 from dataclasses import dataclass
 from pathlib import Path
@@ -35,6 +37,8 @@ import numpy as np
 
 from .errors import SpecError
 from .geometry import block_offsets, polygon_area_centroid
+from .inputs import DRAWING_BYTES_FACTOR, fits_in_memory, read_text, regular_file
+from .resources import size_text
 from .semantics import connected_components
 
 #: Metres per drawing unit.
@@ -82,13 +86,11 @@ def read_drawing(path: str | Path, drawing_unit: str | None = None, chord_tolera
     drawing units. Raises :class:`SpecError` naming the entity (DXF handle, CSV
     row, GeoJSON feature) and its coordinates.
     """
-    path = Path(path)
+    path = drawing_file(path)
     kind = SUFFIXES.get(path.suffix.lower())
     if kind is None:
         raise SpecError(f"drawing {str(path)!r}: unknown file type {path.suffix!r}; "
                         f"use {', '.join(sorted(SUFFIXES))}")
-    if not path.is_file():
-        raise SpecError(f"drawing {str(path)!r}: no such file")
     if drawing_unit is not None and drawing_unit not in DRAWING_UNITS:
         raise SpecError(f"drawing unit {drawing_unit!r}: must be one of {', '.join(DRAWING_UNITS)}")
     if kind == "dxf":
@@ -113,6 +115,14 @@ def _counted(ignored: dict[str, int]) -> str:
 
 # ---------------------------------------------------------------- readers
 
+def drawing_file(path: str | Path) -> Path:
+    """``path`` if it is a regular file whose reading fits in memory (an :class:`InputError` if not)."""
+    file = regular_file(path, "drawing")
+    size = file.stat().st_size
+    fits_in_memory(size * DRAWING_BYTES_FACTOR, f"drawing {str(path)!r} ({size_text(size)})")
+    return file
+
+
 def _open_dxf(path: Path):
     """The ezdxf document of a DXF file, text (repaired where it can be) or binary; ezdxf's own repair
     messages are not printed (they quote the file's lines), a failure is ours to say."""
@@ -120,7 +130,11 @@ def _open_dxf(path: Path):
     from ezdxf import recover
 
     with path.open("rb") as handle:
-        binary = handle.read(len(BINARY_DXF)) == BINARY_DXF
+        head = handle.read(4096)
+    binary = head.startswith(BINARY_DXF)
+    if not binary and not _text_dxf(head):
+        raise SpecError(f"drawing {str(path)!r}: not a DXF file (a text DXF starts with the group code 0 and "
+                        "SECTION, or a 999 comment; a binary one with 'AutoCAD Binary DXF')")
     ezdxf_log = logging.getLogger("ezdxf")
     level = ezdxf_log.level
     ezdxf_log.setLevel(logging.CRITICAL)
@@ -130,6 +144,12 @@ def _open_dxf(path: Path):
         raise SpecError(f"drawing {str(path)!r}: not a readable DXF file ({type(exc).__name__})") from None
     finally:
         ezdxf_log.setLevel(level)
+
+
+def _text_dxf(head: bytes) -> bool:
+    """Whether ``head`` (a file's first bytes) starts as a text DXF does: group code 0 then SECTION, or 999."""
+    lines = [line.strip() for line in head.lstrip(b"\xef\xbb\xbf").splitlines() if line.strip()][:2]
+    return lines[:1] == [b"999"] or lines == [b"0", b"SECTION"]
 
 
 @dataclass(frozen=True)
@@ -146,9 +166,7 @@ def read_dxf_lines(path: str | Path, layer: str | None = None) -> DxfLines:
     polyline in drawing units (arcs flattened to 1e-3 drawing units): a crack map drawn over a wall."""
     from ezdxf import path as dxf_path
 
-    path = Path(path)
-    if not path.is_file():
-        raise SpecError(f"drawing {str(path)!r}: no such file")
+    path = drawing_file(path)
     doc = _open_dxf(path)
     lines, sources = [], []
     for entity in _flat_entities(doc.modelspace()):
@@ -227,13 +245,13 @@ def _number(text: str, where: str, column: str) -> float:
 
 
 def _read_csv(path: Path) -> list[_Ring]:
-    with open(path, newline="", encoding="utf-8-sig") as handle:
+    with io.StringIO(read_text(path, "drawing"), newline="") as handle:
         reader = csv.DictReader(handle)
         columns = [c.strip() for c in (reader.fieldnames or [])]
         missing = [c for c in ("block", "x", "y") if c not in columns]
         if missing:
             raise SpecError(f"drawing {path.name!r}: needs the columns block, x, y (and optionally layer) in "
-                            f"its first row; {', '.join(missing)} missing (found {', '.join(columns) or 'none'})")
+                            f"its first row; {', '.join(missing)} missing{_found_columns(columns)}")
         points: dict[str, list] = {}
         layers: dict[str, str] = {}
         for number, row in enumerate(reader, start=2):
@@ -251,31 +269,80 @@ def _read_csv(path: Path) -> list[_Ring]:
             for name, pts in points.items()]
 
 
+def _found_columns(columns: list[str]) -> str:
+    """``" (found X, Y)"`` when the first row looks like column names; nothing when it does not (the file may
+    be anything: a message never quotes what is not a drawing)."""
+    if columns and all(re.fullmatch(r"[\w .-]{1,32}", c) for c in columns):
+        return f" (found {', '.join(columns)})"
+    return " (its first row is not a row of column names: is it a CSV drawing?)"
+
+
 def _read_geojson(path: Path) -> list[_Ring]:
     try:
-        data = json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, ValueError) as exc:
+        data = json.loads(read_text(path, "drawing"))
+    except ValueError as exc:  # JSONDecodeError says where (line, column), not what is there
         raise SpecError(f"drawing {path.name!r}: not readable JSON ({exc})") from None
     features = data.get("features") if isinstance(data, dict) and data.get("type") == "FeatureCollection" else [data]
+    if not isinstance(features, list):
+        raise SpecError(f"drawing {path.name!r}: 'features' is a {type(features).__name__}, not a list of features")
     rings = []
-    for index, feature in enumerate(features or []):
-        geometry = feature.get("geometry", feature) if isinstance(feature, dict) else None
-        properties = (feature.get("properties") or {}) if isinstance(feature, dict) else {}
+    for index, feature in enumerate(features):
         where = f"drawing {path.name!r} feature {index}"
+        if not isinstance(feature, dict):
+            raise SpecError(f"{where}: a JSON {_json_kind(feature)}, not a Feature object")
+        geometry = feature.get("geometry", feature)
+        properties = feature.get("properties") if isinstance(feature.get("properties"), dict) else {}
         if not isinstance(geometry, dict) or geometry.get("type") != "Polygon":
-            kind = geometry.get("type") if isinstance(geometry, dict) else type(geometry).__name__
+            kind = geometry.get("type") if isinstance(geometry, dict) else f"JSON {_json_kind(geometry)}"
             raise SpecError(f"{where}: a {kind}, not a Polygon; one Polygon per block")
-        coordinates = geometry.get("coordinates") or []
-        if len(coordinates) != 1:
-            raise SpecError(f"{where}: a polygon with {max(len(coordinates) - 1, 0)} hole(s); "
-                            "a block is one outline without holes")
-        try:
-            ring = np.asarray(coordinates[0], dtype=float)[:, :2]
-        except (TypeError, ValueError, IndexError):
-            raise SpecError(f"{where}: its coordinates are not [x, y] pairs") from None
+        ring = _polygon_ring(geometry.get("coordinates"), where)
         name = properties.get("name", properties.get("id", index))
         rings.append(_Ring(ring[:, 0], ring[:, 1], str(properties.get("layer", "0")), f"feature {name}"))
     return rings
+
+
+def _json_kind(value) -> str:
+    return {dict: "object", list: "array", str: "string", bool: "boolean", type(None): "null"}.get(
+        type(value), "number")
+
+
+def _is_position(value) -> bool:
+    return isinstance(value, list) and 2 <= len(value) <= 3 and all(
+        isinstance(v, (int, float)) and not isinstance(v, bool) for v in value)
+
+
+def _polygon_ring(coordinates, where: str) -> np.ndarray:
+    """The outline of a GeoJSON Polygon's ``coordinates`` (a list of rings, the first the outline) as an
+    ``(n, 2)`` array, or a SpecError saying what is wrong where (never quoting more than a position)."""
+    if not isinstance(coordinates, list) or not coordinates:
+        raise SpecError(f"{where}: its coordinates are a JSON {_json_kind(coordinates)}"
+                        f"{' (empty)' if coordinates == [] else ''}, not a list of rings")
+    if _is_position(coordinates[0]):
+        raise SpecError(f"{where}: its coordinates are one ring of [x, y] positions, not a list of rings; "
+                        "wrap the ring in one more [ ]")
+    if len(coordinates) != 1:
+        raise SpecError(f"{where}: a polygon with {len(coordinates) - 1} hole(s); a block is one outline without holes")
+    ring = coordinates[0]
+    if isinstance(ring, list) and ring and isinstance(ring[0], list) and ring[0] and isinstance(ring[0][0], list):
+        raise SpecError(f"{where}: its coordinates are nested one level too deep (a Polygon's are [[[x, y], ...]]; "
+                        "a MultiPolygon's are not read)")
+    if not isinstance(ring, list) or len(ring) < 3:
+        raise SpecError(f"{where}: its ring is a JSON {_json_kind(ring)}"
+                        f"{f' of {len(ring)} position(s)' if isinstance(ring, list) else ''}, not a list of at "
+                        "least 3 [x, y] positions")
+    for k, position in enumerate(ring):
+        if not _is_position(position):
+            shown = f"a JSON {_json_kind(position)}" if not isinstance(position, list) else (
+                "a list of lists (one level too deep)" if position and isinstance(position[0], list)
+                else f"[{', '.join(_json_kind(v) for v in position)}]")
+            raise SpecError(f"{where}: position {k} is {shown}, not [x, y] numbers")
+        try:
+            values = [float(v) for v in position[:2]]
+        except OverflowError:
+            values = [np.inf]
+        if not np.isfinite(values).all():
+            raise SpecError(f"{where}: position {k} has a coordinate too large for a number (not finite)")
+    return np.array([[float(p[0]), float(p[1])] for p in ring])
 
 
 # ---------------------------------------------------------------- cleaning
@@ -285,9 +352,12 @@ def clean(rings: list[_Ring], snap: float | None = None, ignored: dict[str, int]
     x = np.concatenate([r.x for r in rings])
     y = np.concatenate([r.y for r in rings])
     size = float(np.hypot(np.ptp(x), np.ptp(y))) or 1.0
+    derived = snap is None
     snap = RELATIVE_SNAP * size if snap is None else snap
     if not snap > 0:
         raise SpecError(f"geometry.snap_tolerance: must be > 0, got {snap!r}")
+    if derived:
+        _refuse_stray_vertex(rings, x, y, snap)
     raw_x, raw_y = x, y
     x, y = snapped(x, y, snap)
     counts = np.array([r.x.size for r in rings])
@@ -305,6 +375,24 @@ def clean(rings: list[_Ring], snap: float | None = None, ignored: dict[str, int]
     node_x, node_y = _counter_clockwise(node_x, node_y, counts, rings, snap)
     return Drawing(node_x, node_y, counts, tuple(r.layer for r in rings), tuple(r.source for r in rings),
                    dict(ignored or {}))
+
+
+def _refuse_stray_vertex(rings: list[_Ring], x: np.ndarray, y: np.ndarray, snap: float) -> None:
+    """A SpecError naming the vertex that makes the drawing so large that its snap tolerance swallows blocks
+    (one vertex typed at 1e12 among blocks of 0.25 m): the vertex farthest from the median of them all."""
+    sizes = np.array([np.hypot(np.ptp(r.x), np.ptp(r.y)) if r.x.size else 0.0 for r in rings])
+    if not (sizes < 10 * snap).any():
+        return
+    far = int(np.argmax(np.hypot(x - np.median(x), y - np.median(y))))
+    owner = int(np.searchsorted(block_offsets(np.array([r.x.size for r in rings])), far, side="right") - 1)
+    others = np.ones(x.size, dtype=bool)
+    others[far] = False
+    rest = float(np.hypot(np.ptp(x[others]), np.ptp(y[others]))) if others.any() else 0.0
+    if 0 < rest * RELATIVE_SNAP * 10 < sizes.min():  # without that vertex the blocks would survive
+        raise SpecError(f"{rings[owner].source} on layer {rings[owner].layer}: its vertex ({x[far]:.6g}, "
+                        f"{y[far]:.6g}) m lies far from every other one (which span {rest:.6g} m), so that the "
+                        f"snap tolerance ({RELATIVE_SNAP:g} of the drawing's size, {snap:.3g} m) is larger than "
+                        "the blocks; is that vertex a mistake?")
 
 
 def _refuse_open(rings, starts, x, y, raw_x, raw_y, snap: float) -> None:

@@ -36,6 +36,11 @@ class SolveError(MasonryError):
     """A solver ran but could not produce a result (infeasible, diverged, ...)."""
 
 
+class Interrupted(MasonryError):
+    """Ctrl-C (or SIGTERM) stopped a command; the message says what was kept. The CLI exits with 130
+    (143 after SIGTERM)."""
+
+
 def listed(indices, limit: int = 20) -> str:
     """``"12, 13 and 5 more"``: the first ``limit`` indices of a message, then how many more."""
     items = [str(int(i)) for i in indices]

@@ -201,7 +201,7 @@ def build_drawn(spec_dict: dict, text: str, base_dir: Path | None, validate: boo
     """The model of a drawn wall (see the module docstring); checked unless ``validate`` is False."""
     spec = parse_drawn_spec(spec_dict)
     path = resolved_drawing(spec, base_dir)
-    if not path.is_file():
+    if not path.exists():
         raise SpecError(f"spec key {spec.drawing_key!r} = {spec.drawing!r}: no such file ({path})")
     drawing = read_drawing(path, spec.drawing_unit, spec.chord_tolerance, spec.snap_tolerance)
     kept = np.array([spec.layers.get(layer, "unit") != "ignore" for layer in drawing.layers])

@@ -13,19 +13,23 @@ dataset and the file written from it share one content hash.
 """
 from __future__ import annotations
 
+import errno
 import hashlib
 import os
 import secrets
 import shutil
+from collections.abc import Callable
 from datetime import datetime, timezone
 from pathlib import Path
 
 import numpy as np
 import xarray as xr
 
+from . import locks, signals
 from .dofs import upgrade
 from .errors import MasonryError, ModelError
 from .geometry import DERIVED_GEOMETRY_VARIABLES
+from .inputs import file_kind, fits_in_memory
 from .schema import load_schema, variable_attrs
 
 CONVENTIONS = "CF-1.11"
@@ -37,6 +41,8 @@ _GEOMETRY_VARIABLES = ("node_x", "node_y", "block_node_count")
 _NETCDF3_SIGNATURES = (b"CDF\x01", b"CDF\x02", b"CDF\x05")
 _HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
 _HASH_CHUNK = 1 << 20
+#: A write that fails with less free space than this (bytes) in the target's folder failed on a full disk.
+DISK_FULL = 1 << 20
 
 
 # ---------------------------------------------------------------- hashing
@@ -171,7 +177,10 @@ def open_dataset(path: str | os.PathLike) -> xr.Dataset:
         raise ModelError(f"{file}: {problem}")
     try:
         with xr.open_dataset(file, engine="netcdf4", decode_times=False, decode_timedelta=False) as src:
+            _fits_in_memory(src, file)
             ds = src.load()
+    except MasonryError:
+        raise
     except Exception as exc:  # netCDF4/HDF5 raise OSError, RuntimeError, ValueError, ...
         raise ModelError(
             f"{file}: has a netCDF signature but cannot be read ({type(exc).__name__}: {exc}); "
@@ -181,6 +190,17 @@ def open_dataset(path: str | os.PathLike) -> xr.Dataset:
     ds.encoding["source"] = str(file.resolve())
     ds.encoding["sha256"] = digest
     return ds
+
+
+def _fits_in_memory(lazy: xr.Dataset, file: Path) -> None:
+    """Refuse a file whose variables would not fit in memory once read (before reading them: a file of a
+    few MB can hold gigabytes of compressed zeros), naming the largest."""
+    sizes = {name: v.size * (v.dtype.itemsize if v.dtype.kind != "O" else 64) for name, v in lazy.variables.items()}
+    largest = max(sizes, key=sizes.__getitem__, default=None)
+    if largest is not None:
+        dims = ", ".join(f"{d} = {n:,}" for d, n in zip(lazy[largest].dims, lazy[largest].shape))
+        fits_in_memory(sum(sizes.values()), f"{file}: reading it",
+                       f"its largest variable is {largest!r} ({dims}); is the file what it should be?")
 
 
 # ---------------------------------------------------------------- writing
@@ -290,10 +310,14 @@ def _writable_target(path: str | os.PathLike, refusal: str | None) -> Path:
         raise ModelError(f"{path}: cannot write: directory {target.parent} does not exist")
     if target.is_dir():
         raise ModelError(f"{path}: cannot write: is a directory")
+    if target.exists() and not target.is_file():  # a device or FIFO would be replaced by the rename
+        raise ModelError(f"{path}: cannot write: is {file_kind(target.stat().st_mode)}, not a regular file; "
+                         "results are written to regular files only")
     if refusal:
         raise ModelError(f"{path}: refusing to overwrite {refusal}; write to another path")
     if not os.access(target.parent, os.W_OK | os.X_OK):
         raise ModelError(f"{path}: cannot write: no permission to create files in {target.parent}")
+    locks.claim(target, str(path))
     return target
 
 
@@ -311,25 +335,51 @@ def check_output_path(path: str | os.PathLike, inputs=(), suffixes: tuple[str, .
     return _writable_target(path, refusal)
 
 
-def _write_atomically(target: Path, write, shown: str | os.PathLike) -> Path:
-    """Call ``write(temporary)`` next to ``target``, then rename it over ``target``.
+def write_atomically(writes: dict[Path, Callable[[Path], object]], shown: str | os.PathLike | None = None) -> list[Path]:
+    """Write a set of files as one: ``write(temporary)`` for each target (absolute, checked by
+    :func:`check_output_path`), each temporary beside its target; once all are complete they are renamed onto
+    their targets in order. On any failure nothing is renamed, no temporary is left and existing files are
+    unchanged; Ctrl-C and SIGTERM wait until the set is written (:mod:`masonryfw.signals`)."""
+    temporaries = {target: target.with_name(f".{target.name}.{secrets.token_hex(6)}.tmp{target.suffix}")
+                   for target in writes}
+    last = list(writes)[-1]
+    with signals.deferred(last):
+        try:
+            for target, write in writes.items():
+                last = target
+                write(temporaries[target])
+                if target.exists():
+                    shutil.copymode(target, temporaries[target])
+            for target, temporary in temporaries.items():
+                os.replace(temporary, target)
+        except BaseException as exc:
+            for temporary in temporaries.values():
+                temporary.unlink(missing_ok=True)
+            if isinstance(exc, MasonryError) or not isinstance(exc, Exception):
+                raise
+            if len(writes) == 1:
+                failed, unchanged = "", "any existing file is unchanged"
+            else:
+                failed, unchanged = f" {last.name}", f"none of its {len(writes)} files is written or changed"
+            raise ModelError(f"{shown or last}: could not write{failed} ({write_failure(exc, last)}); "
+                             f"{unchanged}") from exc
+        finally:
+            for target in writes:
+                locks.release(target)
+    return list(writes)
 
-    On any failure the temporary file is removed and an existing target is left as it was.
-    """
-    temporary = target.with_name(f".{target.name}.{secrets.token_hex(6)}.tmp{target.suffix}")
+
+def write_failure(exc: BaseException, target: Path) -> str:
+    """What went wrong in a failed write, in words: a full disk is said to be one (the netCDF library reports
+    it as "Permission denied" or "NetCDF: HDF error")."""
     try:
-        write(temporary)
-        if target.exists():
-            shutil.copymode(target, temporary)
-        os.replace(temporary, target)
-    except BaseException as exc:
-        temporary.unlink(missing_ok=True)
-        if isinstance(exc, MasonryError) or not isinstance(exc, Exception):
-            raise
-        raise ModelError(
-            f"{shown}: could not write ({type(exc).__name__}: {exc}); any existing file is unchanged"
-        ) from exc
-    return target
+        free = shutil.disk_usage(target.resolve().parent).free
+    except OSError:
+        free = None
+    said = f"{type(exc).__name__}: {exc}"
+    if getattr(exc, "errno", None) in (errno.ENOSPC, errno.EDQUOT) or (free is not None and free < DISK_FULL):
+        return f"the disk is full: {free if free is not None else 0} bytes free in {target.resolve().parent}; {said}"
+    return said
 
 
 def save(
@@ -348,8 +398,12 @@ def save(
     ``ds`` was read from, and the model file a result was computed from.
     """
     target = _writable_target(path, _refusal(Path(path).resolve(), ds, protect))
-    prepared = add_history(cf_normalized(ds), command or "save")
-    return _write_atomically(target, lambda temporary: _write_netcdf(prepared, temporary), path)
+    try:
+        prepared = add_history(cf_normalized(ds), command or "save")
+    except BaseException:
+        locks.release(target)
+        raise
+    return write_atomically({target: lambda temporary: _write_netcdf(prepared, temporary)}, path)[0]
 
 
 FIGURE_FORMATS = (".png", ".svg", ".pdf")
@@ -360,13 +414,12 @@ def save_figure(figure, path: str | os.PathLike, *, protect=(), dpi: float | Non
     (no empty margins); never onto ``protect``."""
     target = check_output_path(path, protect, FIGURE_FORMATS)
     suffix = target.suffix.lower()
-    return _write_atomically(
-        target, lambda temporary: figure.savefig(temporary, format=suffix[1:], dpi=dpi or "figure",
-                                                 bbox_inches="tight", pad_inches=0.04), path
-    )
+    return write_atomically({
+        target: lambda temporary: figure.savefig(temporary, format=suffix[1:], dpi=dpi or "figure",
+                                                 bbox_inches="tight", pad_inches=0.04)}, path)[0]
 
 
 def save_text(text: str, path: str | os.PathLike, *, protect=(), suffixes: tuple[str, ...] = ()) -> Path:
     """Write ``text`` (UTF-8) to ``path`` atomically; never onto ``protect``; its suffix among ``suffixes``."""
     target = check_output_path(path, protect, suffixes)
-    return _write_atomically(target, lambda temporary: temporary.write_text(text, encoding="utf-8"), path)
+    return write_atomically({target: lambda temporary: temporary.write_text(text, encoding="utf-8")}, path)[0]

@@ -70,10 +70,13 @@ def checked_model(ds: xr.Dataset, where: str = "") -> xr.Dataset:
     """
     if not isinstance(ds, xr.Dataset):
         raise TypeError(f"a model is an xarray.Dataset, not {type(ds).__name__}")
+    kind = ds.attrs.get("masonryfw_format", "model")
+    label = where or repr(ds.attrs.get("title", ""))
+    if kind not in ("model", "result"):
+        raise ModelError(f"{label}: a {kind} dataset (masonryfw_format = {kind!r}), not a model or a result")
     model = model_part(ds)
     if is_checked(model):
         return model
-    label = where or repr(model.attrs.get("title", ""))
     stored = [v for v in DERIVED_GEOMETRY_VARIABLES if v in model.variables]
     model = model.drop_vars(stored)
     problems = check(model, kind="model")

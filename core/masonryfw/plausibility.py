@@ -10,7 +10,7 @@ from, what it is and the nearest plausible reading:
   value in kN/m3 is recognised);
 - units (the median masonry block) 10 mm to 2 m in each direction, the masonry
   at least 0.1 m wide and high (metres under ``length_unit = "mm"`` are
-  recognised);
+  recognised), at most 1 km (a drawing in the wrong unit);
 - friction angles 10-60 degrees (a coefficient or radians typed as degrees is
   recognised);
 - Young's modulus 0.1-100 GPa (MPa or GPa typed as Pa is recognised).
@@ -35,6 +35,7 @@ from .schema import flags
 UNIT_WEIGHT = (5.0e3, 40.0e3)  # N m-3
 UNIT_SIZE = (0.01, 2.0)  # m, each side of the median masonry block
 WALL_SIZE = 0.1  # m, the masonry's smallest extent
+WALL_SIZE_MAX = 1000.0  # m, its largest
 FRICTION_ANGLE = (10.0, 60.0)  # degrees
 YOUNG_MODULUS = (0.1e9, 100.0e9)  # Pa
 GRAVITY = 9.81  # m s-2
@@ -97,10 +98,14 @@ def plausibility(model: xr.Dataset) -> list[str]:
     extent = {"width": float(xmax[masonry].max() - xmin[masonry].min()),
               "height": float(ymax[masonry].max() - ymin[masonry].min())}
     for side, size in extent.items():
+        where = "the drawing" if drawn else f"wall.{side}"
+        measured = f"{where}: the masonry is {size:.6g} m {'wide' if side == 'width' else 'high'}"
         if size < WALL_SIZE:
-            where = "the drawing" if drawn else f"wall.{side}"
-            messages.append(f"{where}: the masonry is {size:.6g} m {'wide' if side == 'width' else 'high'}, less "
-                            f"than {WALL_SIZE:g} m{metres}")
+            messages.append(f"{measured}, less than {WALL_SIZE:g} m{metres}")
+        elif size > WALL_SIZE_MAX:
+            unit = "; is geometry.drawing_unit right?" if drawn else ""
+            messages.append(f"{measured}, more than {WALL_SIZE_MAX:g} m (the longest buildings are a few hundred "
+                            f"metres){unit}")
     messages += _friction(model)
     if "block_young_modulus" in model:
         young = float(np.median(model.block_young_modulus.values[masonry]))

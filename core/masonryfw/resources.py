@@ -60,8 +60,11 @@ def available_memory() -> float:
 
 
 def size_text(nbytes: float) -> str:
-    """``1.5 GiB``, ``300 MiB``."""
-    return f"{nbytes / 2**30:.1f} GiB" if nbytes >= 2**30 else f"{nbytes / 2**20:.0f} MiB"
+    """``300 MiB``, ``1.5 GiB``, ``7.0 PiB``."""
+    for power, unit in ((50, "PiB"), (40, "TiB"), (30, "GiB")):
+        if nbytes >= 2**power:
+            return f"{nbytes / 2**power:.1f} {unit}"
+    return f"{nbytes / 2**20:.0f} MiB"
 
 
 def duration_text(seconds: float) -> str:

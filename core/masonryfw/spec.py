@@ -15,6 +15,7 @@ from pathlib import Path
 
 from . import blocks
 from .errors import SpecError
+from .inputs import read_text
 
 try:  # Python >= 3.11
     import tomllib
@@ -35,7 +36,7 @@ def read_spec(source) -> tuple[dict, str, Path | None]:
         text = _read_text(source)
         base_dir = Path(os.fspath(source)).parent if isinstance(source, os.PathLike) else None
     elif isinstance(source, str):
-        if os.path.isfile(source):
+        if os.path.exists(source):
             text = _read_text(source)
             base_dir = Path(source).parent
         elif "=" in source or "\n" in source:
@@ -51,13 +52,9 @@ def read_spec(source) -> tuple[dict, str, Path | None]:
 
 
 def _read_text(path) -> str:
-    try:
-        if hasattr(path, "read_text"):
-            return path.read_text(encoding="utf-8")
-        with open(path, encoding="utf-8") as handle:
-            return handle.read()
-    except OSError as exc:
-        raise SpecError(f"cannot read spec file {str(path)!r}: {exc.strerror}") from None
+    if hasattr(path, "read_text") and not isinstance(path, os.PathLike):  # a Traversable of a bundled case
+        return path.read_text(encoding="utf-8")
+    return read_text(path, "spec (a TOML file)")
 
 
 class SpecTable:

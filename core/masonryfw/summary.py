@@ -194,7 +194,9 @@ DIAGNOSIS_COLUMNS = ("scenario", "score", "cracks", "levelling", "settlement", "
                      "unobserved", "verified")
 
 
-def _scenario_text(ds: xr.Dataset, k: int) -> str:
+def candidate_text(ds: xr.Dataset, k: int) -> str:
+    """Candidate ``k`` of a diagnosis dataset in words: ``step 1.2..1.5 m``, ``tilt from 1.2 m down to 0 m``,
+    ``gaussian trough at 4 m, i 2 m``."""
     profile = str(ds.candidate_profile.values[k])
     if profile == "gaussian":
         return f"gaussian trough at {float(ds.candidate_center[k]):.4g} m, i {float(ds.candidate_width[k]):.4g} m"
@@ -220,7 +222,7 @@ def diagnosis_rows(diagnosis: xr.Dataset, count: int) -> list[Row]:
         width = float(diagnosis.candidate_verified_crack_width[k]) if verified else float("nan")
         unexplained, unobserved = (int(diagnosis[f"candidate_{n}"][k]) for n in ("unexplained_cracks",
                                                                                    "unobserved_joints"))
-        cells = (_scenario_text(diagnosis, k), f"{score:.3f}", f"{crack:.3f}",
+        cells = (candidate_text(diagnosis, k), f"{score:.3f}", f"{crack:.3f}",
                  f"{level:.3f}" if np.isfinite(level) else MISSING, _mm(magnitude) if np.isfinite(magnitude) else MISSING,
                  "yes" if diagnosis.candidate_plausible.values[k] else "no", str(unexplained), str(unobserved),
                  _mm(width) if np.isfinite(width) else MISSING)

@@ -68,17 +68,6 @@ def _as_vtk(values: np.ndarray) -> np.ndarray:
     return values.astype(np.int32) if values.dtype.kind in "iub" else values.astype(np.float64)
 
 
-def _write(mesh, path: Path) -> Path:
-    """meshio write to a temporary file in the same folder, then an atomic rename."""
-    temporary = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-    try:
-        mesh.write(temporary, file_format="vtu")
-        os.replace(temporary, path)
-    finally:
-        temporary.unlink(missing_ok=True)
-    return path
-
-
 def blocks_mesh(ds: xr.Dataset):
     """Blocks as polygons with their role, macro-block and motion."""
     meshio = _meshio()
@@ -177,9 +166,11 @@ def export_vtk(ds: xr.Dataset, path: str | os.PathLike) -> list[Path]:
     for target in paths:
         mf.check_output_path(target, [ds.encoding.get("source")])
     present = [(name, build) for name, _, has, build in PIECES if has(ds)]
-    pieces = [(name, _write(build(ds), target)) for (name, build), target in zip(present, paths)]
-    index = paths[-1]
-    temporary = index.with_name(f".{index.name}.{os.getpid()}.tmp")
-    temporary.write_text(_multiblock(pieces))
-    os.replace(temporary, index)
-    return [p for _, p in pieces] + [index]
+    pieces = [(name, target) for (name, _), target in zip(present, paths)]
+    writes = {target: _vtu_writer(build(ds)) for (_, build), target in zip(present, paths)}
+    writes[paths[-1]] = lambda temporary: temporary.write_text(_multiblock(pieces))
+    return mf.write_atomically(writes, path)  # the set or nothing: ParaView opens the index, which names the rest
+
+
+def _vtu_writer(mesh):
+    return lambda temporary: mesh.write(temporary, file_format="vtu")

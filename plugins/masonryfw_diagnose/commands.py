@@ -11,9 +11,6 @@ import click
 
 import masonryfw as mf
 
-#: Exit status of a diagnosis stopped by Ctrl-C (what was ranked so far is written).
-INTERRUPTED = 130
-
 
 def _command_line() -> str:
     obj = click.get_current_context().find_root().obj
@@ -142,9 +139,8 @@ def diagnose_command(wall: str, cracks: str, cracks_layer: str | None, levelling
     mf.save(dataset.to_dataset(diagnosis, wall), out, command=_command_line(), protect=inputs)
     _report(diagnosis, wall, top, as_json, seconds, out)
     if diagnosis.interrupted:
-        click.echo(f"interrupted after {len(diagnosis.candidates) + len(diagnosis.failed)} scenario(s): the ranking "
-                   f"of those is written to {out}", err=True)
-        click.get_current_context().exit(INTERRUPTED)
+        raise mf.Interrupted(f"interrupted after {len(diagnosis.candidates) + len(diagnosis.failed)} scenario(s): "
+                             f"the ranking of those is written to {out}")
 
 
 def _report(diagnosis, wall: str, top: int, as_json: bool, seconds: float, out: Path) -> None:

@@ -26,14 +26,6 @@ def _rings(ds: xr.Dataset, x: np.ndarray, y: np.ndarray, blocks: np.ndarray) -> 
     return [np.c_[x[starts[b]:starts[b] + counts[b]], y[starts[b]:starts[b] + counts[b]]] for b in blocks]
 
 
-def _describe(ds: xr.Dataset, k: int) -> str:
-    profile = str(ds.candidate_profile.values[k])
-    if profile == "gaussian":
-        return f"gaussian at {float(ds.candidate_center[k]):.4g} m, i {float(ds.candidate_width[k]):.4g} m"
-    start, end = float(ds.candidate_start[k]), float(ds.candidate_end[k])
-    return f"step {start:.4g}..{end:.4g} m" if profile == "step" else f"tilt from {start:.4g} m down to {end:.4g} m"
-
-
 def _survey_lines(ax, ds: xr.Dataset, style: str = "-", width: float = 1.6) -> None:
     owner = ds.survey_point_crack.values
     matched = ds.survey_crack_matched.values
@@ -104,7 +96,7 @@ def _candidate_panel(ax, ds: xr.Dataset, kept: int, amplification: float | None)
     _survey_lines(ax, ds, width=0.9)
     magnitude = float(ds.candidate_magnitude.values[k])
     size = f", t {1e3 * magnitude:.3g} mm" if np.isfinite(magnitude) else ""
-    ax.set_title(f"{k + 1}: {_describe(ds, k)}\nscore {float(ds.candidate_score.values[k]):.2f}{size}"
+    ax.set_title(f"{k + 1}: {mf.candidate_text(ds, k)}\nscore {float(ds.candidate_score.values[k]):.2f}{size}"
                  + (" (plausible)" if ds.candidate_plausible.values[k] else ""), fontsize=8)
 
 

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import csv
 import dataclasses
+import io
 import json
 import math
 from dataclasses import dataclass, field
@@ -41,9 +42,7 @@ class Survey:
 
 def read_cracks(path: str | Path, unit: str | None = None, layer: str | None = None) -> Survey:
     """The crack map at ``path`` (module docstring)."""
-    path = Path(path)
-    if not path.is_file():
-        raise mf.SpecError(f"crack map {str(path)!r}: no such file")
+    path = mf.regular_file(path, "crack map")
     suffix = path.suffix.lower()
     if suffix not in CRACK_FORMATS:
         raise mf.SpecError(f"crack map {str(path)!r}: unknown file type {suffix!r}; use {', '.join(CRACK_FORMATS)}")
@@ -93,8 +92,8 @@ def _width(value, where: str) -> float | None:
 
 def _geojson_cracks(path: Path):
     try:
-        data = json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, ValueError, UnicodeDecodeError) as exc:
+        data = json.loads(mf.read_text(path, "crack map"))
+    except ValueError as exc:
         raise mf.SpecError(f"crack map {path.name!r}: not readable JSON ({type(exc).__name__})") from None
     features = data.get("features") if isinstance(data, dict) and data.get("type") == "FeatureCollection" else [data]
     lines, widths, names = [], [], []
@@ -122,10 +121,9 @@ def _geojson_cracks(path: Path):
 
 def _csv_cracks(path: Path):
     try:
-        with open(path, newline="", encoding="utf-8-sig") as handle:
-            rows = list(csv.DictReader(handle))
-            columns = [c.strip() for c in (rows[0].keys() if rows else [])]
-    except (OSError, UnicodeDecodeError, csv.Error) as exc:
+        rows = list(csv.DictReader(io.StringIO(mf.read_text(path, "crack map"), newline="")))
+        columns = [c.strip() for c in (rows[0].keys() if rows else [])]
+    except csv.Error as exc:
         raise mf.SpecError(f"crack map {path.name!r}: not a readable CSV file ({type(exc).__name__})") from None
     missing = [c for c in ("crack", "x", "y") if c not in columns]
     if rows and missing:
@@ -172,12 +170,9 @@ def _dxf_cracks(path: Path, unit: str | None, layer: str | None):
 def read_levelling(path: str | Path, unit: str = "m") -> np.ndarray:
     """``(m, 3)`` x, y, dy [m] of a levelling CSV (module docstring)."""
     path = Path(path)
-    if not path.is_file():
-        raise mf.SpecError(f"levelling {str(path)!r}: no such file")
     try:
-        with open(path, newline="", encoding="utf-8-sig") as handle:
-            rows = list(csv.DictReader(handle))
-    except (OSError, UnicodeDecodeError, csv.Error) as exc:
+        rows = list(csv.DictReader(io.StringIO(mf.read_text(path, "levelling"), newline="")))
+    except csv.Error as exc:
         raise mf.SpecError(f"levelling {path.name!r}: not a readable CSV file ({type(exc).__name__})") from None
     values = []
     for number, row in enumerate(rows, start=2):

@@ -11,6 +11,8 @@ import click
 
 import masonryfw as mf
 
+from .store import Store
+
 #: At most this many failed points are listed on the terminal (all are in the output file).
 LISTED_FAILURES = 10
 
@@ -72,9 +74,21 @@ def sweep_command(spec: str, solver: str, params: tuple[str, ...], zipped: bool,
     store_dir = Path(store) if store else out.with_name(out.name.removesuffix(".nc") + ".store")
     if not store_dir.is_dir():
         mf.check_output_path(store_dir)  # its folder exists and is writable: the store is made in it
+    mf.claim(store_dir.resolve(), f"sweep store {store_dir}")  # two sweeps on one store would solve its points twice
     command = _command_line()
-    with dask_client(scheduler, workers) as client, _progress(len(plan.points), not no_progress) as on_point:
-        sweep = run_sweep(plan, client, store_dir, out.resolve().parent, on_point, command)
+    kept: list[int] = []
+    try:
+        with dask_client(scheduler, workers) as client, _progress(len(plan.points), not no_progress) as on_point:
+            def counted(done: int, record: dict) -> None:
+                kept.append(int(record["status"] == "ok" and not record["reused"]))
+                if on_point is not None:
+                    on_point(done, record)
+
+            sweep = run_sweep(plan, client, store_dir, out.resolve().parent, counted, command)
+    except KeyboardInterrupt:
+        raise mf.Interrupted(f"sweep interrupted after {len(kept)} of {len(plan.points)} point(s) ({sum(kept)} newly "
+                             f"solved); the store {store_dir} keeps {Store(store_dir).committed()} result(s), which a "
+                             f"re-run reuses; {out} is not written") from None
     mf.save(sweep, out, command=command)
     reused = int(sweep.from_store.where(sweep.status == 0, 0).sum())
     failures = failed_points(sweep)

@@ -76,6 +76,10 @@ class Store:
     def record_path(self, key: str) -> Path:
         return self.root / RESULTS / f"{key}.json"
 
+    def committed(self) -> int:
+        """How many results the store holds with their records (the commit marks)."""
+        return sum(1 for _ in (self.root / RESULTS).glob("*.json"))
+
     def record(self, key: str) -> dict | None:
         """The record of ``key``, or None when absent or unreadable."""
         try:

@@ -12,7 +12,7 @@ class TestLa(SolverConformance):
 class TestLaNonassociative(SolverConformance):
     solver = "la"
     options = {"flow": "nonassociative"}
-    invariance_tolerance = 1e-5  # the fixed point to its flow_tolerance (docs/la.md)
+    invariance_tolerance = 1e-6  # the fixed point to its flow_tolerance (docs/la.md); measured spread 2e-8
 
 
 class TestFdem(SolverConformance):

@@ -161,7 +161,7 @@ def test_a_mirrored_wall_with_mirrored_cracks_gives_the_mirrored_candidates(diag
     assert mirror.best.score.total == pytest.approx(diagnosis_12c.best.score.total, abs=1e-3)
 
 
-@pytest.mark.parametrize("seed", [0, 1])
+@pytest.mark.parametrize("seed", [0, pytest.param(1, marks=pytest.mark.slow)])
 def test_random_lines_are_not_explained(seed):
     model = mf.open_model("facade-1")
     rng = np.random.default_rng(seed)

@@ -131,10 +131,10 @@ def test_the_regularised_lp_selects_the_least_squared_normal_forces(case, monkey
     assert np.abs(equilibrium).max() < 1e-8
 
 
-def test_an_inexact_regularisation_is_caught_and_its_weight_lowered(walls, monkeypatch):
-    """With a weight far above the exactness threshold the regularised alpha falls short of the plain
-    LP's (or the interior point does not converge); the weight is lowered until they agree, and the
-    sequence ends, to the selections' accuracy, where it does from the default weight and with the QP."""
+def test_an_inexact_regularisation_is_corrected_by_the_exact_finish(walls, monkeypatch):
+    """With a weight far above the exactness threshold the regularised LPs select other forces; the finish with
+    the exact selection (the QP) still ends where the sequence of LP + QP does from the start (highs), and where
+    it does from the default weight, to the flow tolerance."""
     from masonryfw_la import nonassociative
 
     model = mf.open_model("panel-2")
@@ -143,21 +143,8 @@ def test_an_inexact_regularisation_is_caught_and_its_weight_lowered(walls, monke
     monkeypatch.setattr(nonassociative, "SELECTION_WEIGHT", 10.0)
     result = walls.solve(model, **NONASSOCIATIVE)
     assert result.attrs["la_flow_converged"] == 1
-    weight = float(result.attrs["la_flow_selection"].split("weight ")[1].split(" ")[0])
-    assert weight < 10.0  # lowered (panel-2 is exact from 0.1 down)
-    # the fixed points of the selections differ by their accuracy (about 1e-5 on this wall)
-    assert float(result.collapse_multiplier) == pytest.approx(default, abs=2e-5)
-    assert float(result.collapse_multiplier) == pytest.approx(by_qp, abs=2e-5)
-
-
-@pytest.mark.parametrize("case", ["panel-1", "panel-2"])
-def test_the_sequence_stops_within_its_tolerance_of_its_limit(walls, case):
-    """A convergence study: the default stop against the same sequence run 10,000 times tighter."""
-    model = mf.open_model(case)
-    default = walls.solve(model, **NONASSOCIATIVE)
-    limit = walls.solve(model, flow="nonassociative", flow_tolerance=1e-10, flow_iterations=400)
-    assert limit.attrs["la_flow_converged"] == 1
-    assert float(default.collapse_multiplier) == pytest.approx(float(limit.collapse_multiplier), abs=2e-6)
+    assert float(result.collapse_multiplier) == pytest.approx(by_qp, abs=1e-6)
+    assert float(result.collapse_multiplier) == pytest.approx(default, abs=1e-6)
 
 
 def test_an_lp_that_fails_mid_sequence_stops_it_with_the_last_iterate(walls, monkeypatch, caplog):
@@ -180,3 +167,35 @@ def test_an_lp_that_fails_mid_sequence_stops_it_with_the_last_iterate(walls, mon
     assert "LP 3 of the non-associative sequence failed" in result.attrs["stop_reason"]
     assert "MaxIterations" in caplog.text
     assert 0.7 < float(result.collapse_multiplier) < 0.76  # between the non-associative 0.7465 and the associative 0.7517
+
+
+_ORDERS_SCRIPT = """
+import json, numpy as np, masonryfw as mf
+from masonryfw.testing import permuted, small_settlement_wall
+model = small_settlement_wall()
+alphas = []
+for seed in range(4):
+    rng = np.random.default_rng(seed)
+    shuffled = permuted(model, rng.permutation(model.sizes["block"]), rng.permutation(model.sizes["interface"]))
+    alphas.append(float(mf.solve(shuffled, "la", {"flow": "nonassociative"}).collapse_multiplier))
+print(json.dumps(alphas))
+"""
+
+
+def test_the_nonassociative_answer_depends_on_neither_block_order_nor_thread_count():
+    """The conformance kit's wall (a small wall whose regularised selection moved with the round-off: alpha
+    spread 4.4e-6 over 12 block orders before the exact finish) in four block orders, with one and with two
+    BLAS/OpenMP threads: one alpha to 1e-7 (measured spread 2e-8), the flow tolerance being 1e-6."""
+    import json
+    import os
+    import subprocess
+    import sys
+
+    alphas = []
+    for threads in ("1", "2"):
+        env = {**os.environ, "OMP_NUM_THREADS": threads, "OPENBLAS_NUM_THREADS": threads, "NUMBA_NUM_THREADS": threads}
+        done = subprocess.run([sys.executable, "-c", _ORDERS_SCRIPT], env=env, capture_output=True, text=True,
+                              timeout=300)
+        assert done.returncode == 0, done.stderr
+        alphas += json.loads(done.stdout.strip().splitlines()[-1])
+    assert max(alphas) / min(alphas) - 1 < 1e-7, alphas

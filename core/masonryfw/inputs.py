@@ -1,0 +1,89 @@
+"""A user's input files: what may be read, how much of it, and what a message about it may quote.
+
+Every file a user names (a spec, a drawing, a survey, a levelling, a dataset) is read
+through here. Only a regular file is read: a FIFO would block forever, a device
+(``/dev/zero``) never ends. A text file is read whole only when it is under
+:data:`TEXT_LIMIT`, and it must be UTF-8; a netCDF file given where text is expected
+is named for what it is. Messages quote positions (line, column, row, feature), never
+the contents of a file that may not be the user's (a spec key can point at any file).
+"""
+from __future__ import annotations
+
+import os
+import stat
+from pathlib import Path
+
+from .errors import MasonryError
+from .resources import MEMORY_LIMIT_VARIABLE, available_memory, size_text
+
+#: The largest text file (spec, CSV or GeoJSON drawing, survey) read whole: 64 MiB, 100 times the
+#: largest drawing we know of (a 10,000-unit wall as GeoJSON is about 2 MiB).
+TEXT_LIMIT = 64 * 2**20
+#: Memory a reader needs per byte of a drawing file (measured: ezdxf's document of a 3.1 MB DXF of 19,200
+#: polylines takes 53 MB, 17 times the file).
+DRAWING_BYTES_FACTOR = 20
+_NETCDF_SIGNATURES = (b"CDF\x01", b"CDF\x02", b"CDF\x05", b"\x89HDF\r\n\x1a\n")
+_KINDS = ((stat.S_ISFIFO, "a FIFO (named pipe)"), (stat.S_ISCHR, "a character device"),
+          (stat.S_ISBLK, "a block device"), (stat.S_ISSOCK, "a socket"), (stat.S_ISDIR, "a directory"))
+
+
+class InputError(MasonryError):
+    """A user's file cannot be read as what it is given for; the message names the file and why."""
+
+
+def file_kind(mode: int) -> str:
+    """``"a FIFO (named pipe)"``, ``"a character device"``, ... or ``"a regular file"``."""
+    return next((name for test, name in _KINDS if test(mode)), "a regular file")
+
+
+def regular_file(path: str | os.PathLike, what: str) -> Path:
+    """``path`` if it is (or links to) a regular file; else an :class:`InputError` saying what it is."""
+    file = Path(path)
+    try:
+        mode = file.stat().st_mode
+    except FileNotFoundError:
+        broken = " (a broken symbolic link)" if file.is_symlink() else ""
+        raise InputError(f"{path}: no such file{broken}") from None
+    except OSError as exc:
+        raise InputError(f"{path}: cannot be read ({exc.strerror or exc})") from None
+    if not stat.S_ISREG(mode):
+        raise InputError(f"{path}: is {file_kind(mode)}, not a regular file; a {what} must be a file")
+    return file
+
+
+def fits_in_memory(nbytes: float, what: str, advice: str = "") -> None:
+    """Refuse work that would need more than :func:`available_memory` (``MASONRYFW_MEMORY_LIMIT``)."""
+    available = available_memory()
+    if nbytes > available:
+        raise InputError(f"{what} needs about {size_text(nbytes)} of memory and {size_text(available)} is available "
+                         f"({MEMORY_LIMIT_VARIABLE} sets the limit){'; ' + advice if advice else ''}")
+
+
+def is_netcdf(head: bytes) -> bool:
+    """Whether ``head`` (a file's first bytes) is the start of a netCDF-3 or netCDF-4 (HDF5) file."""
+    return any(head.startswith(signature) for signature in _NETCDF_SIGNATURES)
+
+
+def read_text(path: str | os.PathLike, what: str, limit: int = TEXT_LIMIT) -> str:
+    """The UTF-8 text of the regular file ``path`` (a leading byte-order mark dropped), at most ``limit`` bytes.
+
+    Refused with a message that names the file: not a regular file, too big, a netCDF
+    file, not UTF-8 (the line and column of the first bad byte, not the text).
+    """
+    file = regular_file(path, what)
+    try:
+        with file.open("rb") as stream:
+            data = stream.read(limit + 1)
+    except OSError as exc:
+        raise InputError(f"{path}: cannot be read ({exc.strerror or exc})") from None
+    if len(data) > limit:
+        raise InputError(f"{path}: over {size_text(limit)}, too big for a {what}")
+    if is_netcdf(data[:8]):
+        raise InputError(f"{path}: is a netCDF file (a model, result or sweep), not a {what}")
+    try:
+        return data.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        line = data.count(b"\n", 0, exc.start) + 1
+        column = exc.start - (data.rfind(b"\n", 0, exc.start) + 1) + 1
+        raise InputError(f"{path}: is not UTF-8 text (byte 0x{data[exc.start]:02x} at line {line}, column {column}); "
+                         f"a {what} must be saved as UTF-8") from None
