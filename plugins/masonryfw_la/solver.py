@@ -62,7 +62,8 @@ def solve(model: xr.Dataset, options: Mapping[str, Any], progress=mf.no_progress
             la_alpha_associative=flow.alpha_associative,
             la_flow_selection="the first fixed point of the sequence of LPs started from the associative solution's "
                               "normal forces; each LP's contact forces with the least squared normal forces, "
-                              + (f"by the LP regularised with weight {flow.selection_weight:g} (ipm)"
+                              + (f"by the LP regularised with weight {flow.selection_weight:g} (ipm), then the "
+                                 f"exact finish by LP + QP{'' if flow.finish == 'exact' else ': ' + flow.finish}"
                                  if options["solver"] == "ipm" else f"by a QP after the {options['solver']} LP")
                               + " (docs/la.md)",
         )

@@ -199,3 +199,24 @@ def test_the_nonassociative_answer_depends_on_neither_block_order_nor_thread_cou
         assert done.returncode == 0, done.stderr
         alphas += json.loads(done.stdout.strip().splitlines()[-1])
     assert max(alphas) / min(alphas) - 1 < 1e-7, alphas
+
+
+def test_a_failed_exact_finish_reports_the_regularised_fixed_point_and_says_so(walls, monkeypatch):
+    """The finish's QP can fail (Clarabel's iteration cap on the 1,000-unit wall): the sequence's regularised
+    fixed point is then reported, converged, and the result says the finish failed; its alpha is the exact
+    one's to the selections' spread (docs/la.md: up to 1.5e-5)."""
+    from masonryfw_la import nonassociative
+
+    model = mf.open_model("panel-2")
+    exact = walls.solve(model, **NONASSOCIATIVE)
+
+    def failing(lp, alpha, tolerance):
+        raise mf.SolveError("la: the least-compression contact forces were not found (Clarabel: MaxIterations)")
+
+    monkeypatch.setattr(nonassociative, "least_compression", failing)
+    result = walls.solve(model, **NONASSOCIATIVE)
+    assert result.attrs["la_flow_converged"] == 1 and "stop_reason" not in result.attrs
+    assert "exact finish by LP + QP: failed at LP" in result.attrs["la_flow_selection"]
+    assert "exact finish by LP + QP (docs/la.md)" in exact.attrs["la_flow_selection"]
+    assert result.attrs["la_flow_iterations"] < exact.attrs["la_flow_iterations"]
+    assert float(result.collapse_multiplier) == pytest.approx(float(exact.collapse_multiplier), abs=2e-5)
