@@ -325,6 +325,7 @@ def test_a_sweep_tabulates_the_key_numbers_of_an_incremental_solver(spec, tmp_pa
 
 # ---------------------------------------------------------------- compile time
 
+@pytest.mark.slow  # 25 s: it compiles fdem's kernels afresh
 def test_numba_compilation_is_recorded_apart_from_the_wall_time(spec, tmp_path):
     """An empty numba cache forces the fdem kernels to compile (seconds) for a run of a fraction of that."""
     done = run(["solve", spec.name, "--plugin", "fdem", "-o", "f.nc"], tmp_path,

@@ -381,13 +381,13 @@ def test_a_message_never_quotes_a_file_that_is_not_the_users_drawing(tmp_path):
 def test_a_second_command_writing_the_same_output_is_refused_while_the_first_runs(tmp_path):
     """Two solves writing one file both exited 0 and one result was lost. The first claims the output when it
     checks it (before its work); the second is refused at once, naming the holder; the first's result stands."""
-    first = subprocess.Popen([sys.executable, "-m", "masonryfw", "solve", "panel-5", "--plugin", "fdem",
+    first = subprocess.Popen([sys.executable, "-m", "masonryfw", "solve", "test-12c", "--plugin", "fdem",
                               "--no-progress", "-o", "r.nc"], cwd=tmp_path, stdout=subprocess.PIPE,
                              stderr=subprocess.PIPE, text=True)
     deadline = time.monotonic() + 60
     while not (tmp_path / ".r.nc.lock").exists() and first.poll() is None and time.monotonic() < deadline:
         time.sleep(0.01)
-    second = cli(["solve", "panel-5", "--plugin", "la", "-o", "r.nc"], tmp_path)
+    second = cli(["solve", "test-12c", "--plugin", "la", "-o", "r.nc"], tmp_path)
     refused(second, "r.nc", "being written by another masonryfw process", f"pid {first.pid}")
     out, err = first.communicate(timeout=300)
     assert first.returncode == 0, err

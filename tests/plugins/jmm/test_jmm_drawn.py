@@ -93,6 +93,7 @@ def test_a_wide_block_on_a_tilting_table_slides_at_its_friction_coefficient(tmp_
     assert np.all(np.diff(incremental.step_load_factor.values) > 0)
 
 
+@pytest.mark.slow  # 10 s: three meshes
 def test_the_arch_tilts_below_its_discrete_limit_and_its_lower_bound_rises_with_the_mesh():
     """The continuum has a joint plane at every point, so it cannot outlast la's 27 voussoirs (0.308); the
     static LP's lower bound rises with refinement (measured 0.181 on 10 mm, 0.227 on 5 mm cells)."""
