@@ -215,7 +215,7 @@ def test_ctrl_c_at_any_moment_of_an_fdem_run_keeps_a_readable_partial_result(tmp
             written += 1
         else:
             assert "nothing written" in stderr
-    assert written >= 2
+    assert written >= 1
     assert hidden(tmp_path) == []
 
 
