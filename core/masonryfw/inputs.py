@@ -22,7 +22,9 @@ TEXT_LIMIT = 64 * 2**20
 #: Memory a reader needs per byte of a drawing file (measured: ezdxf's document of a 3.1 MB DXF of 19,200
 #: polylines takes 53 MB, 17 times the file).
 DRAWING_BYTES_FACTOR = 20
-_NETCDF_SIGNATURES = (b"CDF\x01", b"CDF\x02", b"CDF\x05", b"\x89HDF\r\n\x1a\n")
+#: File signatures: netCDF-3 (classic, 64-bit offset, 64-bit data) and HDF5, which netCDF-4 files are.
+NETCDF3_SIGNATURES = (b"CDF\x01", b"CDF\x02", b"CDF\x05")
+HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
 _KINDS = ((stat.S_ISFIFO, "a FIFO (named pipe)"), (stat.S_ISCHR, "a character device"),
           (stat.S_ISBLK, "a block device"), (stat.S_ISSOCK, "a socket"), (stat.S_ISDIR, "a directory"))
 
@@ -61,7 +63,7 @@ def fits_in_memory(nbytes: float, what: str, advice: str = "") -> None:
 
 def is_netcdf(head: bytes) -> bool:
     """Whether ``head`` (a file's first bytes) is the start of a netCDF-3 or netCDF-4 (HDF5) file."""
-    return any(head.startswith(signature) for signature in _NETCDF_SIGNATURES)
+    return head[:4] in NETCDF3_SIGNATURES or head[:8] == HDF5_SIGNATURE
 
 
 def read_text(path: str | os.PathLike, what: str, limit: int = TEXT_LIMIT) -> str:

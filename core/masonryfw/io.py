@@ -29,7 +29,7 @@ from . import locks, signals
 from .dofs import upgrade
 from .errors import MasonryError, ModelError
 from .geometry import DERIVED_GEOMETRY_VARIABLES
-from .inputs import file_kind, fits_in_memory
+from .inputs import HDF5_SIGNATURE, file_kind, fits_in_memory, is_netcdf
 from .schema import load_schema, variable_attrs
 
 CONVENTIONS = "CF-1.11"
@@ -38,8 +38,6 @@ COMPRESSION = {"zlib": True, "complevel": 4, "shuffle": True}
 _NODE_AXES = {"node_x": "X", "node_y": "Y"}
 _GEOMETRY_VARIABLES = ("node_x", "node_y", "block_node_count")
 
-_NETCDF3_SIGNATURES = (b"CDF\x01", b"CDF\x02", b"CDF\x05")
-_HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
 _HASH_CHUNK = 1 << 20
 #: A write that fails with less free space than this (bytes) in the target's folder failed on a full disk.
 DISK_FULL = 1 << 20
@@ -139,18 +137,18 @@ def _netcdf_problem(path: Path) -> str | None:
     if path.is_dir():
         return "is a directory, not a netCDF file"
     if not path.is_file():
-        return "is not a regular file"
+        return f"is {file_kind(path.stat().st_mode)}, not a regular file"
     size = path.stat().st_size
     if size == 0:
         return "is empty (0 bytes), not a netCDF file"
     with path.open("rb") as stream:
         head = stream.read(8)
-        if head[:4] in _NETCDF3_SIGNATURES or head == _HDF5_SIGNATURE:
+        if is_netcdf(head):
             return None
         offset = 512
-        while offset + len(_HDF5_SIGNATURE) <= size:
+        while offset + len(HDF5_SIGNATURE) <= size:
             stream.seek(offset)
-            if stream.read(len(_HDF5_SIGNATURE)) == _HDF5_SIGNATURE:
+            if stream.read(len(HDF5_SIGNATURE)) == HDF5_SIGNATURE:
                 return None
             offset *= 2
     return (

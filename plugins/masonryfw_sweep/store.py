@@ -20,7 +20,6 @@ from __future__ import annotations
 import hashlib
 import json
 import os
-import secrets
 from collections.abc import Mapping
 from datetime import datetime, timezone
 from pathlib import Path
@@ -51,17 +50,14 @@ def model_hash(model: xr.Dataset) -> str:
     return mf.content_sha256(model)
 
 
-def write_text_atomic(path: Path, text: str) -> None:
-    """Write ``text`` to a temporary file beside ``path``, flush it to disk, rename it over ``path``."""
-    temporary = path.with_name(f".{path.name}.{secrets.token_hex(6)}.tmp")
-    try:
+def _synced_text(text: str):
+    """A writer of ``text`` that flushes it to disk (a record is the commit mark of its result)."""
+    def write(temporary: Path) -> None:
         with open(temporary, "w", encoding="utf-8") as stream:
             stream.write(text)
             stream.flush()
             os.fsync(stream.fileno())
-        os.replace(temporary, path)
-    finally:
-        temporary.unlink(missing_ok=True)
+    return write
 
 
 class Store:
@@ -132,5 +128,5 @@ class Store:
             "created": datetime.now(timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ"),
             **provenance,
         }
-        write_text_atomic(self.record_path(key), json.dumps(record, indent=2, sort_keys=True) + "\n")
+        mf.write_atomically({self.record_path(key): _synced_text(json.dumps(record, indent=2, sort_keys=True) + "\n")})
         return result_file
