@@ -5,6 +5,7 @@ Each benchmark script owns the section between ``<!-- begin:NAME -->`` and
 """
 from __future__ import annotations
 
+import argparse
 import datetime as _dt
 import os
 import platform
@@ -17,6 +18,11 @@ HEADER = (
     "Written by the scripts in `benchmarks/` (run `python benchmarks/<script>.py`); each section\n"
     "names the machine and date it was measured on. Times are wall-clock medians unless stated.\n"
 )
+
+
+def command_line(doc: str | None) -> argparse.ArgumentParser:
+    """The benchmark's command line, its module docstring as the help (``--help`` runs nothing)."""
+    return argparse.ArgumentParser(description=doc, formatter_class=argparse.RawDescriptionHelpFormatter)
 
 
 def machine() -> str:

@@ -16,12 +16,12 @@ import time
 from pathlib import Path
 
 import numpy as np
-from _report import write_section
+from _report import command_line, write_section
 
 import masonryfw as mf
 from masonryfw_diagnose import diagnose, read_cracks, read_levelling
 from masonryfw_diagnose.survey import Survey
-from masonryfw_diagnose.synthetic import cracked_joints
+from masonryfw_diagnose.synthetic import visible_cracks
 
 SURVEYS = Path(__file__).resolve().parents[1] / "datasets" / "surveys"
 SEGMENTS = (0.15, 0.1, 0.075, 0.05)
@@ -56,7 +56,7 @@ def main() -> None:
         print(rows[-1], flush=True)
     big = mf.open_model("facade-3")
     result = mf.solve(big, "la", {})
-    lines = tuple(np.c_[result.interface_x.values[j], result.interface_y.values[j]] for j in cracked_joints(result))
+    lines = tuple(np.c_[result.interface_x.values[j], result.interface_y.values[j]] for j in visible_cracks(result))
     own = Survey(lines, (None,) * len(lines), tuple(map(str, range(len(lines)))), sources={"unit": "m"})
     seconds, diagnosis = timed(big, own, None)
     tried = len(diagnosis.candidates) + len(diagnosis.failed)
@@ -80,4 +80,5 @@ la cracks, the default segment.
 
 
 if __name__ == "__main__":
+    command_line(__doc__).parse_args()
     main()

@@ -26,7 +26,7 @@ from pathlib import Path
 import masonryfw as mf
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from _report import write_section  # noqa: E402
+from _report import command_line, write_section  # noqa: E402
 
 ROLE = mf.flags("block_role")
 SWEEPS = {
@@ -194,7 +194,7 @@ def cst_rows(repeats: int = 5) -> list[str]:
     deformable step (forces + central-difference update of the nodes, no contacts)."""
     import numpy as np
 
-    from masonryfw_fdem import deformable
+    from masonryfw_fdem import deformable, kernels
 
     rows = []
     for columns in (16, 300):
@@ -225,12 +225,18 @@ def cst_rows(repeats: int = 5) -> list[str]:
         for _ in range(repeats):
             vel = np.zeros((n_node, 2))
             xs, ys = x.copy(), y.copy()
-            acc, out = np.zeros(7), np.zeros(6)
-            args = (1e-4, xs, ys, vel, x0, y0, x0.copy(), y0.copy(), np.array([0, 0]), node_block, triangles,
-                    grad_x, grad_y, area, young, nu, on, mass, 1 / mass, np.zeros(n_node, np.bool_),
-                    np.zeros(1, np.bool_), np.zeros((1, 3)), np.zeros((1, 3)), no_faces, np.zeros((0, 4)),
-                    1.0, 0.5, 0.0, 0.2, face_rows, face_rows.astype(np.int64), face_rows.copy(),
-                    face_rows.copy(), load, 0.0, np.zeros_like(load), 0.0, 0.0, 0.7, 0.0, 1.0, 0.0, 0.0, 1e300, acc, out)
+            mesh = deformable.Mesh(x0, y0, node_block, triangles, grad_x, grad_y, area, young, nu, mass, 1 / mass,
+                                   np.zeros(n_node, np.bool_), on)
+            bodies = kernels.Bodies(np.zeros((1, 3)), np.ones(1), x0[:1], y0[:1], np.array([0, 0]),
+                                    np.ones((1, 3)), np.zeros(1), np.zeros((1, 3), np.bool_), np.zeros(1, np.bool_),
+                                    np.zeros(1, np.bool_), np.zeros((1, 3)))
+            pairs = kernels.Pairs(no_faces, np.zeros((0, 4)), face_rows, face_rows.astype(np.int64),
+                                  face_rows.copy(), face_rows.copy(), np.zeros((0, 4)))
+            motion = deformable.NodeMotion(xs, ys, vel, x0.copy(), y0.copy(), np.zeros(kernels.N_ACC))
+            loading = kernels.Loading(load, 0.0, np.zeros_like(load), 0.0, 0.0, 0.0, 1.0, 0.0, 0.0)
+            stepping = kernels.Stepping(1e-4, 0.7, 1e300, 0.0, 0, 0.0)
+            args = (bodies, mesh, pairs, kernels.ContactLaw(1.0, 0.5, 0.0, 0.2), motion, loading, stepping,
+                    np.zeros((1, 3)))
             deformable.advance(1, *args)  # compile
             clock = time.perf_counter()
             deformable.advance(steps, *args)
@@ -289,7 +295,9 @@ def deformable_main() -> None:
 
 
 if __name__ == "__main__":
-    if "--deformable" in sys.argv:
+    parser = command_line(__doc__)
+    parser.add_argument("--deformable", action="store_true", help="part 5 only: the deformable mode")
+    if parser.parse_args().deformable:
         deformable_main()
     else:
         main()

@@ -16,7 +16,7 @@ import time
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from _report import write_section  # noqa: E402
+from _report import command_line, write_section  # noqa: E402
 from bench_scale import wall_spec  # noqa: E402
 
 import masonryfw as mf  # noqa: E402
@@ -68,4 +68,5 @@ def main() -> None:
 
 
 if __name__ == "__main__":
+    command_line(__doc__).parse_args()
     main()

@@ -20,7 +20,7 @@ import xarray as xr
 import masonryfw as mf
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from _report import write_section  # noqa: E402
+from _report import command_line, write_section  # noqa: E402
 
 WALLS = [(10, 10), (32, 31), (100, 100), (200, 200)]  # (courses, units per even course)
 REPEATS = 3
@@ -137,4 +137,5 @@ def main() -> None:
 
 
 if __name__ == "__main__":
+    command_line(__doc__).parse_args()
     main()

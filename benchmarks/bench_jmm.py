@@ -7,11 +7,10 @@ docs/benchmarks.md.
 from __future__ import annotations
 
 import statistics
-import sys
 import time
 
 import numpy as np
-from _report import write_section
+from _report import command_line, write_section
 
 import masonryfw as mf
 from masonryfw_jmm.material import JointStrength, ReturnMap, elastic_matrix
@@ -204,7 +203,9 @@ def step_control(case: str = "facade-3") -> str:
 
 
 def main() -> None:
-    cases = sys.argv[1:] or ["test-12c", "facade-3"]
+    parser = command_line(__doc__)
+    parser.add_argument("cases", nargs="*", default=["test-12c", "facade-3"], help="bundled walls to run whole")
+    cases = parser.parse_args().cases
     parts = [big_return_map()] + kernels("facade-3") + [convergence(), tolerance_study(), step_control()]
     runs = [whole_run(case) for case in cases]
     parts.append(

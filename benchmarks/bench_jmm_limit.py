@@ -8,11 +8,10 @@ from __future__ import annotations
 
 import os
 import statistics
-import sys
 import time
 
 import numpy as np
-from _report import write_section
+from _report import command_line, write_section
 
 import masonryfw as mf
 
@@ -41,9 +40,11 @@ def limit_row(case: str, repeat: int, incremental: bool) -> str:
 
 
 def main() -> None:
-    args = [a for a in sys.argv[1:] if not a.startswith("--")]
-    incremental = "--incremental" in sys.argv
-    cases = args or ["test-8c", "test-12c", "facade-3"]
+    parser = command_line(__doc__)
+    parser.add_argument("cases", nargs="*", default=["test-8c", "test-12c", "facade-3"], help="bundled walls")
+    parser.add_argument("--incremental", action="store_true", help="jmm's incremental run beside each limit LP")
+    args = parser.parse_args()
+    cases, incremental = args.cases, args.incremental
     load = os.getloadavg()[0]
     rows = [limit_row(case, 3, incremental) for case in cases]
     body = (

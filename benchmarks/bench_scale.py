@@ -1,6 +1,6 @@
 """Scale: every solver on running-bond walls of 300 to 10,000 units, as a user runs them.
 
-The walls keep issue 16's proportions (8 m x 3 m for 2,400 units of 200 x 50 mm: 40 units
+The walls keep the proportions of the big-wall targets (8 m x 3 m for 2,400 units of 200 x 50 mm: 40 units
 a course, 60 courses; the right 40 % of the base settling); ``courses = sqrt(1.5 n)``.
 Each solve is one CLI process (``masonryfw solve WALL.nc --plugin P``, solver defaults),
 timed from outside with its peak resident memory (``os.wait4``); one that outlives the
@@ -141,7 +141,7 @@ def main(argv=None) -> None:
                 if code == 0:
                     finished.setdefault(solver, []).append((blocks, seconds))
     body = f"""
-Running-bond walls of 200 x 50 mm units in issue 16's proportions (2,400 units: 8 m x 3 m; the right
+Running-bond walls of 200 x 50 mm units in the proportions of the big-wall targets (2,400 units: 8 m x 3 m; the right
 40 % of the base settling; gamma 18 kN/m3, mu = tan 30 deg, E = 3 GPa), each solver at its defaults,
 one CLI process per solve, timed from outside with its peak memory; interrupted (Ctrl-C, the history
 kept, exit 130) after {args.limit:.0f} s. "Estimated": what the solver's `estimate` hook said before the

@@ -15,7 +15,7 @@ import os
 import statistics
 import time
 
-from _report import write_section
+from _report import command_line, write_section
 
 import masonryfw as mf
 
@@ -75,4 +75,5 @@ Time against error (the trough at half the loading rate as the reference, {slow:
 
 
 if __name__ == "__main__":
+    command_line(__doc__).parse_args()
     main()

@@ -34,7 +34,7 @@ from masonryfw_sweep.params import point_assignments, with_values
 from masonryfw_sweep.tasks import run_point
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from _report import write_section  # noqa: E402
+from _report import command_line, write_section  # noqa: E402
 
 LA_POINTS = "supports.settling.start=0.5:0.89:0.01"  # 40 values
 MEMORY_POINTS = "material.unit_weight=10000:19990:10"  # 1,000 values
@@ -207,4 +207,5 @@ each finished future is released at once, so the scheduler holds no results.
 
 
 if __name__ == "__main__":
+    command_line(__doc__).parse_args()
     main()

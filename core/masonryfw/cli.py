@@ -20,7 +20,7 @@ import numpy as np
 
 import masonryfw as mf
 from masonryfw.locks import release_all
-from masonryfw.plugins import command_plugin, installed_plugins, plugin_commands, render
+from masonryfw.registry import command_plugin, installed_plugins, plugin_commands
 
 #: The signals that stopped this command: the exit status is 128 + the first (130 after Ctrl-C, 143 after SIGTERM),
 #: as shells report it.
@@ -131,22 +131,13 @@ _OPTION = click.option(
 @click.option("-o", "--output", type=click.Path(dir_okay=False), help="Model file to write [default: <spec stem>.nc].")
 def build(spec: str, output: str | None) -> None:
     """Build a model from SPEC (a TOML file or a bundled case name)."""
-    spec_path = Path(spec) if _is_path(spec) else _bundled_spec(spec)
+    spec_path = mf.source_path(spec)
     inputs = _input_files(spec)
     out = Path(output) if output else Path(f"{Path(spec).stem}.nc")
     mf.check_output_path(out, inputs)
     model = mf.build(spec_path)
     mf.save(model, out, command=_command_line(), protect=inputs)
     click.echo(f"wrote {out}: {model.sizes['block']} blocks, {model.sizes.get('interface', 0)} interfaces")
-
-
-def _bundled_spec(name: str):
-    """The spec of a bundled case; a name that looks like a path is a missing file."""
-    if name in mf.BUNDLED_NAMES:
-        return mf.bundled_spec_path(name)
-    if "/" in name or Path(name).suffix:
-        raise mf.SpecError(f"{name}: no such file")
-    raise mf.SpecError(f"{name}: no such file, and not a bundled case; bundled cases: {', '.join(mf.BUNDLED_NAMES)}")
 
 
 def _input_files(*names: str) -> list[Path]:
@@ -325,7 +316,7 @@ def _open_input(path_or_name: str, validate: bool = True):
     """A dataset file as it is (model, result); a spec file or a bundled case name as its model
     (not checked with ``validate`` False: to draw a model that is wrong)."""
     path = Path(path_or_name)
-    if path.is_file() and path.suffix.lower() not in mf.model.SPEC_SUFFIXES:
+    if path.is_file() and not mf.is_spec(path):
         return mf.open_dataset(path)
     return mf.open_model(path_or_name, validate=validate)
 
@@ -458,7 +449,7 @@ def plot(results: tuple[str, ...], kind: str | None, output: str, file_format: s
         click.echo(f"table: {output} ({len(rows)} rows)")
         return
     mf.check_output_path(output, inputs, mf.io.FIGURE_FORMATS)
-    figure = render([_open_input(r, validate=kind != "model") for r in results], kind, options)
+    figure = mf.render([_open_input(r, validate=kind != "model") for r in results], kind, options)
     mf.save_figure(figure, output, protect=inputs)
     click.echo(f"plot: {output}")
 

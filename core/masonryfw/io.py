@@ -31,6 +31,7 @@ from .errors import MasonryError, ModelError
 from .geometry import DERIVED_GEOMETRY_VARIABLES
 from .inputs import HDF5_SIGNATURE, file_kind, fits_in_memory, is_netcdf
 from .schema import load_schema, variable_attrs
+from .version import __version__
 
 CONVENTIONS = "CF-1.11"
 COMPRESSION = {"zlib": True, "complevel": 4, "shuffle": True}
@@ -205,8 +206,6 @@ def _fits_in_memory(lazy: xr.Dataset, file: Path) -> None:
 
 def add_history(ds: xr.Dataset, command: str) -> xr.Dataset:
     """A new dataset whose ``history`` has one more line: ``<UTC time> masonryfw <version>: <command>``."""
-    from . import __version__
-
     stamp = datetime.now(timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")
     line = f"{stamp} masonryfw {__version__}: {' '.join(str(command).split())}"
     previous = str(ds.attrs.get("history", "")).rstrip("\n")

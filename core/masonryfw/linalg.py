@@ -20,6 +20,7 @@ import scipy.sparse as sp
 
 
 def has_cholmod() -> bool:
+    """Whether CHOLMOD (through cvxopt) is installed: :func:`cholesky_factor` then uses it, else SuperLU."""
     try:
         import cvxopt.cholmod  # noqa: F401
     except ImportError:

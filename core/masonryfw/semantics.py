@@ -11,15 +11,19 @@ histories); :func:`masonryfw.solve` derives the comparable fields below from
   (``rotations = "finite"``) by ``u_c + (R(rz) - I)(p - c)``;
 - **joint motion**: the largest ``|(max(opening, 0), slip)|`` of the joint's two
   ends (a closing end is compression, not a crack);
-- **intact**: a joint whose motion is at most :data:`INTACT_SHARE` of the largest
-  masonry-joint motion. One threshold for every solver; measured on the ten
-  bundled walls (docs/format.md): fdem's elastic contact motions stay below
-  0.3-1 % of the largest joint motion, while la's mechanisms have joints moving
-  1-2 % of it;
-- **crack_indicator**: joint motion over the largest masonry-joint motion, 0 on
-  intact joints and on joints between two supports (ground against ground). A
-  continuum result (no block motion, plastic points ``qp_failure`` at ``qp_x``,
-  ``qp_y``) gets the share of the points nearest to the joint that yield;
+- **cracked** and **intact**: a joint is cracked where its motion is more than
+  :data:`CRACK_THRESHOLD` (a tenth) of the largest masonry-joint motion, intact
+  otherwise. One threshold for every solver, every plot, the comparisons, the
+  report and the diagnosis; a user's ``threshold`` option re-derives the states,
+  the indicator and the macro-blocks at another one (:func:`at_threshold`). A
+  tenth keeps every joint one sees open in an amplified mechanism drawing and
+  drops fdem's elastic contact motions (0.3-1 % of the largest on the ten bundled
+  walls) and the round-off an interior-point solution leaves (1e-6 and below);
+- **crack_indicator**: joint motion over the largest masonry-joint motion on
+  cracked joints, 0 on intact joints and on joints between two supports (ground
+  against ground). A continuum result (no block motion, plastic points
+  ``qp_failure`` at ``qp_x``, ``qp_y``) gets the share of the points nearest to
+  the joint that yield, 0 where that share is at most the threshold;
 - **interface_state**: ``intact``; ``open`` when the slip stays within the
   threshold; ``slide`` when the slip exceeds it and the opening is no more than
   the flow rule's dilatancy of that slip (``tan(psi) |slip|``: ``mu |slip|`` for
@@ -41,8 +45,9 @@ from .errors import ModelError
 from .geometry import block_offsets, model_scale, node_block
 from .schema import flags, variable_attrs
 
-#: A joint moving at most this share of the largest masonry-joint motion is intact.
-INTACT_SHARE = 0.01
+#: A joint is cracked where it moves more than this share of the largest masonry-joint motion
+#: (``crack_indicator > CRACK_THRESHOLD``), intact otherwise.
+CRACK_THRESHOLD = 0.1
 #: The reaction history is at its plateau from the first settlement after which it stays within
 #: this share of the dead reaction of its final value.
 PLATEAU_SHARE = 0.01
@@ -223,12 +228,12 @@ def joint_motion(opening: np.ndarray, slip: np.ndarray) -> np.ndarray:
     return np.hypot(np.maximum(opening, 0.0), slip).max(axis=1)
 
 
-def intact_threshold(motion: np.ndarray, masonry: np.ndarray, share: float = INTACT_SHARE) -> float:
+def intact_threshold(motion: np.ndarray, masonry: np.ndarray, share: float = CRACK_THRESHOLD) -> float:
     """The joint motion at or below which a joint is intact: ``share`` of the largest masonry-joint motion."""
     return share * float(motion[masonry].max(initial=0.0))
 
 
-def crack_indicator(motion: np.ndarray, masonry: np.ndarray, share: float = INTACT_SHARE) -> np.ndarray:
+def crack_indicator(motion: np.ndarray, masonry: np.ndarray, share: float = CRACK_THRESHOLD) -> np.ndarray:
     """Joint motion over the largest masonry-joint motion; 0 on intact and non-masonry joints."""
     largest = float(motion[masonry].max(initial=0.0))
     if largest <= 0:
@@ -259,8 +264,10 @@ def nearest_interface(model: xr.Dataset, x: np.ndarray, y: np.ndarray, spacing: 
     return index[owner[nearest]]
 
 
-def plastic_crack_indicator(model: xr.Dataset, x: np.ndarray, y: np.ndarray, plastic: np.ndarray) -> np.ndarray:
-    """Continuum ``crack_indicator``: the share of the points nearest to each joint that yield.
+def plastic_crack_indicator(model: xr.Dataset, x: np.ndarray, y: np.ndarray, plastic: np.ndarray,
+                            threshold: float = CRACK_THRESHOLD) -> np.ndarray:
+    """Continuum ``crack_indicator``: the share of the points nearest to each joint that yield, where it is
+    more than ``threshold``.
 
     Points go to their nearest interface to within a quarter of the points' median
     spacing (nearest-neighbour distance) or a sixteenth of the median joint length,
@@ -277,7 +284,8 @@ def plastic_crack_indicator(model: xr.Dataset, x: np.ndarray, y: np.ndarray, pla
     total = np.bincount(owner, minlength=n)
     hits = np.bincount(owner, weights=np.asarray(plastic, dtype=float), minlength=n)
     share = np.divide(hits, total, out=np.zeros(n), where=total > 0)
-    return np.where(masonry_joints(model.block_role.values, model.interface_blocks.values), share, 0.0)
+    cracked = masonry_joints(model.block_role.values, model.interface_blocks.values) & (share > threshold)
+    return np.where(cracked, share, 0.0)
 
 
 def interface_states(opening: np.ndarray, slip: np.ndarray, dilatancy: np.ndarray | float,
@@ -308,7 +316,7 @@ def dilatancy(model: xr.Dataset, flow_rule: str) -> np.ndarray:
 
 
 def derived_variables(model: xr.Dataset, u: np.ndarray, rotations: str, flow_rule: str,
-                      share: float = INTACT_SHARE) -> dict[str, tuple]:
+                      share: float = CRACK_THRESHOLD) -> dict[str, tuple]:
     """The comparable result variables of block motions ``u`` (block, 3) on ``model`` (derived geometry)."""
     opening, slip = relative_motion(model, u, rotations)
     motion = joint_motion(opening, slip)
@@ -320,18 +328,53 @@ def derived_variables(model: xr.Dataset, u: np.ndarray, rotations: str, flow_rul
         "interface_opening": (ie, opening, variable_attrs("interface_opening")),
         "interface_slip": (ie, slip, variable_attrs("interface_slip")),
         "interface_state": (("interface",), state, variable_attrs("interface_state")),
-        "crack_indicator": (("interface",), crack_indicator(motion, masonry, share), variable_attrs("crack_indicator")),
+        "crack_indicator": (("interface",), crack_indicator(motion, masonry, share), indicator_attrs(share)),
         "macro_block": (("block",), labels.astype(np.int32), variable_attrs("macro_block")),
     }
 
 
-def states_at(result: xr.Dataset, share: float) -> np.ndarray:
-    """``interface_state`` recomputed with another intact share (e.g. a plot's threshold)."""
-    opening, slip = result.interface_opening.values, result.interface_slip.values
-    motion = joint_motion(opening, slip)
-    masonry = masonry_joints(result.block_role.values, result.interface_blocks.values)
-    rule = str(result.attrs.get("flow_rule", "nonassociative"))
-    return interface_states(opening, slip, dilatancy(result, rule), intact_threshold(motion, masonry, share))
+def indicator_attrs(threshold: float) -> dict:
+    """``crack_indicator``'s attributes, with the threshold it was derived at (``crack_threshold``)."""
+    return {**variable_attrs("crack_indicator"), "crack_threshold": float(threshold)}
+
+
+def at_threshold(result: xr.Dataset, threshold: float = CRACK_THRESHOLD) -> xr.Dataset:
+    """``result`` with ``interface_state``, ``crack_indicator`` and ``macro_block`` derived at another crack
+    threshold (a user's ``threshold`` option): from the relative motion at the joints of a block result,
+    from the plastic points of a continuum one; a result with only an indicator keeps the part of it
+    above the threshold. A result whose ``crack_indicator`` says it was derived at ``threshold``
+    (its attribute ``crack_threshold``) is returned as it is."""
+    derived = "crack_indicator" in result and result.crack_indicator.attrs.get("crack_threshold") == threshold
+    if derived and ("interface_state" in result or "interface_opening" not in result):
+        return result
+    if "interface_opening" in result and "interface_slip" in result:
+        opening, slip = result.interface_opening.values, result.interface_slip.values
+        motion = joint_motion(opening, slip)
+        masonry = masonry_joints(result.block_role.values, result.interface_blocks.values)
+        rule = str(result.attrs.get("flow_rule", "nonassociative"))
+        state = interface_states(opening, slip, dilatancy(result, rule), intact_threshold(motion, masonry, threshold))
+        labels = macro_blocks(result.sizes["block"], result.interface_blocks.values, state)
+        return result.assign(
+            interface_state=("interface", state, variable_attrs("interface_state")),
+            crack_indicator=("interface", crack_indicator(motion, masonry, threshold), indicator_attrs(threshold)),
+            macro_block=("block", labels.astype(np.int32), variable_attrs("macro_block")))
+    if "qp_failure" in result and "crack_indicator" in result:
+        indicator = plastic_crack_indicator(result, result.qp_x.values, result.qp_y.values,
+                                            result.qp_failure.values > 0, threshold)
+        return result.assign(crack_indicator=("interface", indicator, indicator_attrs(threshold)))
+    if "crack_indicator" in result:
+        indicator = np.asarray(result.crack_indicator.values, dtype=float)
+        return result.assign(crack_indicator=("interface", np.where(indicator > threshold, indicator, 0.0),
+                                              indicator_attrs(threshold)))
+    return result
+
+
+def cracked_joints(result: xr.Dataset, threshold: float = CRACK_THRESHOLD) -> np.ndarray:
+    """bool per interface: the joints ``result`` has cracked at ``threshold`` (``crack_indicator > 0`` once
+    derived there); every plot, comparison, report and diagnosis counts cracks through this."""
+    if "crack_indicator" not in result:
+        return np.zeros(result.sizes.get("interface", 0), dtype=bool)
+    return np.asarray(at_threshold(result, threshold).crack_indicator.values) > 0
 
 
 # ---------------------------------------------------------------- the numbers a user came for
@@ -516,8 +559,12 @@ def key_numbers(result: xr.Dataset) -> list[KeyNumber]:
             numbers.append(KeyNumber(name, float(result[f"step_{name}"].values[-1]), "1" if "ratio" in name else "rad",
                                      what))
     numbers += _assessment_numbers(result)
-    if "macro_block" in result:
-        masonry = masonry_blocks(result.block_role.values)
-        count = np.unique(result.macro_block.values[masonry]).size
+    derived = at_threshold(result)
+    if "crack_indicator" in derived:
+        numbers.append(KeyNumber("cracked_joints", float(np.count_nonzero(derived.crack_indicator.values)), "1",
+                                 f"joints moving more than {CRACK_THRESHOLD:g} of the largest joint motion"))
+    if "macro_block" in derived:
+        masonry = masonry_blocks(derived.block_role.values)
+        count = np.unique(derived.macro_block.values[masonry]).size
         numbers.append(KeyNumber("macro_blocks", float(count), "1", "macro-blocks of the masonry"))
     return numbers

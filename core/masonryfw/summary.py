@@ -121,6 +121,9 @@ _HEADLINES = (
      "(sagging positive)"),
     ("angular_distortion", "angular distortion", lambda n: _slope(n["angular_distortion"]),
      "of the imposed ground at the last record: its largest slope less the chord's tilt"),
+    ("cracked_joints", "cracked joints", lambda n: f"{int(n['cracked_joints'])}",
+     "joints moving more than a tenth of the largest joint motion (the one crack threshold of every plot, "
+     "comparison and diagnosis)"),
     ("macro_blocks", "macro-blocks", lambda n: f"{int(n['macro_blocks'])}",
      "pieces the masonry breaks into (blocks joined by intact joints)"),
 )

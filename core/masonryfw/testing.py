@@ -38,10 +38,11 @@ import pytest
 import xarray as xr
 
 from . import blocks
+from .api import estimate, solve
 from .checks import check
 from .errors import PluginError
 from .model import checked_model
-from .plugins import estimate, get_solver, solve
+from .registry import get_solver
 from .schema import flags, load_schema
 from .semantics import key_numbers
 

@@ -111,9 +111,9 @@ def generator(cases: int, cache: Path) -> dict:
                 rows.append({"seed": seed, "skipped": str(exc).splitlines()[0]})
                 continue
             if solver == "la":
-                row = run_case(spec, truth, result, sy.cracked_joints(result), SURVEYOR, seed)
+                row = run_case(spec, truth, result, sy.visible_cracks(result), SURVEYOR, seed)
             else:
-                joints = sy.cracked_joints(result, width=FDEM_WIDTH)
+                joints = sy.visible_cracks(result, width=FDEM_WIDTH)
                 opening = np.maximum(result.interface_opening.values, 0.0).max(axis=1)
                 row = run_case(spec, truth, result, joints, SURVEYOR, seed,
                                {int(j): 1e3 * float(opening[j]) for j in joints})
@@ -135,7 +135,7 @@ def noise(cases: int, cache: Path) -> dict:
                 spec, truth = case(seed)
                 model = mf.build({**spec, "settlement": truth, "loading": {"type": "settlement"}})
                 result = forward(cache, f"case{seed}", model, "la")
-                rows.append(run_case(spec, truth, result, sy.cracked_joints(result), surveyor, seed))
+                rows.append(run_case(spec, truth, result, sy.visible_cracks(result), surveyor, seed))
             out[f"{factor}={level}"] = rates(rows)
             print(factor, level, out[f"{factor}={level}"], flush=True)
     return out
@@ -151,7 +151,7 @@ def walls(cache: Path) -> dict:
         settling = (float(xmin[moving].min()), float(xmax[moving].max()))
         for solver in ("la", "fdem"):
             result = forward(cache, name, model, solver)
-            joints = sy.cracked_joints(result) if solver == "la" else sy.cracked_joints(result, width=FDEM_WIDTH)
+            joints = sy.visible_cracks(result) if solver == "la" else sy.visible_cracks(result, width=FDEM_WIDTH)
             started = time.perf_counter()
             diagnosis = diagnose(model, survey_of(sy.draw(result, joints, sy.Surveyor(), np.random.default_rng(0))))
             best = diagnosis.best.table
@@ -174,7 +174,7 @@ def walls(cache: Path) -> dict:
 def survey(cache: Path) -> dict:
     """The bundled survey of the README tour (datasets/surveys/README.md): facade-1's fdem cracks and a levelling."""
     result = forward(cache, "facade-1", mf.open_model("facade-1"), "fdem")
-    joints = sy.cracked_joints(result, width=FDEM_WIDTH)
+    joints = sy.visible_cracks(result, width=FDEM_WIDTH)
     opening = np.maximum(result.interface_opening.values, 0.0).max(axis=1)
     collection = sy.draw(result, joints, sy.Surveyor(offset=0.15, gaps=0.1, missing=1.0, spurious=1),
                          np.random.default_rng(7), {int(j): 1e3 * float(opening[j]) for j in joints})

@@ -11,6 +11,7 @@
 """
 from __future__ import annotations
 
+import argparse
 import time
 
 import numpy as np
@@ -89,4 +90,5 @@ def main() -> None:
 
 
 if __name__ == "__main__":
+    argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter).parse_args()
     main()

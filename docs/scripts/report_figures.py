@@ -17,7 +17,7 @@ import matplotlib
 matplotlib.use("Agg")
 
 import masonryfw as mf  # noqa: E402
-from masonryfw_compare.plotting import drawable_kinds  # noqa: E402
+from masonryfw_compare.block_plots import drawable_kinds  # noqa: E402
 from masonryfw_compare.report import report_html  # noqa: E402
 
 DOCS = Path(__file__).resolve().parents[1]

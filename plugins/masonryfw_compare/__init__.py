@@ -2,8 +2,9 @@
 
 Registration only (cheap to import: see :mod:`.records`); the work lives in
 :mod:`.comparison` (the ``crack`` comparator), :mod:`.scores` (the score
-functions), :mod:`.plotting` (the plot kinds, drawn through ``masonryfw.render``),
-:mod:`.gallery` and :mod:`.export`.
+functions), the plot kinds drawn through ``masonryfw.render`` (:mod:`.block_plots`,
+:mod:`.history_plot`, :mod:`.compare_plot`, :mod:`.ltsm_plot`, their shared parts in
+:mod:`.figure_parts`), :mod:`.gallery` and :mod:`.export`.
 """
 from __future__ import annotations
 

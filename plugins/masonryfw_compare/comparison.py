@@ -85,13 +85,14 @@ def ensure_same_model(a: xr.Dataset, b: xr.Dataset) -> None:
             raise _different_models(a, b, f"{name} differs at {at} ({va.ravel()[where].item()!r} vs {vb.ravel()[where].item()!r})")
 
 
-def interface_scores(a: xr.Dataset, b: xr.Dataset, length: np.ndarray, threshold: float) -> dict:
-    """Scores on ``crack_indicator``: thresholded set scores and the threshold-free ones."""
+def interface_scores(a: xr.Dataset, b: xr.Dataset, length: np.ndarray) -> dict:
+    """Scores on ``crack_indicator`` (derived at the comparison's threshold): the cracked sets' scores and
+    the scores of the indicators themselves."""
     if "crack_indicator" not in a or "crack_indicator" not in b:
         return {}
     ca = a.crack_indicator.values.astype(float)
     cb = b.crack_indicator.values.astype(float)
-    out = scores.confusion_scores(ca > threshold, cb > threshold)
+    out = scores.confusion_scores(ca > 0, cb > 0)
     out["crack_overlap"] = scores.weighted_overlap(ca, cb, length)
     out["crack_spearman"] = scores.spearman(ca, cb)
     return out
@@ -134,7 +135,7 @@ class Locus:
         return distance_to_points(px, py, self.x, self.y)
 
 
-def failure_locus(ds: xr.Dataset, threshold: float) -> Locus | None:
+def failure_locus(ds: xr.Dataset) -> Locus | None:
     """Plastic points (qp_failure != 0) of a continuum result, else its cracked joints; None if empty.
 
     Joints are sampled along their length (midpoint rule) and weighted by length,
@@ -148,7 +149,7 @@ def failure_locus(ds: xr.Dataset, threshold: float) -> Locus | None:
         return Locus(x, y, np.ones(x.size))
     if "crack_indicator" not in ds:
         return None
-    cracked = ds.crack_indicator.values > threshold
+    cracked = ds.crack_indicator.values > 0
     if not cracked.any():
         return None
     sx, sy = ds.interface_x.values[cracked], ds.interface_y.values[cracked]
@@ -156,9 +157,9 @@ def failure_locus(ds: xr.Dataset, threshold: float) -> Locus | None:
     return Locus(x, y, weight, sx, sy)
 
 
-def locus_scores(a: xr.Dataset, b: xr.Dataset, size: float, threshold: float) -> dict:
+def locus_scores(a: xr.Dataset, b: xr.Dataset, size: float) -> dict:
     """Mean distance between the failure loci, both ways and averaged, over the model size."""
-    la, lb = failure_locus(a, threshold), failure_locus(b, threshold)
+    la, lb = failure_locus(a), failure_locus(b)
     if la is None or lb is None:
         return {}
     a_to_b = float(np.average(lb.distance_from(la.x, la.y), weights=la.weight)) / size
@@ -198,16 +199,17 @@ def comparison_variables(values: Mapping[str, float | int | None]) -> xr.Dataset
 
 
 def compare(a: xr.Dataset, b: xr.Dataset, options: Mapping[str, Any]) -> xr.Dataset:
-    """Score result ``b`` against result ``a`` (same model); returns the score variables."""
+    """Score result ``b`` against result ``a`` (same model), both read at the option ``threshold``
+    (:func:`masonryfw.at_threshold`); returns the score variables."""
     ensure_same_model(a, b)
+    a, b = mf.at_threshold(a, options["threshold"]), mf.at_threshold(b, options["threshold"])
     geo = mf.derive_geometry(a[list(GEOMETRY_VARIABLES)])
     masonry = mf.masonry_blocks(geo.block_role.values)
-    threshold = options["threshold"]
     size = mf.model_scale(geo.node_x.values, geo.node_y.values)
     values: dict[str, float | int | None] = {"length_scale": size}
     values.update(multiplier_values(a, b))
-    values.update(interface_scores(a, b, geo.interface_length.values, threshold))
+    values.update(interface_scores(a, b, geo.interface_length.values))
     values.update(partition_scores(a, b, masonry))
     values.update(mechanism_scores(a, b, geo, masonry))
-    values.update(locus_scores(a, b, size, threshold))
+    values.update(locus_scores(a, b, size))
     return comparison_variables(values)

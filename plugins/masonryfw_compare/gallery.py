@@ -23,8 +23,6 @@ import xarray as xr
 
 import masonryfw as mf
 
-from .records import DEFAULT_THRESHOLD
-
 GALLERY_DPI = 110
 IDENTICAL_COSINE_GAP = 1e-3
 SKIPPED = "skipped (--skip)"
@@ -175,7 +173,7 @@ def solve_case(
         echo(f"  {run.label}: {seconds[run.label]:.2f} s")
     labels = [mf.result_label(r) for r in results]
     comparisons = [
-        (labels[i], labels[j], mf.compare(results[i], results[j], "crack", {"threshold": DEFAULT_THRESHOLD}))
+        (labels[i], labels[j], mf.compare(results[i], results[j], "crack", {"threshold": mf.CRACK_THRESHOLD}))
         for i, j in compared_pairs(labels)
     ]
     return CaseOutcome(case, title, results, failures, comparisons, seconds)
@@ -369,7 +367,7 @@ def gallery_command_line(
 def agreement_markdown(outcomes: list[CaseOutcome], runs: list[Run], command: str = DEFAULT_COMMAND,
                        notes: str = "") -> str:
     """The whole of docs/agreement.md (``notes``: hand-written markdown put in as its Discussion section)."""
-    parts = [INTRODUCTION.format(threshold=DEFAULT_THRESHOLD, command=command)]
+    parts = [INTRODUCTION.format(threshold=mf.CRACK_THRESHOLD, command=command)]
     installed = sorted({r.solver for r in runs})
     parts.append("## Status\n")
     parts.append(f"Methods run: {', '.join(installed) or 'none'}.")
@@ -400,7 +398,7 @@ def agreement_markdown(outcomes: list[CaseOutcome], runs: list[Run], command: st
         parts.append(notes.strip())
     parts.append("\n## Solve times [s]\n")
     parts.append(timing_table(outcomes, runs))
-    comparator = json.dumps({"threshold": DEFAULT_THRESHOLD})
+    comparator = json.dumps({"threshold": mf.CRACK_THRESHOLD})
     parts.append(f"\nComparator options: `{comparator}`; masonryfw {mf.__version__}.\n")
     return "\n".join(parts)
 

@@ -17,7 +17,7 @@ from matplotlib.patches import Rectangle
 import masonryfw as mf
 from masonryfw.assessment import LTSM_LIMITS, POISSON, Part, assess, deep_beam_strains, wall_extent
 
-from .plotting import DAMAGE_COLOURS, _single, title_of
+from .figure_parts import DAMAGE_COLOURS, single_result, title_of
 
 ZONE_NAMES = ("0 negligible", "1 very slight", "2 slight", "3 moderate", "4-5 severe to very severe")
 
@@ -48,7 +48,7 @@ def zone_boundary(limit: float, strain: np.ndarray, part: Part, height: float) -
 
 def draw_ltsm(datasets: Sequence[xr.Dataset], ax, options: Mapping[str, Any]) -> None:
     """The trough under the wall and the interaction chart with the wall's parts (module docstring)."""
-    ds = _single(datasets, "ltsm")
+    ds = single_result(datasets, "ltsm")
     settlement = assessed_settlement(ds)
     stages = assess(ds, settlement)
     if stages is None:

@@ -7,12 +7,12 @@ from __future__ import annotations
 
 import masonryfw as mf
 
-DEFAULT_THRESHOLD = 0.1
 THRESHOLD_OPTION = mf.Option(
     "threshold",
     float,
-    DEFAULT_THRESHOLD,
-    "a joint counts as cracked where crack_indicator > threshold",
+    mf.CRACK_THRESHOLD,
+    "a joint is cracked where it moves more than this share of the largest joint motion (the core's crack "
+    "threshold; states, indicator and macro-blocks are derived at it)",
     at_least=0.0,
     below=1.0,
 )
@@ -32,7 +32,7 @@ COMPARATOR = mf.Comparator(
 
 
 def _plotter(name: str, summary: str, options: tuple = (), table: bool = False,
-             side_by_side: bool = False, module: str = "plotting") -> mf.Plotter:
+             side_by_side: bool = False, module: str = "block_plots") -> mf.Plotter:
     return mf.Plotter(name, summary, mf.lazy(f"masonryfw_compare.{module}:draw_{name}"), options=options,
                       table=mf.lazy(f"masonryfw_compare.{module}:{name}_table") if table else None,
                       side_by_side=side_by_side)
@@ -60,9 +60,9 @@ PLOTTERS = {
                   mf.Option("xscale", str, "linear", "settlement axis; log shows the first fraction of a millimetre "
                             "(where jmm's history lives) next to fdem's centimetres", ("linear", "log")),
                   mf.Option("settlement_max", float, None, "zoom: the settlement axis ends here [mm]", above=0.0)),
-                 table=True),
+                 table=True, module="history_plot"),
         _plotter("compare", "two or more results side by side with their scores",
-                 (AMPLIFICATION_OPTION, THRESHOLD_OPTION), side_by_side=True),
+                 (AMPLIFICATION_OPTION, THRESHOLD_OPTION), side_by_side=True, module="compare_plot"),
         _plotter("ltsm", "the engineers' stage 2 over a settlement profile: the trough under the wall and the LTSM "
                  "interaction chart (deflection ratio against horizontal strain, the category zones, the wall's "
                  "sagging and hogging parts)", module="ltsm_plot"),

@@ -22,8 +22,8 @@ import xarray as xr
 
 import masonryfw as mf
 
+from .block_plots import drawable_kinds
 from .comparison import ensure_same_model
-from .plotting import drawable_kinds
 
 FIGURE_DPI = 130
 #: Libraries whose versions the provenance lists.

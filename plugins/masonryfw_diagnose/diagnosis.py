@@ -104,7 +104,7 @@ def wall_model(source: str) -> xr.Dataset:
     its supports, ``[settlement]`` and ``[loading]`` (:func:`masonryfw.load_wall`): the diagnosis sets them aside
     and makes its ground."""
     path = Path(source)
-    if path.is_file() and path.suffix.lower() in mf.model.SPEC_SUFFIXES:
+    if path.is_file() and mf.is_spec(path):
         return mf.build(mf.load_wall(path))
     return mf.open_model(source)
 

@@ -1,6 +1,6 @@
 """A surveyor's crack map drawn from a forward result: the known answer a diagnosis is tested against.
 
-The cracked joints of a result (``crack_indicator`` above a threshold, or an opening wider than a width
+The cracked joints of a result (the core's, at its crack threshold, or an opening wider than a width
 for an incremental result) are joined into cracks (joints sharing an end), then drawn as a surveyor would:
 every line offset sideways (and kept on the wall), some joints left out (gaps), short cracks missed
 altogether, and a few spurious hairlines added where nothing cracked. Used by the tests and docs/diagnose.md's studies.
@@ -26,15 +26,16 @@ class Surveyor:
     spurious_length: float = 2.0  # their length [h]
 
 
-def cracked_joints(result: xr.Dataset, threshold: float = 0.1, width: float | None = None) -> np.ndarray:
-    """Joints between masonry blocks that ``result`` cracks: an opening or slip over ``width`` [m] at the last
-    record when given, else ``crack_indicator > threshold``."""
+def visible_cracks(result: xr.Dataset, threshold: float = mf.CRACK_THRESHOLD, width: float | None = None) -> np.ndarray:
+    """Joints between masonry blocks (a surveyor draws no base gap) that ``result`` cracks: an opening or
+    slip over ``width`` [m] at the last record when given, else the core's cracked joints at ``threshold``
+    (:func:`masonryfw.cracked_joints`)."""
     masonry = mf.masonry_blocks(result.block_role.values)
     inner = masonry[result.interface_blocks.values.astype(np.int64)].all(axis=1)
     if width is not None:
         motion = np.maximum(np.abs(result.interface_opening.values), np.abs(result.interface_slip.values)).max(axis=1)
         return np.flatnonzero(inner & (motion > width))
-    return np.flatnonzero(inner & (result.crack_indicator.values > threshold))
+    return np.flatnonzero(inner & mf.cracked_joints(result, threshold))
 
 
 def chains(result: xr.Dataset, joints: np.ndarray) -> list[np.ndarray]:

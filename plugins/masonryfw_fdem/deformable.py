@@ -23,7 +23,7 @@ Support blocks stay rigid: their nodes follow ``pos0 + settlement * direction`` 
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit
@@ -33,18 +33,13 @@ import masonryfw as mf
 from .kernels import (
     DISSIPATED_DAMPING,
     DISSIPATED_FRICTION,
-    KINETIC,
-    OUT_SCALARS,
-    REBUILD,
     RELEASED,
     SETTLEMENT,
-    STEPS,
-    STORED,
     TIME,
-    UNBALANCED,
     WORK_GRAVITY,
     WORK_SUPPORT,
     face_geometry,
+    next_node,
     settlement_rate,
     smooth_share,
 )
@@ -55,9 +50,8 @@ jit = njit(cache=True, error_model="numpy")
 fast_jit = njit(cache=True, error_model="numpy", fastmath=True, boundscheck=False)
 
 
-@dataclass
-class Mesh:
-    """Flat non-dimensional arrays of the triangulated blocks."""
+class Mesh(NamedTuple):
+    """Flat non-dimensional arrays of the triangulated blocks (what the kernels take)."""
 
     x0: np.ndarray  # (node,) reference coordinates
     y0: np.ndarray
@@ -281,17 +275,28 @@ def edge_weight(x, y, k0, k1, px, py):
     return min(max(w, 0.0), 1.0)
 
 
-@jit
-def next_node(k, b, offs):
-    return k + 1 if k + 1 < offs[b + 1] else offs[b]
+class NodeMotion(NamedTuple):
+    """What the steps change: node positions and velocities (node, 2), positions at the last detection,
+    the accumulators ``acc`` (:mod:`.kernels`)."""
+
+    x: np.ndarray
+    y: np.ndarray
+    vel: np.ndarray
+    x_detect: np.ndarray
+    y_detect: np.ndarray
+    acc: np.ndarray
 
 
 @jit
-def node_contact_forces(x, y, vel, offs, faces, props, kn, kt, min_half, contact_damping, inv_mass, dt,
-                        shear, bonded, normal, energy, force, acc, update_history):
+def node_contact_forces(offs, mesh, pairs, law, motion, force, dt, update_history):
     """The rigid mode's face-pair contact law (see :func:`.kernels.contact_forces`) on the current
     boundary nodes: the force at each contact end goes to the two nodes of each edge by linear
     interpolation, and the relative velocity is interpolated from them. Returns the spring energy."""
+    faces, props, shear, bonded, normal, energy = pairs.faces, pairs.props, pairs.shear, pairs.bonded, \
+        pairs.normal, pairs.energy
+    x, y, vel, acc = motion.x, motion.y, motion.vel, motion.acc
+    kn, kt, min_half, contact_damping = law
+    inv_mass = mesh.inv_mass
     stored = 0.0
     for f in range(faces.shape[0]):
         a, ea, b, eb = faces[f, 0], faces[f, 1], faces[f, 2], faces[f, 3]
@@ -377,8 +382,10 @@ def node_contact_forces(x, y, vel, offs, faces, props, kn, kt, min_half, contact
 
 
 @jit
-def driven_motion(settlement, rate, x0, y0, node_block, driven_nodes, pos0, direction, x, y, vel):
+def driven_motion(settlement, rate, bodies, mesh, driven_nodes, motion):
     """Positions and velocities of the support nodes: rigid motion ``pos0 + settlement * direction``."""
+    x0, y0, node_block, pos0, direction = mesh.x0, mesh.y0, mesh.node_block, bodies.pos0, bodies.direction
+    x, y, vel = motion.x, motion.y, motion.vel
     for k in driven_nodes:
         b = node_block[k]
         theta = settlement * direction[b, 2]
@@ -392,33 +399,34 @@ def driven_motion(settlement, rate, x0, y0, node_block, driven_nodes, pos0, dire
 
 
 @jit
-def advance(n_steps, dt, x, y, vel, x0, y0, x_detect, y_detect, offs, node_block, triangles, grad_x, grad_y,
-            area0, young, poisson, active_tri, mass, inv_mass, driven, pos0, direction, faces, props,
-            kn, kt, min_half, contact_damping, shear, bonded, normal, energy, load, load_ramp, added_load,
-            added_start, added_time, damping, rate, ramp_time, start_time, target, half_buffer, acc, out):
+def advance(n_steps, bodies, mesh, pairs, law, motion, loading, stepping, wrench):
     """Up to ``n_steps`` central-difference steps of the nodes (see :func:`.kernels.advance` for the
-    damping, the loads, the supports, the stop conditions and ``out``; stored energy = strain + springs)."""
+    damping, the loads (per node here), the supports, the stop conditions, ``wrench`` and what it returns;
+    stored energy = strain + springs)."""
+    x, y, vel, acc = motion.x, motion.y, motion.vel, motion.acc
+    driven, inv_mass, node_block = mesh.driven, mesh.inv_mass, mesh.node_block
+    load, added_load = loading.load, loading.added
+    pos0, direction = bodies.pos0, bodies.direction
+    dt, damping = stepping.dt, stepping.damping
     n_node = x.size
     force = np.zeros((n_node, 2))
-    elements, constants = element_constants(triangles, grad_x, grad_y, area0, young, poisson, active_tri)
+    elements, constants = element_constants(mesh.triangles, mesh.grad_x, mesh.grad_y, mesh.area0, mesh.young,
+                                            mesh.poisson, mesh.active_tri)
     driven_nodes = np.flatnonzero(driven)
     steps = 0
-    rebuild = 0
+    rebuild = False
     load_norm = 0.0
     for k in range(n_node):
         load_norm += abs(load[k, 0] + added_load[k, 0]) + abs(load[k, 1] + added_load[k, 1])
-    limit = half_buffer * half_buffer
+    limit = stepping.half_buffer * stepping.half_buffer
     for _ in range(n_steps):
         time = acc[TIME]
-        added_share = smooth_share(time - added_start, added_time)
-        rate_now = settlement_rate(time + 0.5 * dt, rate, ramp_time, start_time)
-        driven_motion(acc[SETTLEMENT], rate_now, x0, y0, node_block, driven_nodes, pos0, direction, x, y, vel)
+        added_share = smooth_share(time - loading.added_start, loading.added_time)
+        rate_now = settlement_rate(time + 0.5 * dt, loading.rate, loading.rate_ramp, loading.start)
+        driven_motion(acc[SETTLEMENT], rate_now, bodies, mesh, driven_nodes, motion)
         cst_element_forces(x, y, elements, constants, force)
-        node_contact_forces(x, y, vel, offs, faces, props, kn, kt, min_half, contact_damping, inv_mass, dt,
-                            shear, bonded, normal, energy, force, acc, True)
-        load_share = 1.0
-        if time < load_ramp:
-            load_share = 0.5 * (1.0 - np.cos(np.pi * time / load_ramp))
+        node_contact_forces(bodies.offs, mesh, pairs, law, motion, force, dt, True)
+        load_share = smooth_share(time, loading.load_ramp)
         # one pass over the nodes: velocity, position, distance since the detection; the force
         # buffer is cleared behind it for the next step
         moved = 0.0
@@ -439,7 +447,7 @@ def advance(n_steps, dt, x, y, vel, x0, y0, x_detect, y_detect, offs, node_block
                 damping_work -= damp * v_new
             x[k] += dt * vel[k, 0]
             y[k] += dt * vel[k, 1]
-            dx, dy = x[k] - x_detect[k], y[k] - y_detect[k]
+            dx, dy = x[k] - motion.x_detect[k], y[k] - motion.y_detect[k]
             moved = max(moved, dx * dx + dy * dy)
         acc[WORK_GRAVITY] += work_gravity * dt
         acc[DISSIPATED_DAMPING] += damping_work * dt
@@ -447,41 +455,36 @@ def advance(n_steps, dt, x, y, vel, x0, y0, x_detect, y_detect, offs, node_block
             acc[WORK_SUPPORT] -= (force[k, 0] * vel[k, 0] + force[k, 1] * vel[k, 1]) * dt
             force[k, 0] = force[k, 1] = 0.0
         acc[SETTLEMENT] += rate_now * dt
-        driven_motion(acc[SETTLEMENT], rate_now, x0, y0, node_block, driven_nodes, pos0, direction, x, y, vel)
+        driven_motion(acc[SETTLEMENT], rate_now, bodies, mesh, driven_nodes, motion)
         for k in driven_nodes:
-            dx, dy = x[k] - x_detect[k], y[k] - y_detect[k]
+            dx, dy = x[k] - motion.x_detect[k], y[k] - motion.y_detect[k]
             moved = max(moved, dx * dx + dy * dy)
         acc[TIME] = time + dt
         steps += 1
         if moved > limit:
-            rebuild = 1
+            rebuild = True
             break
-        if target > 0.0 and acc[SETTLEMENT] >= target:
+        if loading.target > 0.0 and acc[SETTLEMENT] >= loading.target:
             break
     force[:, :] = 0.0
     strain = cst_element_forces(x, y, elements, constants, force)
-    springs = node_contact_forces(x, y, vel, offs, faces, props, kn, kt, min_half, contact_damping, inv_mass,
-                                  dt, shear, bonded, normal, energy, force, acc, False)
+    springs = node_contact_forces(bodies.offs, mesh, pairs, law, motion, force, dt, False)
     kinetic = 0.0
     unbalanced = 0.0
-    out[OUT_SCALARS:] = 0.0
+    wrench[:, :] = 0.0
     for k in range(n_node):
         if driven[k]:  # the wall's force on the support block, and its moment about the block's centroid
             b = node_block[k]
             cx = pos0[b, 0] + acc[SETTLEMENT] * direction[b, 0]
             cy = pos0[b, 1] + acc[SETTLEMENT] * direction[b, 1]
-            out[OUT_SCALARS + 3 * b] += force[k, 0]
-            out[OUT_SCALARS + 3 * b + 1] += force[k, 1]
-            out[OUT_SCALARS + 3 * b + 2] += (x[k] - cx) * force[k, 1] - (y[k] - cy) * force[k, 0]
+            wrench[b, 0] += force[k, 0]
+            wrench[b, 1] += force[k, 1]
+            wrench[b, 2] += (x[k] - cx) * force[k, 1] - (y[k] - cy) * force[k, 0]
         if not driven[k]:
-            kinetic += 0.5 * mass[k] * (vel[k, 0] * vel[k, 0] + vel[k, 1] * vel[k, 1])
+            kinetic += 0.5 * mesh.mass[k] * (vel[k, 0] * vel[k, 0] + vel[k, 1] * vel[k, 1])
             unbalanced += (abs(force[k, 0] + load[k, 0] + added_load[k, 0])
                            + abs(force[k, 1] + load[k, 1] + added_load[k, 1]))
-    out[STEPS] = steps
-    out[REBUILD] = rebuild
-    out[KINETIC] = kinetic
-    out[STORED] = strain + springs
-    out[UNBALANCED] = unbalanced / load_norm if load_norm > 0.0 else 0.0
+    return steps, rebuild, kinetic, strain + springs, unbalanced / load_norm if load_norm > 0.0 else 0.0
 
 
 def rigid_fit(mesh: Mesh, x: np.ndarray, y: np.ndarray, n_block: int) -> np.ndarray:

@@ -11,8 +11,9 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from . import deformable, kernels
-from .scene import Scene, face_properties
-from .simulation import Controls, State
+from .controls import Controls
+from .scene import Scene
+from .simulation import State, bodies, contact_law, detect, stepping
 
 
 @dataclass
@@ -43,21 +44,8 @@ class DeformableState(State):
         """Face pairs of the current boundary (the rigid detection with the node positions as the
         block shapes at zero motion); contact history carried from the previous list."""
         n_poly = scene.lx.size
-        zero = np.zeros_like(scene.pos0)
-        faces = kernels.detect_face_pairs(zero, self.x[:n_poly], self.y[:n_poly], scene.offs, scene.driven,
-                                          controls.buffer, controls.max_penetration, controls.min_cos)
-        props, bonded_start = face_properties(scene, faces)
-        shear = np.zeros((faces.shape[0], 2))
-        energy = np.zeros((faces.shape[0], 2))
-        if first:
-            bonded = np.repeat(bonded_start[:, None], 2, axis=1).astype(np.int64)
-        else:
-            bonded = np.zeros((faces.shape[0], 2), dtype=np.int64)
-            self.acc[kernels.RELEASED] += kernels.carry_history(
-                kernels.face_keys(self.faces, n_poly), self.shear, self.bonded, self.energy,
-                kernels.face_keys(faces, n_poly), shear, bonded, energy)
-        self.faces, self.props, self.shear, self.bonded, self.energy = faces, props, shear, bonded, energy
-        self.normal = np.zeros((faces.shape[0], 2))
+        self.pairs = detect(scene, controls, None if first else self, np.zeros_like(scene.pos0),
+                            self.x[:n_poly], self.y[:n_poly])
         self.x_detect, self.y_detect = self.x.copy(), self.y.copy()
 
     def rebuild_pairs(self, scene: Scene, controls: Controls) -> None:
@@ -65,18 +53,15 @@ class DeformableState(State):
         self.rebuilds += 1
 
     def advance_chunk(self, scene: Scene, controls: Controls, n_steps: int, rate: float, target: float,
-                      out: np.ndarray) -> None:
+                      wrench: np.ndarray) -> kernels.Report:
         """One call of :func:`.deformable.advance`, then the rigid fit of the blocks."""
-        m = self.mesh
-        deformable.advance(n_steps, controls.dt, self.x, self.y, self.node_vel, m.x0, m.y0, self.x_detect,
-                           self.y_detect, scene.offs, m.node_block, m.triangles, m.grad_x, m.grad_y, m.area0,
-                           m.young, m.poisson, m.active_tri, m.mass, m.inv_mass, m.driven, scene.pos0,
-                           scene.direction, self.faces, self.props, controls.kn, controls.kt,
-                           controls.min_half, controls.contact_damping, self.shear, self.bonded, self.normal,
-                           self.energy, self.node_load, controls.load_ramp, self.node_added, self.added_start,
-                           self.added_time, controls.damping, rate, controls.ramp_time, self.settlement_start, target,
-                           0.5 * controls.buffer, self.acc, out)
+        motion = deformable.NodeMotion(self.x, self.y, self.node_vel, self.x_detect, self.y_detect, self.acc)
+        loading = self.loading(controls, rate, target)._replace(load=self.node_load, added=self.node_added)
+        report = kernels.Report(*deformable.advance(n_steps, bodies(scene), self.mesh, self.pairs,
+                                                    contact_law(controls), motion, loading, stepping(controls),
+                                                    wrench))
         self.fit_blocks(scene)
+        return report
 
 
 def deformable_controls(mesh: deformable.Mesh, scene: Scene, controls: Controls, dt_safety: float) -> Controls:
@@ -91,10 +76,10 @@ def deformable_controls(mesh: deformable.Mesh, scene: Scene, controls: Controls,
 def initial_state(scene: Scene, controls: Controls, mesh: deformable.Mesh, load: np.ndarray) -> DeformableState:
     state = DeformableState(
         pos=scene.pos0.copy(), vel=np.zeros_like(scene.pos0), pos_detect=scene.pos0.copy(),
-        faces=np.zeros((0, 4), np.int64), props=np.zeros((0, 4)), shear=np.zeros((0, 2)),
-        bonded=np.zeros((0, 2), np.int64), normal=np.zeros((0, 2)), energy=np.zeros((0, 2)),
+        pairs=kernels.Pairs(np.zeros((0, 4), np.int64), np.zeros((0, 4)), np.zeros((0, 2)),
+                            np.zeros((0, 2), np.int64), np.zeros((0, 2)), np.zeros((0, 2)), np.zeros((0, 4))),
         acc=np.zeros(kernels.N_ACC), active=(~scene.driven).astype(np.int64),
-        calm=np.zeros(scene.driven.size, dtype=np.int64), face_force=np.zeros((0, 4)),
+        calm=np.zeros(scene.driven.size, dtype=np.int64),
         mesh=mesh, x=mesh.x0.copy(), y=mesh.y0.copy(), node_vel=np.zeros((mesh.x0.size, 2)))
     state.set_loads(scene, load)
     state.detect(scene, controls, first=True)

@@ -19,6 +19,7 @@ import xarray as xr
 
 import masonryfw as mf
 
+from .controls import make_controls, masonry_height
 from .scene import build_scene
 
 STEP_SECONDS_PER_BLOCK = 0.35e-6  # 1,035 blocks: 0.36 ms a step on one thread (0.29e-6 measured 2026-11-25)
@@ -44,8 +45,6 @@ def threads(options: Mapping[str, Any], blocks: int) -> int:
 
 
 def estimate(model: xr.Dataset, options: Mapping[str, Any]) -> mf.Estimate:
-    from .solver import make_controls, masonry_height
-
     scene = build_scene(model)
     controls = make_controls(scene, options)
     blocks = model.sizes["block"]

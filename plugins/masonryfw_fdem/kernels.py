@@ -26,16 +26,108 @@ detection buffer since the last detection.
 """
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 from numba import njit, prange
 
 # Indices into the scalar state vector ``acc`` (accumulators carried between chunks).
 TIME, SETTLEMENT, WORK_GRAVITY, WORK_SUPPORT, DISSIPATED_DAMPING, DISSIPATED_FRICTION, RELEASED = range(7)
 N_ACC = 7
-# Indices into a chunk's report ``out``: these scalars, then per block the force (x, y) and moment the wall
-# exerts on it if it is a support (0 for the others), OUT_SCALARS + 3 * block + component.
-STEPS, REBUILD, KINETIC, STORED, UNBALANCED = range(5)
-OUT_SCALARS = 5
+
+
+class Bodies(NamedTuple):
+    """The blocks as the kernels see them (fixed for a run): rest positions (block, 3), radius, the
+    polygons (``lx``, ``ly`` about the centroid, ``offs``), masses (block, 3) and their inverses (block,
+    translation; 0 for supports), free components (block, 3), support flags and settlement directions."""
+
+    pos0: np.ndarray
+    radius: np.ndarray
+    lx: np.ndarray
+    ly: np.ndarray
+    offs: np.ndarray
+    mass: np.ndarray
+    inv_mass: np.ndarray
+    free: np.ndarray
+    driven: np.ndarray
+    moving: np.ndarray
+    direction: np.ndarray
+
+
+class Pairs(NamedTuple):
+    """The face pairs (face, 4: block A, its edge, block B, its edge) with their properties (face, 4) and
+    histories: tangential spring force, bond, normal force, spring energy (face, 2 ends) and each pair's
+    forces (face, 4, kept while both blocks sleep)."""
+
+    faces: np.ndarray
+    props: np.ndarray
+    shear: np.ndarray
+    bonded: np.ndarray
+    normal: np.ndarray
+    energy: np.ndarray
+    face_force: np.ndarray
+
+
+class ContactLaw(NamedTuple):
+    """Normal and tangential stiffness per unit length, the shortest contact's half length, the normal
+    dashpot as a share of critical."""
+
+    kn: float
+    kt: float
+    min_half: float
+    damping: float
+
+
+class Motion(NamedTuple):
+    """What the steps change: positions and velocities (block, 3), positions at the last detection,
+    the active (integrated) and calm (slow steps in a row) counters, the accumulators ``acc``."""
+
+    pos: np.ndarray
+    vel: np.ndarray
+    pos_detect: np.ndarray
+    active: np.ndarray
+    calm: np.ndarray
+    acc: np.ndarray
+
+
+class Loading(NamedTuple):
+    """The loads (block or node, components) with the smooth ramp of the first ``load_ramp``, the added
+    load ramped in from ``added_start`` over ``added_time``, and the settlement: ``rate`` ramped in over
+    ``rate_ramp`` from ``start``, up to ``target`` (0: none)."""
+
+    load: np.ndarray
+    load_ramp: float
+    added: np.ndarray
+    added_start: float
+    added_time: float
+    rate: float
+    rate_ramp: float
+    start: float
+    target: float
+
+
+class Stepping(NamedTuple):
+    """The time step, Cundall's local damping, the motion that asks for a new detection, and sleeping:
+    the speed and the number of steps below it that put a block to sleep, the unbalanced share that wakes
+    it."""
+
+    dt: float
+    damping: float
+    half_buffer: float
+    sleep_speed: float
+    sleep_steps: int
+    wake_force: float
+
+
+class Report(NamedTuple):
+    """What a chunk of steps ends with: the steps done, whether the pair list must be rebuilt, the kinetic
+    and stored energy, the unbalanced-force ratio (the support wrenches go to the caller's array)."""
+
+    steps: int
+    rebuild: bool
+    kinetic: float
+    stored: float
+    unbalanced: float
 
 # error_model="numpy": float division by zero gives inf/nan instead of a checked branch (3x faster)
 jit = njit(cache=True, error_model="numpy")
@@ -200,7 +292,7 @@ def carry_history(old_keys, old_shear, old_bonded, old_energy, new_keys, new_she
 
 
 @jit
-def wake_sleepers(pos, vel, vx, vy, offs, faces, kn, min_half, normal, active, driven, calm, wake_speed):
+def wake_sleepers(bodies, pairs, law, motion, vx, vy, wake_speed):
     """Wake every sleeping block with a contact end shared with an active block that moves
     faster than ``wake_speed`` or has lost half its compression (the sleeper's support goes).
 
@@ -209,6 +301,9 @@ def wake_sleepers(pos, vel, vx, vy, offs, faces, kn, min_half, normal, active, d
     those springs would change with its motion, made from nothing (the energy leak of the
     first version: 3.7 % on the small test wall, ~20 % on Facade 3).
     """
+    offs, faces, normal, driven = bodies.offs, pairs.faces, pairs.normal, bodies.driven
+    pos, vel, active, calm = motion.pos, motion.vel, motion.active, motion.calm
+    kn, min_half = law.kn, law.min_half
     for f in range(faces.shape[0]):
         a, ea, b, eb = faces[f, 0], faces[f, 1], faces[f, 2], faces[f, 3]
         if active[a] == active[b]:
@@ -237,10 +332,8 @@ def wake_sleepers(pos, vel, vx, vy, offs, faces, kn, min_half, normal, active, d
 
 
 @pjit
-def contact_forces(pos, vel, vx, vy, offs, faces, props, kn, kt, min_half, contact_damping, inv_mass,
-                   dt, shear, bonded, normal, energy, force, acc, update_history, active, driven, calm,
-                   wake_speed, face_force):
-    """Add the contact forces of every face pair to ``force`` (block, 3).
+def contact_forces(bodies, pairs, law, motion, vx, vy, force, dt, update_history, wake_speed):
+    """Add the contact forces of every face pair to ``force`` (block, 3), the vertices at ``vx``, ``vy``.
 
     Each pair's forces go to ``face_force`` (face, 4) first: the force on B (x, y), its moment on B
     and on A (A gets minus the force), the pairs in parallel with numba's threads; then into
@@ -268,8 +361,12 @@ def contact_forces(pos, vel, vx, vy, offs, faces, props, kn, kt, min_half, conta
     or opening faster than ``wake_speed`` resets both blocks' calm counters: nothing
     touched by a moving block falls asleep.
     """
+    offs, inv_mass = bodies.offs, bodies.inv_mass
+    faces, props, shear, bonded, normal, energy, face_force = pairs
+    pos, vel, active, calm, acc = motion.pos, motion.vel, motion.active, motion.calm, motion.acc
+    kn, kt, min_half, contact_damping = law
     if wake_speed > 0.0:
-        wake_sleepers(pos, vel, vx, vy, offs, faces, kn, min_half, normal, active, driven, calm, wake_speed)
+        wake_sleepers(bodies, pairs, law, motion, vx, vy, wake_speed)
     stored = 0.0
     d_friction = 0.0
     d_damping = 0.0
@@ -375,20 +472,20 @@ def contact_forces(pos, vel, vx, vy, offs, faces, props, kn, kt, min_half, conta
 
 
 @jit
-def unbalanced_beyond(i, force, load, added_load, load_share, added_share, free, radius, share):
+def unbalanced_beyond(i, force, bodies, loading, load_share, added_share, share):
     """Whether block ``i``'s unbalanced force (translation, plus the moment over its radius) exceeds
     ``share`` of its applied load (translation)."""
     unbalanced = 0.0
     applied = 0.0
     for d in range(3):
-        if not free[i, d]:
+        if not bodies.free[i, d]:
             continue
-        load_d = load_share * load[i, d] + added_share * added_load[i, d]
+        load_d = load_share * loading.load[i, d] + added_share * loading.added[i, d]
         if d < 2:
             unbalanced += abs(force[i, d] + load_d)
             applied += abs(load_d)
         else:
-            unbalanced += abs(force[i, d] + load_d) / radius[i]
+            unbalanced += abs(force[i, d] + load_d) / bodies.radius[i]
     return unbalanced > share * applied
 
 
@@ -397,10 +494,7 @@ def settlement_rate(time, rate, ramp_time, start_time):
     """Smooth velocity ramp (half cosine over ``ramp_time``) from ``start_time`` on."""
     if rate == 0.0 or time <= start_time:
         return 0.0
-    tau = time - start_time
-    if tau >= ramp_time:
-        return rate
-    return rate * 0.5 * (1.0 - np.cos(np.pi * tau / ramp_time))
+    return rate * smooth_share(time - start_time, ramp_time)
 
 
 @jit
@@ -414,11 +508,14 @@ def smooth_share(tau, duration):
 
 
 @pjit
-def integrate_velocities(dt, force, vel, mass, free, driven, active, calm, radius, load, added_load, load_share,
-                         added_share, damping, direction, rate_now, sleeping, wake_force):
+def integrate_velocities(bodies, motion, loading, stepping, force, load_share, added_share, rate_now, sleeping):
     """The velocity update of every block (in parallel): driven blocks follow the support's motion, free
     ones the unbalanced force with Cundall's local damping; a sleeper wakes when :func:`unbalanced_beyond`.
     Returns the work of the supports, the work of the loads and the damping's dissipation in the step."""
+    mass, free, driven, direction = bodies.mass, bodies.free, bodies.driven, bodies.direction
+    vel, active, calm = motion.vel, motion.active, motion.calm
+    load, added_load = loading.load, loading.added
+    dt, damping = stepping.dt, stepping.damping
     work_support = 0.0
     work_gravity = 0.0
     damped = 0.0
@@ -430,8 +527,8 @@ def integrate_velocities(dt, force, vel, mass, free, driven, active, calm, radiu
                 vel[i, d] = v
             continue
         if not active[i]:
-            if not sleeping or not unbalanced_beyond(i, force, load, added_load, load_share, added_share, free,
-                                                     radius, wake_force):
+            if not sleeping or not unbalanced_beyond(i, force, bodies, loading, load_share, added_share,
+                                                     stepping.wake_force):
                 continue
             active[i] = 1  # loaded out of its equilibrium: awake from this step on
             calm[i] = 0
@@ -455,10 +552,12 @@ def integrate_velocities(dt, force, vel, mass, free, driven, active, calm, radiu
 
 
 @pjit
-def move_blocks(dt, pos, vel, pos0, mass, driven, active, calm, radius, direction, settlement, sleeping,
-                sleep_speed, sleep_steps):
+def move_blocks(bodies, motion, stepping, settlement, sleeping):
     """The position update of every block (in parallel); a block slow for ``sleep_steps`` steps falls asleep
     and its kinetic energy, returned, is dissipated."""
+    pos0, mass, driven, radius, direction = bodies.pos0, bodies.mass, bodies.driven, bodies.radius, bodies.direction
+    pos, vel, active, calm = motion.pos, motion.vel, motion.active, motion.calm
+    dt, sleep_speed, sleep_steps = stepping.dt, stepping.sleep_speed, stepping.sleep_steps
     dissipated = 0.0
     for i in prange(pos.shape[0]):
         if driven[i]:
@@ -489,17 +588,13 @@ def farthest_move(pos, pos_detect, radius):
 
 
 @jit
-def advance(n_steps, dt, pos, vel, pos0, pos_detect, radius, lx, ly, offs, faces, props, kn, kt,
-            min_half, contact_damping, inv_mass, shear, bonded, normal, energy, mass, free, driven, moving,
-            direction, load, load_ramp, added_load, added_start, added_time, damping, rate, ramp_time,
-            start_time, target, half_buffer, active, calm, sleep_speed, sleep_steps, wake_force, face_force,
-            acc, out):
-    """Up to ``n_steps`` explicit central-difference steps.
+def advance(n_steps, bodies, pairs, law, motion, loading, stepping, wrench):
+    """Up to ``n_steps`` explicit central-difference steps; returns the fields of a :class:`Report`.
 
     Local non-viscous damping (Cundall): each free component of the unbalanced
     force is reduced by ``damping * |F|`` against its velocity. Driven blocks
     (supports) follow ``pos0 + settlement * direction``. The loads grow with a smooth
-    ramp over ``load_ramp`` from time 0 (applied at once if 0); ``added_load`` comes on
+    ramp over ``load_ramp`` from time 0 (applied at once if 0); the added load comes on
     top of them with a smooth ramp from ``added_start`` over ``added_time`` (the steps
     of a load-factor search, :func:`smooth_share`). Stops early when some
     block has moved more than ``half_buffer`` since the last detection (the pair
@@ -511,18 +606,20 @@ def advance(n_steps, dt, pos, vel, pos0, pos_detect, radius, lx, ly, offs, faces
     (see :func:`contact_forces`) or its unbalanced force (translation, and the moment over its
     radius) exceeds ``wake_force`` times its load: a neighbour creeping below the sleep speed
     still loads it more and more, and it must follow. Moving supports are active while they move.
-    ``face_force`` (face, 4): each pair's forces, kept for the frozen pairs of sleepers.
 
-    ``out`` receives (indices above): steps done, rebuild needed (0/1), kinetic energy, stored energy,
-    unbalanced-force ratio, then per block the force and moment (about its centroid) the wall exerts on a
-    support block. Returns nothing; ``acc`` carries the accumulators.
+    ``wrench`` (block, 3) receives the force and moment (about its centroid) the wall exerts on every
+    support block (0 for the others); ``motion.acc`` carries the accumulators.
     """
+    pos, vel, active, acc = motion.pos, motion.vel, motion.active, motion.acc
+    lx, ly, offs, driven, free, mass = bodies.lx, bodies.ly, bodies.offs, bodies.driven, bodies.free, bodies.mass
+    load, added_load = loading.load, loading.added
+    dt = stepping.dt
     n_block = pos.shape[0]
     force = np.zeros((n_block, 3))
     vx = np.empty(lx.size)
     vy = np.empty(lx.size)
     steps = 0
-    rebuild = 0
+    rebuild = False
     load_norm = 0.0
     for i in range(n_block):
         load_norm += abs(load[i, 0] + added_load[i, 0]) + abs(load[i, 1] + added_load[i, 1])
@@ -530,56 +627,45 @@ def advance(n_steps, dt, pos, vel, pos0, pos_detect, radius, lx, ly, offs, faces
         force[:, :] = 0.0
         place_vertices(pos, lx, ly, offs, vx, vy)
         time = acc[TIME]
-        added_share = smooth_share(time - added_start, added_time)
-        rate_now = settlement_rate(time + 0.5 * dt, rate, ramp_time, start_time)
-        sleeping = sleep_speed > 0.0 and rate_now > 0.0
+        added_share = smooth_share(time - loading.added_start, loading.added_time)
+        rate_now = settlement_rate(time + 0.5 * dt, loading.rate, loading.rate_ramp, loading.start)
+        sleeping = stepping.sleep_speed > 0.0 and rate_now > 0.0
         for i in range(n_block):
             if driven[i]:
-                active[i] = 1 if (moving[i] and rate_now != 0.0) else 0
-        stored = contact_forces(pos, vel, vx, vy, offs, faces, props, kn, kt, min_half, contact_damping,
-                                inv_mass, dt, shear, bonded, normal, energy, force, acc, True, active,
-                                driven, calm, sleep_speed if sleeping else 0.0, face_force)
-        load_share = 1.0
-        if time < load_ramp:
-            load_share = 0.5 * (1.0 - np.cos(np.pi * time / load_ramp))
+                active[i] = 1 if (bodies.moving[i] and rate_now != 0.0) else 0
+        contact_forces(bodies, pairs, law, motion, vx, vy, force, dt, True,
+                       stepping.sleep_speed if sleeping else 0.0)
+        load_share = smooth_share(time, loading.load_ramp)
         work_support, work_gravity, damped = integrate_velocities(
-            dt, force, vel, mass, free, driven, active, calm, radius, load, added_load, load_share, added_share,
-            damping, direction, rate_now, sleeping, wake_force)
+            bodies, motion, loading, stepping, force, load_share, added_share, rate_now, sleeping)
         acc[WORK_SUPPORT] += work_support
         acc[WORK_GRAVITY] += work_gravity
         acc[DISSIPATED_DAMPING] += damped
         acc[SETTLEMENT] += rate_now * dt
-        acc[DISSIPATED_DAMPING] += move_blocks(dt, pos, vel, pos0, mass, driven, active, calm, radius, direction,
-                                               acc[SETTLEMENT], sleeping, sleep_speed, sleep_steps)
+        acc[DISSIPATED_DAMPING] += move_blocks(bodies, motion, stepping, acc[SETTLEMENT], sleeping)
         acc[TIME] = time + dt
         steps += 1
-        if farthest_move(pos, pos_detect, radius) > half_buffer:
-            rebuild = 1
+        if farthest_move(pos, motion.pos_detect, bodies.radius) > stepping.half_buffer:
+            rebuild = True
             break
-        if target > 0.0 and acc[SETTLEMENT] >= target:
+        if loading.target > 0.0 and acc[SETTLEMENT] >= loading.target:
             break
     # state at the end of the chunk (forces at the current positions, history untouched)
     force[:, :] = 0.0
     place_vertices(pos, lx, ly, offs, vx, vy)
-    stored = contact_forces(pos, vel, vx, vy, offs, faces, props, kn, kt, min_half, contact_damping,
-                            inv_mass, dt, shear, bonded, normal, energy, force, acc, False, active,
-                            driven, calm, 0.0, face_force)
+    stored = contact_forces(bodies, pairs, law, motion, vx, vy, force, dt, False, 0.0)
     kinetic = 0.0
     unbalanced = 0.0
     for i in range(n_block):
         for d in range(3):
-            out[OUT_SCALARS + 3 * i + d] = force[i, d] if driven[i] else 0.0
+            wrench[i, d] = force[i, d] if driven[i] else 0.0
         if not driven[i]:
             for d in range(3):
                 if free[i, d]:
                     kinetic += 0.5 * mass[i, d] * vel[i, d] * vel[i, d]
                     if d < 2:
                         unbalanced += abs(force[i, d] + load[i, d] + added_load[i, d])
-    out[STEPS] = steps
-    out[REBUILD] = rebuild
-    out[KINETIC] = kinetic
-    out[STORED] = stored
-    out[UNBALANCED] = unbalanced / load_norm if load_norm > 0.0 else 0.0
+    return steps, rebuild, kinetic, stored, unbalanced / load_norm if load_norm > 0.0 else 0.0
 
 
 @jit

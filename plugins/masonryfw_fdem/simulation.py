@@ -27,6 +27,7 @@ import numpy as np
 import masonryfw as mf
 
 from . import kernels
+from .controls import Controls
 from .scene import Scene, face_properties
 
 LOG = logging.getLogger("masonryfw.fdem")
@@ -35,43 +36,6 @@ GRAVITY_PHASE, SETTLEMENT_PHASE, SEARCH_PHASE = 0, 1, 2
 # the whole wall falling a thousand times its own size. Beyond it the integration has blown up.
 UNSTABLE_KINETIC_ENERGY = 1e3
 GRAVITY_TIME_LIMIT = 20.0  # scaled time units (sqrt(length / g)) for the gravity phase to come to rest
-
-
-@dataclass(frozen=True)
-class Controls:
-    """Non-dimensional run parameters (resolved from the options by the solver)."""
-
-    kn: float  # normal stiffness per unit contact length
-    kt: float
-    min_half: float  # half the shortest overlap that is a contact
-    contact_damping: float
-    dt: float
-    dt_critical: float
-    damping: float
-    target: float  # settlement to reach (0: no settlement phase)
-    rate: float  # settlement velocity
-    ramp_time: float
-    load_ramp: float  # duration of the smooth load ramp at the start
-    gravity_time: float  # fixed duration of the gravity phase, 0: until at rest
-    rest_tolerance: float
-    max_steps: int
-    record_steps: int
-    buffer: float
-    max_penetration: float
-    min_cos: float
-    sleep_speed: float  # 0: no sleeping
-    sleep_steps: int
-    wake_force: float
-    plateau_tolerance: float
-    plateau_window: float
-    snapshots: tuple[float, ...]
-    search: bool = False  # the load-factor search instead of a settlement
-    search_first: float = 0.1
-    search_limit: float = 10.0
-    search_tolerance: float = 1e-3
-    search_step_time: float = 1.0  # ramp to a trial multiplier
-    search_trial_time: float = 20.0  # longest hold of one trial
-    collapse_motion: float = 0.0  # block motion (centroid + rotation x radius) that makes a trial unstable
 
 
 @dataclass(frozen=True)
@@ -101,13 +65,13 @@ class History:
     COLUMNS = ("phase", "time", "settlement", "reaction", "kinetic", "stored", "work_gravity",
                "work_support", "dissipated_damping", "dissipated_friction", "released", "unbalanced", "load_factor")
 
-    def add(self, phase: int, state: State, out: np.ndarray, load_factor: float = 0.0) -> None:
+    def add(self, phase: int, state: State, chunk: Chunk, load_factor: float = 0.0) -> None:
         acc = state.acc
-        wrench = out[kernels.OUT_SCALARS:].reshape(-1, 3)  # the wall's action on each support
+        wrench = chunk.wrench  # the wall's action on each support
         row = (phase, acc[kernels.TIME], acc[kernels.SETTLEMENT], float((wrench * self.weights).sum()),
-               out[kernels.KINETIC], out[kernels.STORED], acc[kernels.WORK_GRAVITY], acc[kernels.WORK_SUPPORT],
+               chunk.report.kinetic, chunk.report.stored, acc[kernels.WORK_GRAVITY], acc[kernels.WORK_SUPPORT],
                acc[kernels.DISSIPATED_DAMPING], acc[kernels.DISSIPATED_FRICTION], acc[kernels.RELEASED],
-               out[kernels.UNBALANCED], load_factor)
+               chunk.report.unbalanced, load_factor)
         cracks = self.opening(state.pos) if self.opening is not None else None
         self.records.append(Record(row, -wrench[:, 1], cracks))
 
@@ -116,21 +80,24 @@ class History:
         return {name: data[:, i] for i, name in enumerate(self.COLUMNS)}
 
 
+@dataclass(frozen=True)
+class Chunk:
+    """The end of a run of steps: the last kernel call's :class:`.kernels.Report` and the wall's force and
+    moment on every support (block, 3; 0 for the other blocks)."""
+
+    report: kernels.Report
+    wrench: np.ndarray
+
+
 @dataclass
 class State:
     pos: np.ndarray
     vel: np.ndarray
     pos_detect: np.ndarray
-    faces: np.ndarray
-    props: np.ndarray
-    shear: np.ndarray
-    bonded: np.ndarray
-    normal: np.ndarray
-    energy: np.ndarray
+    pairs: kernels.Pairs  # the face pairs and their contact histories
     acc: np.ndarray
     active: np.ndarray  # (block,) 1 while integrated (free blocks not asleep)
     calm: np.ndarray  # (block,) consecutive slow steps
-    face_force: np.ndarray  # (face, 4) each pair's forces (kernels.contact_forces), frozen while both sleep
     steps: int = 0
     rebuilds: int = 0
     gravity_steps: int = 0
@@ -152,11 +119,55 @@ class State:
         self.added = np.zeros_like(load) if added is None else added
         self.added_start, self.added_time = start, duration
 
+    def loading(self, controls: Controls, rate: float, target: float) -> kernels.Loading:
+        """The loads and the settlement of the next steps, as the kernels take them."""
+        return kernels.Loading(self.load, float(controls.load_ramp), self.added, float(self.added_start),
+                               float(self.added_time), float(rate), float(controls.ramp_time),
+                               float(self.settlement_start), float(target))
 
-def detect(scene: Scene, controls: Controls, state: State | None, pos: np.ndarray):
-    """Face pairs at ``pos`` with their properties; contact history carried from ``state``
-    (the spring energy of pairs the rebuild drops is added to the released energy)."""
-    faces = kernels.detect_face_pairs(pos, scene.lx, scene.ly, scene.offs, scene.driven,
+    def advance_chunk(self, scene: Scene, controls: Controls, n_steps: int, rate: float, target: float,
+                      wrench: np.ndarray) -> kernels.Report:
+        """One call of the rigid stepping kernel (:func:`.kernels.advance`)."""
+        motion = kernels.Motion(self.pos, self.vel, self.pos_detect, self.active, self.calm, self.acc)
+        return kernels.Report(*kernels.advance(n_steps, bodies(scene), self.pairs, contact_law(controls), motion,
+                                               self.loading(controls, rate, target), stepping(controls), wrench))
+
+    def rebuild_pairs(self, scene: Scene, controls: Controls) -> None:
+        """New face pairs at the current positions; every free block wakes (the new pairs have no frozen
+        forces)."""
+        self.pairs = detect(scene, controls, self, self.pos)
+        self.active[~scene.driven] = 1
+        self.calm[:] = 0
+        self.pos_detect = self.pos.copy()
+        self.rebuilds += 1
+
+
+def contact_law(controls: Controls) -> kernels.ContactLaw:
+    """The contact constants as the kernels take them."""
+    return kernels.ContactLaw(float(controls.kn), float(controls.kt), float(controls.min_half),
+                              float(controls.contact_damping))
+
+
+def stepping(controls: Controls) -> kernels.Stepping:
+    """The time step, damping and sleeping constants as the kernels take them."""
+    return kernels.Stepping(float(controls.dt), float(controls.damping), 0.5 * float(controls.buffer),
+                            float(controls.sleep_speed), int(controls.sleep_steps), float(controls.wake_force))
+
+
+def bodies(scene: Scene) -> kernels.Bodies:
+    """The scene's blocks as the kernels take them."""
+    return kernels.Bodies(scene.pos0, scene.radius, scene.lx, scene.ly, scene.offs, scene.mass, scene.inv_mass,
+                          scene.free, scene.driven, scene.moving, scene.direction)
+
+
+def detect(scene: Scene, controls: Controls, state: State | None, pos: np.ndarray,
+           lx: np.ndarray | None = None, ly: np.ndarray | None = None) -> kernels.Pairs:
+    """Face pairs at ``pos`` (the blocks' shapes ``lx``, ``ly``, default the scene's) with their properties;
+    contact history carried from ``state`` (the spring energy of pairs the rebuild drops is added to the
+    released energy)."""
+    lx = scene.lx if lx is None else lx
+    ly = scene.ly if ly is None else ly
+    faces = kernels.detect_face_pairs(pos, lx, ly, scene.offs, scene.driven,
                                       controls.buffer, controls.max_penetration, controls.min_cos)
     props, bonded_start = face_properties(scene, faces)
     shear = np.zeros((faces.shape[0], 2))
@@ -166,71 +177,39 @@ def detect(scene: Scene, controls: Controls, state: State | None, pos: np.ndarra
     else:
         bonded = np.zeros((faces.shape[0], 2), dtype=np.int64)
         n_node = scene.lx.size
+        old = state.pairs
         state.acc[kernels.RELEASED] += kernels.carry_history(
-            kernels.face_keys(state.faces, n_node), state.shear, state.bonded, state.energy,
+            kernels.face_keys(old.faces, n_node), old.shear, old.bonded, old.energy,
             kernels.face_keys(faces, n_node), shear, bonded, energy)
-    return faces, props, shear, bonded, energy
+    return kernels.Pairs(faces, props, shear, bonded, np.zeros((faces.shape[0], 2)), energy,
+                         np.zeros((faces.shape[0], 4)))
 
 
 def initial_state(scene: Scene, controls: Controls) -> State:
     pos = scene.pos0.copy()
-    faces, props, shear, bonded, energy = detect(scene, controls, None, pos)
-    return State(pos=pos, vel=np.zeros_like(pos), pos_detect=pos.copy(), faces=faces, props=props,
-                 shear=shear, bonded=bonded, normal=np.zeros((faces.shape[0], 2)), energy=energy,
+    return State(pos=pos, vel=np.zeros_like(pos), pos_detect=pos.copy(), pairs=detect(scene, controls, None, pos),
                  acc=np.zeros(kernels.N_ACC), active=(~scene.driven).astype(np.int64),
-                 calm=np.zeros(scene.driven.size, dtype=np.int64), face_force=np.zeros((faces.shape[0], 4)))
+                 calm=np.zeros(scene.driven.size, dtype=np.int64))
 
 
-def rebuild(scene: Scene, controls: Controls, state: State) -> None:
-    """New face pairs at the current positions; every free block wakes (the new pairs have no frozen forces)."""
-    state.faces, state.props, state.shear, state.bonded, state.energy = detect(scene, controls, state, state.pos)
-    state.normal = np.zeros((state.faces.shape[0], 2))
-    state.face_force = np.zeros((state.faces.shape[0], 4))
-    state.active[~scene.driven] = 1
-    state.calm[:] = 0
-    state.pos_detect = state.pos.copy()
-    state.rebuilds += 1
-
-
-def advance(scene: Scene, controls: Controls, state: State, n_steps: int, rate: float,
-            target: float, out: np.ndarray) -> None:
-    """One call of the numba stepping kernel (see :func:`.kernels.advance`)."""
-    kernels.advance(n_steps, controls.dt, state.pos, state.vel, scene.pos0, state.pos_detect, scene.radius,
-                    scene.lx, scene.ly, scene.offs, state.faces, state.props, controls.kn, controls.kt,
-                    controls.min_half, controls.contact_damping, scene.inv_mass, state.shear, state.bonded, state.normal,
-                    state.energy, scene.mass, scene.free, scene.driven, scene.moving, scene.direction, state.load,
-                    controls.load_ramp, state.added, state.added_start, state.added_time, controls.damping, rate,
-                    controls.ramp_time, state.settlement_start, target, 0.5 * controls.buffer, state.active,
-                    state.calm, controls.sleep_speed, controls.sleep_steps, controls.wake_force, state.face_force,
-                    state.acc, out)
-
-
-def chunk(scene: Scene, controls: Controls, state: State, n_steps: int, rate: float, target: float) -> np.ndarray:
-    """Run up to ``n_steps`` steps (rebuilding the pair list as needed); returns the kernel's ``out``."""
-    out = np.zeros(kernels.OUT_SCALARS + 3 * scene.driven.size)
+def chunk(scene: Scene, controls: Controls, state: State, n_steps: int, rate: float, target: float) -> Chunk:
+    """Run up to ``n_steps`` steps (rebuilding the pair list as needed); returns the last kernel call's end."""
+    wrench = np.zeros((scene.driven.size, 3))
     left = n_steps
     while True:
-        nodal = hasattr(state, "advance_chunk")  # deformable mode: the state steps its own nodes
-        if nodal:
-            state.advance_chunk(scene, controls, left, rate, target, out)
-        else:
-            advance(scene, controls, state, left, rate, target, out)
-        if not out[kernels.KINETIC] < UNSTABLE_KINETIC_ENERGY:  # also catches nan
+        report = state.advance_chunk(scene, controls, left, rate, target, wrench)
+        if not report.kinetic < UNSTABLE_KINETIC_ENERGY:  # also catches nan
             raise mf.SolveError(
-                f"fdem: the time integration blew up (kinetic energy {out[kernels.KINETIC]:.3g} W x length after "
+                f"fdem: the time integration blew up (kinetic energy {report.kinetic:.3g} W x length after "
                 f"{state.steps} steps, dt = {controls.dt:.3g} = {controls.dt / controls.dt_critical:.2f} dt_crit "
                 "in scaled units); lower the option dt_safety"
             )
-        done = int(out[kernels.STEPS])
-        state.steps += done
-        left -= done
-        if out[kernels.REBUILD]:
-            if nodal:
-                state.rebuild_pairs(scene, controls)
-            else:
-                rebuild(scene, controls, state)
-        if not out[kernels.REBUILD] or left <= 0 or (target > 0 and state.acc[kernels.SETTLEMENT] >= target):
-            return out
+        state.steps += report.steps
+        left -= report.steps
+        if report.rebuild:
+            state.rebuild_pairs(scene, controls)
+        if not report.rebuild or left <= 0 or (target > 0 and state.acc[kernels.SETTLEMENT] >= target):
+            return Chunk(report, wrench)
 
 
 def gravity_phase(scene, controls, state, history, progress) -> None:
@@ -247,11 +226,11 @@ def gravity_phase(scene, controls, state, history, progress) -> None:
         state.gravity_steps += state.steps - before
         history.add(GRAVITY_PHASE, state, out)
         ramped = state.acc[kernels.TIME] >= controls.load_ramp
-        if controls.gravity_time <= 0 and ramped and out[kernels.UNBALANCED] < controls.rest_tolerance:
+        if controls.gravity_time <= 0 and ramped and out.report.unbalanced < controls.rest_tolerance:
             state.stop_reason = "at rest"
             break
         progress(0.05 * min(1.0, state.gravity_steps / max(total, 1)),
-                 f"fdem: gravity, unbalanced force ratio {out[kernels.UNBALANCED]:.2e}")
+                 f"fdem: gravity, unbalanced force ratio {out.report.unbalanced:.2e}")
     else:
         if controls.gravity_time <= 0:
             raise mf.SolveError(
@@ -328,7 +307,7 @@ def hold(scene: Scene, controls: Controls, state: State, reference: np.ndarray, 
         if motion > controls.collapse_motion:
             return False, motion
         now = state.acc[kernels.TIME]
-        if now >= ramp_end and out[kernels.UNBALANCED] < controls.rest_tolerance:
+        if now >= ramp_end and out.report.unbalanced < controls.rest_tolerance:
             return True, motion
         if now >= limit or state.steps >= controls.max_steps:
             return False, motion

@@ -16,108 +16,12 @@ import xarray as xr
 import masonryfw as mf
 
 from . import estimate, postprocess
+from .controls import make_controls
 from .scene import Scene, build_scene
-from .simulation import Controls, History, State, initial_state, run
+from .simulation import History, State, initial_state, run
 
 LOG = logging.getLogger("masonryfw.fdem")
 #: Load-factor search (scaled time, sqrt(length / g)): the ramp to a trial multiplier, the longest hold.
-SEARCH_STEP_TIME = 1.0
-SEARCH_TRIAL_TIME = 20.0
-
-
-def critical_time_step(scene: Scene, kn: float) -> float:
-    """2 / omega_max, omega^2 bounded per free block by the stiffness of springs all round
-    its perimeter: kn P / m in translation, kn P R^2 / I in rotation."""
-    free = ~scene.driven
-    translation = kn * scene.perimeter[free] / scene.mass[free, 0]
-    rotation = kn * scene.perimeter[free] * scene.radius[free] ** 2 / scene.mass[free, 2]
-    omega = np.sqrt(max(translation.max(initial=0.0), rotation.max(initial=0.0)))
-    return 2.0 / omega if omega > 0 else np.inf
-
-
-def masonry_height(scene: Scene) -> float:
-    """Height of the masonry (non-dimensional): top of the highest minus bottom of the lowest free block."""
-    y = scene.pos0[:, 1][np.repeat(np.arange(scene.driven.size), np.diff(scene.offs))] + scene.ly
-    free_nodes = ~np.repeat(scene.driven, np.diff(scene.offs))
-    return float(np.ptp(y[free_nodes]))
-
-
-#: The reaction plateau that stops a run when the target is not the model's own (share of the dead reaction).
-PLATEAU_TOLERANCE = 0.005
-
-
-def target_settlement(scene: Scene, options: Mapping[str, Any]) -> float:
-    """The settlement a run goes to [m]: the option, else the model's settlement_target, else a share of the
-    masonry height."""
-    if options["settlement"] is not None:
-        return options["settlement"]
-    if "settlement_target" in scene.model:
-        return float(scene.model.settlement_target.values)
-    return options["settlement_ratio"] * masonry_height(scene) * scene.scales.length
-
-
-def plateau_tolerance(scene: Scene, options: Mapping[str, Any]) -> float:
-    """The option, else none when the run goes to the model's settlement_target (the damage there is the
-    answer), else :data:`PLATEAU_TOLERANCE`."""
-    if options["plateau_tolerance"] is not None:
-        return options["plateau_tolerance"]
-    return 0.0 if options["settlement"] is None and "settlement_target" in scene.model else PLATEAU_TOLERANCE
-
-
-def make_controls(scene: Scene, options: Mapping[str, Any]) -> Controls:
-    length, force = scene.scales.length, scene.scales.force
-    if options["contact_stiffness"] is not None:
-        kn = options["contact_stiffness"] * length**2 / force
-    else:
-        base_pressure = 1.0 / scene.support_length
-        kn = base_pressure / (options["penetration_ratio"] * scene.unit_height)
-    dt_critical = critical_time_step(scene, kn)
-    dt = options["dt_safety"] * dt_critical
-    height = masonry_height(scene)
-    target = target_settlement(scene, options) / length
-    rate = options["loading_rate"] * np.sqrt(height)
-    target_time = target / rate if rate > 0 else 0.0
-    record_steps = max(1, int(target_time / dt / options["records"])) if target > 0 else 2000
-    return Controls(
-        kn=kn,
-        kt=options["shear_stiffness_ratio"] * kn,
-        min_half=0.5 * options["min_contact_length"] * scene.unit_height,
-        contact_damping=options["contact_damping"],
-        dt=dt,
-        dt_critical=dt_critical,
-        damping=options["damping"],
-        target=target,
-        rate=rate,
-        ramp_time=max(options["ramp_fraction"] * target_time, dt),
-        load_ramp=options["load_ramp"] / scene.scales.time,
-        gravity_time=(options["gravity_time"] or 0.0) / scene.scales.time,
-        rest_tolerance=options["rest_tolerance"],
-        max_steps=options["max_steps"],
-        record_steps=record_steps,
-        buffer=options["buffer_ratio"] * scene.unit_height,
-        max_penetration=0.25 * scene.unit_height,
-        min_cos=float(np.cos(np.radians(options["max_contact_angle"]))),
-        sleep_speed=options["sleep"] * rate,
-        sleep_steps=options["sleep_steps"],
-        wake_force=options["wake_force"],
-        plateau_tolerance=plateau_tolerance(scene, options),
-        plateau_window=options["plateau_window"],
-        snapshots=tuple(v / length for v in options["snapshots"]),
-        search=searches(scene, options),
-        search_first=options["search_first"],
-        search_limit=options["search_limit"],
-        search_tolerance=options["search_tolerance"],
-        search_step_time=SEARCH_STEP_TIME,
-        search_trial_time=SEARCH_TRIAL_TIME,
-        collapse_motion=options["collapse_motion"] * scene.unit_height,
-    )
-
-
-def searches(scene: Scene, options: Mapping[str, Any]) -> bool:
-    """The load-factor search runs when load_factor is auto, no support moves and the masonry has a live load."""
-    return options["load_factor"] is None and not scene.moving.any() and bool(np.any(scene.live != 0))
-
-
 def solve(model: xr.Dataset, options: Mapping[str, Any], progress=mf.no_progress) -> xr.Dataset:
     """Settlement response of ``model``: gravity to rest, then the support moves down slowly.
 
@@ -172,7 +76,7 @@ def _solve(model: xr.Dataset, options: Mapping[str, Any], progress) -> xr.Datase
         fdem_steps=int(state.steps),
         fdem_gravity_steps=int(state.gravity_steps),
         fdem_rebuilds=int(state.rebuilds),
-        fdem_face_pairs=int(state.faces.shape[0]),
+        fdem_face_pairs=int(state.pairs.faces.shape[0]),
         fdem_asleep_blocks=int((~scene.driven & (state.active == 0)).sum()),
         fdem_target_settlement=controls.target * scene.scales.length,
     )
@@ -245,7 +149,8 @@ def history_variables(scene: Scene, history: History) -> dict:
 
 def result_dataset(scene: Scene, state: State, history: History) -> xr.Dataset:
     """The primary result variables: final displacements (finite rotations), contact forces, history."""
-    normal, shear = postprocess.interface_forces(scene, state.faces, state.props, state.normal, state.shear, state.pos)
+    normal, shear = postprocess.interface_forces(scene, state.pairs.faces, state.pairs.props, state.pairs.normal,
+                                                 state.pairs.shear, state.pos)
     ie = ("interface", "end")
     data = {
         **mf.motion_variables(postprocess.block_displacement(scene, state.pos)),

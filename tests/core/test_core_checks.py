@@ -390,7 +390,7 @@ def test_moving_support_with_zero_settlement_direction():
 
 
 def test_settlement_direction_length_is_the_rate():
-    """Issue 14: a moving support's direction need not be a unit vector (its length is its rate)."""
+    """A moving support's direction need not be a unit vector (its length is its rate)."""
     ds = model_dataset()
     ds["settlement_direction"].values[3] = (0.0, -0.5, 0.0)
     assert [p for p in check(ds) if p.where == "block 3"] == []

@@ -18,7 +18,7 @@ import xarray as xr
 from click.testing import CliRunner
 
 import masonryfw as mf
-from masonryfw import plugins
+from masonryfw import registry
 from masonryfw.cli import cli
 
 
@@ -51,18 +51,18 @@ class ToolsPlugin:
 @pytest.fixture
 def tools():
     """The real plugins plus :class:`ToolsPlugin`."""
-    plugins.reset()
+    registry.reset()
     mf.plugin_manager().register(ToolsPlugin(), name="tools")
     yield
-    plugins.reset()
+    registry.reset()
 
 
 @pytest.fixture
 def no_plugins(monkeypatch):
-    monkeypatch.setattr(plugins, "entry_points", lambda group: [])
-    plugins.reset()
+    monkeypatch.setattr(registry, "entry_points", lambda group: [])
+    registry.reset()
     yield
-    plugins.reset()
+    registry.reset()
 
 
 @pytest.fixture

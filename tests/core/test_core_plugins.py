@@ -23,7 +23,7 @@ import xarray as xr
 from click.testing import CliRunner
 
 import masonryfw as mf
-from masonryfw import plugins
+from masonryfw import registry
 from masonryfw.cli import cli, main
 from masonryfw.errors import ModelError, PluginError, SolveError
 
@@ -77,18 +77,18 @@ def returning_solver(produced):
 @pytest.fixture
 def manager():
     """The real plugin manager (entry points loaded afresh), reset afterwards."""
-    plugins.reset()
+    registry.reset()
     yield mf.plugin_manager()
-    plugins.reset()
+    registry.reset()
 
 
 @pytest.fixture
 def empty_manager(monkeypatch):
     """A plugin manager that sees no entry point at all."""
-    monkeypatch.setattr(plugins, "entry_points", lambda group: [])
-    plugins.reset()
+    monkeypatch.setattr(registry, "entry_points", lambda group: [])
+    registry.reset()
     yield mf.plugin_manager()
-    plugins.reset()
+    registry.reset()
 
 
 # ---------------------------------------------------------------- loading and lookup
@@ -96,14 +96,14 @@ def empty_manager(monkeypatch):
 def test_builtin_plugins_come_from_the_entry_point_group():
     """Exactly the entry points load (the ones that cannot are warnings); the example is one of them."""
     declared = {ep.name for ep in entry_points(group="masonryfw")}
-    plugins.reset()
+    registry.reset()
     try:
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
             manager = mf.plugin_manager()
         failed = {re.match(r"masonryfw plugin '([^']+)'", str(w.message)).group(1) for w in caught
-                  if issubclass(w.category, plugins.PluginLoadWarning)}
-        info = {p.name: p for p in plugins.installed_plugins()}
+                  if issubclass(w.category, registry.PluginLoadWarning)}
+        info = {p.name: p for p in registry.installed_plugins()}
         assert set(info) == declared - failed and "example" not in failed
         assert info["example"].distribution == "masonryfw"
         assert info["example"].version == dist_version("masonryfw")
@@ -111,20 +111,20 @@ def test_builtin_plugins_come_from_the_entry_point_group():
         assert mf.get_solver("statics").solve is info["example"].solvers[0].solve
         assert mf.plugin_manager() is manager  # cached
     finally:
-        plugins.reset()
+        registry.reset()
 
 
 def test_a_plugin_that_fails_to_import_is_a_warning_and_the_others_load(monkeypatch):
     example = next(ep for ep in entry_points(group="masonryfw") if ep.name == "example")
     ghost = EntryPoint("ghost", "no_such_module_for_masonryfw", "masonryfw")
-    monkeypatch.setattr(plugins, "entry_points", lambda group: [ghost, example])
-    plugins.reset()
+    monkeypatch.setattr(registry, "entry_points", lambda group: [ghost, example])
+    registry.reset()
     try:
-        with pytest.warns(plugins.PluginLoadWarning, match=r"'ghost'.*no_such_module_for_masonryfw.*ModuleNotFoundError"):
+        with pytest.warns(registry.PluginLoadWarning, match=r"'ghost'.*no_such_module_for_masonryfw.*ModuleNotFoundError"):
             mf.plugin_manager()
         assert mf.get_solver("statics").name == "statics"
     finally:
-        plugins.reset()
+        registry.reset()
 
 
 def test_a_hook_that_raises_is_a_warning(empty_manager):
@@ -135,7 +135,7 @@ def test_a_hook_that_raises_is_a_warning(empty_manager):
 
     empty_manager.register(Raising(), name="raising")
     empty_manager.register(ToyPlugin([CONSTANT]), name="toy")
-    with pytest.warns(plugins.PluginLoadWarning, match=r"'raising'.*RuntimeError: cannot list"):
+    with pytest.warns(registry.PluginLoadWarning, match=r"'raising'.*RuntimeError: cannot list"):
         assert mf.get_solver("constant") is CONSTANT
 
 
@@ -320,7 +320,7 @@ def test_render_draws_with_the_plotter(empty_manager, model):
             ax.plot(ds.node_x.values, ds.node_y.values, options["style"])
 
     empty_manager.register(ToyPlugin(plotters=[mf.Plotter("nodes", "", outline, "1", (mf.Option("style", str, "k."),))]), name="toy")
-    figure = plugins.render([model], None, {"style": "r+"})
+    figure = mf.render([model], None, {"style": "r+"})
     (line,) = figure.axes[0].lines
     np.testing.assert_array_equal(line.get_xdata(), model.node_x.values)
     assert line.get_marker() == "+"
@@ -395,12 +395,12 @@ def installed(site, monkeypatch):
     def install(*names):
         for name in names:
             monkeypatch.syspath_prepend(str(site[name]))
-        plugins.reset()
+        registry.reset()
 
     yield install
     for module in ("thirdparty_mf", "dup_mf", "broken_mf"):
         sys.modules.pop(module, None)
-    plugins.reset()
+    registry.reset()
 
 
 def test_thirdparty_solver_runs_from_the_command_line(site, tmp_path):

@@ -116,6 +116,7 @@ def test_the_tour_ends_with_a_report_and_its_last_step_runs_as_written(tmp_path)
     assert (tmp_path / "history.csv").read_text().startswith("result,record,stage,settlement_m,reaction_N")
 
 
+@pytest.mark.slow  # 17 s; the tunnel keys and stages are tested by default in test_core_tunnels.py
 def test_the_tunnel_step_of_the_tour_runs_as_written(tmp_path):
     """Step 1d: fdem runs the bundled facade to its trough's S_max (15 mm: V_L 1 %, D 6 m, z0 15 m, K 0.5) and
     prints the three stages; the ltsm chart is drawn; la assesses stages 1 and 2 at S_max."""
@@ -136,6 +137,7 @@ def test_the_tunnel_step_of_the_tour_runs_as_written(tmp_path):
     assert (tmp_path / "ltsm.png").stat().st_size > 20_000
 
 
+@pytest.mark.slow  # 20 s; the diagnose command is tested by default in tests/plugins/diagnose
 def test_the_diagnosis_step_of_the_tour_runs_as_written(tmp_path):
     """Step 1e: the bundled survey (drawn from fdem's run of facade-1 settling under x = 1.2 .. 1.5 m, stopped at
     6.65 mm: datasets/surveys/README.md) points back to that step, and its levelling to that settlement."""

@@ -119,11 +119,12 @@ def test_states_by_hand():
 
 
 def test_crack_indicator_is_relative_to_the_largest_masonry_joint():
-    motion = np.array([2.0, 1.0, 0.03, 0.019, 5.0])
+    motion = np.array([2.0, 1.0, 0.3, 0.19, 5.0])
     masonry = np.array([True, True, True, True, False])  # the last is ground against ground
     indicator = mf.crack_indicator(motion, masonry)
-    assert indicator.tolist() == pytest.approx([1.0, 0.5, 0.015, 0.0, 0.0])  # 0.019 / 2 is below 1 %
-    assert mf.INTACT_SHARE == 0.01
+    assert indicator.tolist() == pytest.approx([1.0, 0.5, 0.15, 0.0, 0.0])  # 0.19 / 2 is below a tenth
+    assert mf.CRACK_THRESHOLD == 0.1
+    assert mf.crack_indicator(motion, masonry, 0.05).tolist() == pytest.approx([1.0, 0.5, 0.15, 0.095, 0.0])
 
 
 def segment_distances(model, x, y):
@@ -221,15 +222,15 @@ class Plugin:
 
 @pytest.fixture
 def registered(monkeypatch):
-    from masonryfw import plugins
+    from masonryfw import registry
 
-    plugins.reset()
+    registry.reset()
     manager = mf.plugin_manager()
 
     def register(solve, name="tipping"):
         manager.register(Plugin(mf.Solver(name, "hand mechanism", solve)), name=name)
     yield register
-    plugins.reset()
+    registry.reset()
 
 
 def test_a_third_party_mechanism_gets_the_core_s_fields(registered):

@@ -1,4 +1,4 @@
-"""Settlement profiles and damage (issue 14): the spec keys, the supports they make, the damage scale."""
+"""Settlement profiles and damage: the spec keys, the supports they make, the damage scale."""
 from __future__ import annotations
 
 import math

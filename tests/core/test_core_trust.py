@@ -121,7 +121,6 @@ def test_plugins_say_that_sweep_needs_dask(monkeypatch):
 
     real = importlib.util.find_spec
     monkeypatch.setattr(importlib.util, "find_spec", lambda name, *a: None if name == "distributed" else real(name, *a))
-    mf.plugins.installed_plugins.cache_clear() if hasattr(mf.plugins.installed_plugins, "cache_clear") else None
     from masonryfw_sweep.commands import available_commands, sweep_command
 
     before = sweep_command.short_help
@@ -190,7 +189,7 @@ def test_report_of_a_trough_result_reads_right(tmp_path):
 
 def test_three_results_of_one_solver_get_three_legend_entries(tmp_path):
     """Three fdem runs that differ only in their model (the segment length) are told apart by their files."""
-    from masonryfw_compare.plotting import distinct_labels
+    from masonryfw_compare.history_plot import distinct_labels
 
     results = []
     for k, segment in enumerate((0.05, 0.025, 0.0125)):

@@ -7,7 +7,7 @@ import xarray as xr
 from PIL import Image
 
 import masonryfw as mf
-from masonryfw_compare.plotting import default_amplification, thrust_segments
+from masonryfw_compare.block_plots import default_amplification, thrust_segments
 
 
 def plot(result, kind, **options):

@@ -17,7 +17,7 @@ from PIL import Image
 
 import masonryfw as mf
 from masonryfw.cli import cli
-from masonryfw_compare.plotting import gravity_records
+from masonryfw_compare.history_plot import gravity_records
 
 R0 = 792.0 * 0.6 / 1.1  # Test 12C's dead load on its settling support (datasets/README.md)
 #: Appended to a copy of the report: after loading, the body says how many images decoded, and how big.

@@ -51,7 +51,7 @@ def la_12c():
 
 @pytest.fixture(scope="module")
 def cracks_12c(la_12c):
-    return joint_lines(la_12c, sy.cracked_joints(la_12c))
+    return joint_lines(la_12c, sy.visible_cracks(la_12c))
 
 
 @pytest.fixture(scope="module")
@@ -123,7 +123,7 @@ def test_verify_runs_the_best_forward_to_its_settlement(la_12c, cracks_12c):
 def test_surveyed_widths_give_the_settlement(la_12c, cracks_12c):
     """Widths of la's own openings at a known settlement: the estimate is that settlement."""
     settlement = 3e-3
-    joints = sy.cracked_joints(la_12c)
+    joints = sy.visible_cracks(la_12c)
     opening = np.maximum(la_12c.interface_opening.values, 0.0).max(axis=1)
     widths = [1e3 * settlement * float(opening[j]) for j in joints]
     diagnosis = diagnose(mf.open_model("test-12c"), survey(cracks_12c, widths), segment=SEGMENT)
@@ -280,7 +280,7 @@ def cli_diagnosis(tmp_path_factory, la_12c, cracks_12c):
     """``masonryfw diagnose test-12c --json`` on its own la cracks with widths, and one stray line in the middle of
     a unit (further than ``--tolerance 0.01`` m from every joint)."""
     folder = tmp_path_factory.mktemp("cli")
-    joints = sy.cracked_joints(la_12c)
+    joints = sy.visible_cracks(la_12c)
     opening = np.maximum(la_12c.interface_opening.values, 0.0).max(axis=1)
     lines = [*cracks_12c, np.array([[0.3, 0.3245], [0.3, 0.3255]])]  # in the unit 0.2..0.4 x 0.3..0.35
     widths = [1e3 * 2e-3 * float(opening[j]) for j in joints] + [0.1]
@@ -387,7 +387,7 @@ def test_a_drawn_wall_with_a_dxf_crack_map(tmp_path):
     result = mf.solve(mf.open_model("stepped-units"), "la", {})
     doc = ezdxf.new()
     doc.header["$INSUNITS"] = 4
-    for line in joint_lines(result, sy.cracked_joints(result)):
+    for line in joint_lines(result, sy.visible_cracks(result)):
         doc.modelspace().add_lwpolyline([tuple(1e3 * p) for p in line], dxfattribs={"layer": "CRACKS"})
     doc.modelspace().add_lwpolyline([(0, 0), (1200, 0), (1200, 600), (0, 600)], close=True,
                                     dxfattribs={"layer": "OUTLINE"})

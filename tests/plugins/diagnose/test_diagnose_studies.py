@@ -37,7 +37,7 @@ def random_case(seed: int) -> dict:
     spec = sy.random_wall(rng)
     truth = sy.random_truth(spec, rng)
     result = mf.solve(mf.build({**spec, "settlement": truth, "loading": {"type": "settlement"}}), "la", {})
-    collection = sy.draw(result, sy.cracked_joints(result), SURVEYOR, np.random.default_rng(1000 + seed))
+    collection = sy.draw(result, sy.visible_cracks(result), SURVEYOR, np.random.default_rng(1000 + seed))
     diagnosis = diagnose(mf.build({**spec, **mf.STAND_IN_GROUND}), survey_of(collection))
     return sy.judged([c.table for c in diagnosis.candidates], [c.table for c in diagnosis.plausible], truth,
                      diagnosis.extent, diagnosis.segment)
@@ -78,7 +78,7 @@ def settling_edges(model) -> list[float]:
 def own_cracks_diagnosis(name: str):
     model = mf.open_model(name)
     result = mf.solve(model, "la", {})
-    lines = tuple(np.c_[result.interface_x.values[j], result.interface_y.values[j]] for j in sy.cracked_joints(result))
+    lines = tuple(np.c_[result.interface_x.values[j], result.interface_y.values[j]] for j in sy.visible_cracks(result))
     survey = Survey(lines, (None,) * len(lines), tuple(map(str, range(len(lines)))), sources={"unit": "m"})
     return model, diagnose(model, survey)
 

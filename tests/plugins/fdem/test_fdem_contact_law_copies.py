@@ -50,10 +50,13 @@ def compare_once(seed) -> dict:
     kernels.place_vertices(pos, lx, ly, offs, vx, vy)
     rigid = {k: v.copy() for k, v in history.items()}
     force, acc = np.zeros((2, 3)), np.zeros(N_ACC)
-    stored = kernels.contact_forces(pos, vel, vx, vy, offs, faces, props, kn, kt, min_half, damping,
-                                    1.0 / mass, dt, rigid["shear"], rigid["bonded"], rigid["normal"], rigid["energy"],
-                                    force, acc, True, np.ones(2, dtype=np.int64), driven, np.zeros(2, np.int64), 0.0,
-                                    np.zeros((n_face, 4)))
+    bodies = kernels.Bodies(pos, np.ones(2), lx, ly, offs, np.repeat(mass[:, None], 3, axis=1), 1.0 / mass,
+                            np.ones((2, 3), np.bool_), driven, driven, np.zeros((2, 3)))
+    law = kernels.ContactLaw(kn, kt, min_half, damping)
+    pairs = kernels.Pairs(faces, props, rigid["shear"], rigid["bonded"], rigid["normal"], rigid["energy"],
+                          np.zeros((n_face, 4)))
+    motion = kernels.Motion(pos, vel, pos.copy(), np.ones(2, dtype=np.int64), np.zeros(2, np.int64), acc)
+    stored = kernels.contact_forces(bodies, pairs, law, motion, vx, vy, force, dt, True, 0.0)
 
     # the same state on nodes: each vertex moves with its block's rigid velocity; node inverse masses chosen
     # so that the nodal dashpot's mass (half the sum over the four nodes of a pair) is the blocks' reduced mass
@@ -62,9 +65,13 @@ def compare_once(seed) -> dict:
                                 vel[owner, 1] + vel[owner, 2] * (vx - pos[owner, 0])])
     nodal = {k: v.copy() for k, v in history.items()}
     node_force, node_acc = np.zeros((8, 2)), np.zeros(N_ACC)
-    node_stored = deformable.node_contact_forces(vx, vy, node_vel, offs, faces, props, kn, kt, min_half, damping,
-                                                 1.0 / mass[owner], dt, nodal["shear"], nodal["bonded"],
-                                                 nodal["normal"], nodal["energy"], node_force, node_acc, True)
+    mesh = deformable.Mesh(vx, vy, owner, np.zeros((0, 3), np.int64), np.zeros((0, 3)), np.zeros((0, 3)),
+                           np.zeros(0), np.zeros(0), np.zeros(0), 1.0 / (1.0 / mass[owner]), 1.0 / mass[owner],
+                           np.zeros(8, np.bool_), np.zeros(0, np.bool_))
+    node_pairs = kernels.Pairs(faces, props, nodal["shear"], nodal["bonded"], nodal["normal"], nodal["energy"],
+                               np.zeros((0, 4)))
+    node_motion = deformable.NodeMotion(vx, vy, node_vel, vx.copy(), vy.copy(), node_acc)
+    node_stored = deformable.node_contact_forces(offs, mesh, node_pairs, law, node_motion, node_force, dt, True)
 
     block_force = np.zeros((2, 2))
     np.add.at(block_force[:, 0], owner, node_force[:, 0])

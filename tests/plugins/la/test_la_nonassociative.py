@@ -1,4 +1,4 @@
-"""la with non-associative friction (issue 15): joints that slide without opening.
+"""la with non-associative friction: joints that slide without opening.
 
 References: closed forms (a unit between a base and a cap; rocking; a unit over a
 settling support; cohesion), the associative alpha as an upper bound, the same

@@ -1,4 +1,4 @@
-"""la under settlement profiles: supports at their own rates, troughs, tilts (issue 14).
+"""la under settlement profiles: supports at their own rates, troughs, tilts.
 
 References: the single-support model (a profile at rate 1 everywhere must be the
 same problem), the mirror image of a symmetric problem, and the static LP of the

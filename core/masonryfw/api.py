@@ -1,243 +1,42 @@
-"""The plugin manager: loading, lookup by name, and the ``solve`` / ``compare`` / ``render`` entry points.
-
-Every plugin, built-in or third-party, is found through the entry-point group
-``masonryfw``; nothing is special-cased. A plugin that fails to load becomes a
-:class:`PluginLoadWarning` naming the entry point and the error, and the other
-plugins stay usable. Records (solvers, comparators, plotters) are looked up by
-name; the same name contributed twice is an error naming both plugins.
-"""
+"""The entry points every command and script goes through: ``solve``, ``estimate``, ``compare``,
+``render`` and ``plot_table``. Each looks its record up in the registry, resolves the options, checks
+what goes in and what comes out, derives the comparable fields (:mod:`.semantics`, :mod:`.damage`) and
+records the provenance (:mod:`.provenance`)."""
 from __future__ import annotations
 
-import functools
-import hashlib
-import importlib.util
-import json
-import sys
 import time
-import warnings
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
-from importlib.metadata import entry_points
-from pathlib import Path
 from typing import Any
 
-import click
 import numpy as np
-import pluggy
 import xarray as xr
 
 from .checks import check
 from .damage import DERIVED_STEP_VARIABLES, damage_variables
 from .dofs import block_motion
 from .errors import MasonryError, ModelError, PluginError, SolveError
-from .hookspecs import (
-    PROJECT,
-    Comparator,
-    Estimate,
-    MasonryfwSpec,
-    Plotter,
-    Solver,
-    resolve_options,
-    unknown_name_message,
-)
+from .hookspecs import Comparator, Estimate, Plotter, Solver
 from .hookspecs import resolved as resolved_function
 from .io import CONVENTIONS, add_history, content_sha256
-from .model import checked_model
+from .model import checked_digest, checked_model, contents_digest
+from .options import resolve_options
 from .progress import ProgressCallback, no_progress
+from .provenance import core_version, input_hash, options_json, plugin_version, record_version
+from .registry import by_name, lookup
 from .resources import require_memory
 from .schema import FORMAT_VERSION, variable_attrs
-from .semantics import DERIVED_RESULT_VARIABLES, FLOW_RULES, ROTATIONS, derived_variables, plastic_crack_indicator
+from .semantics import (
+    CRACK_THRESHOLD,
+    DERIVED_RESULT_VARIABLES,
+    FLOW_RULES,
+    ROTATIONS,
+    derived_variables,
+    indicator_attrs,
+    plastic_crack_indicator,
+)
 
-#: record kind -> (hook name, record type)
-_HOOKS = {
-    "solver": ("masonryfw_solvers", Solver),
-    "comparator": ("masonryfw_comparators", Comparator),
-    "plotter": ("masonryfw_plotters", Plotter),
-    "command": ("masonryfw_commands", click.Command),
-}
-
-
-class PluginLoadWarning(UserWarning):
-    """A plugin could not be loaded or one of its hooks failed; the others still work."""
-
-
-@dataclass(frozen=True)
-class PluginInfo:
-    """An installed plugin: its entry-point name, distribution and what it contributes."""
-
-    name: str
-    distribution: str | None
-    version: str | None
-    solvers: tuple[Solver, ...]
-    comparators: tuple[Comparator, ...]
-    plotters: tuple[Plotter, ...]
-    commands: tuple[click.Command, ...]
-
-
-@dataclass(frozen=True)
-class _Contribution:
-    record: Any
-    plugin: str
-
-
-_manager: pluggy.PluginManager | None = None
-_distributions: dict[str, tuple[str, str]] = {}  # plugin name -> (distribution, version)
-
-
-def plugin_manager() -> pluggy.PluginManager:
-    """The process-wide plugin manager, created (and the entry points loaded) on first use."""
-    global _manager
-    if _manager is None:
-        manager = pluggy.PluginManager(PROJECT)
-        manager.add_hookspecs(MasonryfwSpec)
-        for entry_point in entry_points(group=PROJECT):
-            _load_entry_point(manager, entry_point)
-        _manager = manager
-    return _manager
-
-
-def reset() -> None:
-    """Forget the plugin manager so that the next use reloads the entry points (for tests)."""
-    global _manager
-    _manager = None
-    _distributions.clear()
-
-
-def _load_entry_point(manager: pluggy.PluginManager, entry_point) -> None:
-    dist = getattr(entry_point, "dist", None)
-    origin = f"{dist.name} {dist.version}" if dist is not None else "unknown distribution"
-    try:
-        manager.register(entry_point.load(), name=entry_point.name)
-        try:
-            manager.check_pending()  # a misspelt hook name would otherwise be ignored silently
-        except pluggy.PluginValidationError:
-            manager.unregister(name=entry_point.name)
-            raise
-    except Exception as exc:  # a broken plugin must not take the others down
-        warnings.warn(
-            f"masonryfw plugin {entry_point.name!r} ({entry_point.value}, from {origin}) "
-            f"failed to load: {type(exc).__name__}: {exc}",
-            PluginLoadWarning,
-            stacklevel=3,
-        )
-        return
-    if dist is not None:
-        _distributions[entry_point.name] = (dist.name, dist.version)
-
-
-def _describe_plugin(plugin: str) -> str:
-    dist = _distributions.get(plugin)
-    return f"{plugin!r} (distribution {dist[0]} {dist[1]})" if dist else repr(plugin)
-
-
-def _contributions(kind: str) -> list[_Contribution]:
-    """Every record of ``kind`` from every plugin, in registration order, duplicates included."""
-    hook_name, record_type = _HOOKS[kind]
-    found = []
-    for impl in getattr(plugin_manager().hook, hook_name).get_hookimpls():
-        try:
-            records = list(impl.function() or ())
-        except Exception as exc:
-            warnings.warn(
-                f"masonryfw plugin {impl.plugin_name!r}: {hook_name}() failed: {type(exc).__name__}: {exc}",
-                PluginLoadWarning,
-                stacklevel=3,
-            )
-            continue
-        for record in records:
-            if isinstance(record, record_type):
-                found.append(_Contribution(record, impl.plugin_name))
-            else:
-                warnings.warn(
-                    f"masonryfw plugin {impl.plugin_name!r}: {hook_name}() returned "
-                    f"{type(record).__name__}, not a {record_type.__name__}; ignored",
-                    PluginLoadWarning,
-                    stacklevel=3,
-                )
-    return found
-
-
-def _by_name(kind: str) -> dict[str, _Contribution]:
-    """Records of ``kind`` by name; a name contributed twice raises naming both plugins."""
-    named: dict[str, _Contribution] = {}
-    for item in _contributions(kind):
-        first = named.get(item.record.name)
-        if first is not None:
-            raise PluginError(
-                f"{kind} {item.record.name!r} is provided twice: by plugin "
-                f"{_describe_plugin(first.plugin)} and by plugin {_describe_plugin(item.plugin)}; "
-                "uninstall or disable one of them"
-            )
-        named[item.record.name] = item
-    return named
-
-
-def _lookup(kind: str, name: str | None) -> _Contribution:
-    """The record ``name`` of ``kind``; with ``name=None``, the only one installed."""
-    named = _by_name(kind)
-    if not named:
-        raise PluginError(f"no {kind} is installed")
-    if name is None:
-        if len(named) == 1:
-            return next(iter(named.values()))
-        raise PluginError(f"several {kind}s are installed ({', '.join(sorted(named))}); choose one by name")
-    if name not in named:
-        raise PluginError(unknown_name_message(kind, name, list(named)))
-    return named[name]
-
-
-def installed_solvers() -> list[Solver]:
-    """Every installed solver record, in name order."""
-    return [item.record for _, item in sorted(_by_name("solver").items())]
-
-
-def get_solver(name: str) -> Solver:
-    """The solver record called ``name``."""
-    return _lookup("solver", name).record
-
-
-def get_comparator(name: str) -> Comparator:
-    """The comparator record called ``name``."""
-    return _lookup("comparator", name).record
-
-
-def get_plotter(name: str) -> Plotter:
-    """The plotter record (plot kind) called ``name``."""
-    return _lookup("plotter", name).record
-
-
-def plugin_commands() -> dict[str, click.Command]:
-    """Extra CLI commands contributed by plugins, by name (a name given twice raises naming both)."""
-    return {name: item.record for name, item in _by_name("command").items()}
-
-
-def command_plugin(name: str) -> str:
-    """A description of the plugin that contributes the CLI command ``name``."""
-    return _describe_plugin(_lookup("command", name).plugin)
-
-
-def installed_plugins() -> list[PluginInfo]:
-    """Every loaded plugin with its distribution and records, sorted by plugin name."""
-    manager = plugin_manager()
-    by_plugin: dict[str, dict[str, list]] = {
-        name: {kind: [] for kind in _HOOKS} for name, _ in manager.list_name_plugin()
-    }
-    for kind in _HOOKS:
-        for item in _contributions(kind):
-            by_plugin[item.plugin][kind].append(item.record)
-    infos = []
-    for name, records in sorted(by_plugin.items()):
-        dist, version = _distributions.get(name, (None, None))
-        infos.append(PluginInfo(name, dist, version, *(tuple(records[kind]) for kind in _HOOKS)))
-    return infos
-
-
-def _plugin_version(item: _Contribution) -> str:
-    """The contributing distribution's version (the masonryfw version for a plugin registered by hand)."""
-    from . import __version__
-
-    dist = _distributions.get(item.plugin)
-    return dist[1] if dist else __version__
+_VALID = "masonryfw_valid"  # encoding key: (kind, contents digest) of an input found valid
+_ESTIMATES = "masonryfw_estimates"  # encoding key: the estimates made on a checked model
 
 
 def _problem_list(problems) -> str:
@@ -245,10 +44,16 @@ def _problem_list(problems) -> str:
 
 
 def _require_valid_input(ds: xr.Dataset, what: str, kind: str) -> None:
-    """Raise one :class:`ModelError` listing every problem of an input dataset."""
+    """Raise one :class:`ModelError` listing every problem of an input dataset. A dataset found valid is
+    marked with the digest of its contents (:func:`.model.contents_digest`) and not checked again while
+    the digest holds: ``compare`` of N results checks each once."""
+    digest = contents_digest(ds)
+    if ds.encoding.get(_VALID) == (kind, digest):
+        return
     problems = check(ds, kind=kind)
     if problems:
         raise ModelError(f"{what} is invalid ({len(problems)} problem(s))", problems)
+    ds.encoding[_VALID] = (kind, digest)
 
 
 def _require_valid_output(ds: xr.Dataset, what: str, error: type[MasonryError], model_checked: bool = False) -> None:
@@ -290,62 +95,6 @@ def _merge_result(kind: str, name: str, base: xr.Dataset, reserved: xr.Dataset, 
         raise error(f"{kind} {name} returned variables that do not fit its input: {exc}") from exc
 
 
-def _package_files(module_name: str) -> tuple[Path, list[Path]]:
-    """The folder and the ``.py`` files of the top-level package of ``module_name`` (or of the module alone)."""
-    top = module_name.split(".")[0]
-    try:
-        spec = importlib.util.find_spec(top)
-    except (ImportError, ValueError):
-        spec = None
-    if spec is not None and spec.submodule_search_locations:
-        root = Path(next(iter(spec.submodule_search_locations)))
-        return root, sorted(root.rglob("*.py"))
-    module = sys.modules.get(module_name) or sys.modules.get(top)
-    origin = getattr(module, "__file__", None) or (spec.origin if spec is not None else None)
-    if origin and Path(origin).is_file():
-        return Path(origin).parent, [Path(origin)]
-    return Path("."), []
-
-
-@functools.cache
-def code_digest(module_name: str) -> str:
-    """First 12 hex digits of the SHA-256 of the code of the package holding ``module_name``.
-
-    Every ``.py`` file of the package in sorted order, by its path relative to
-    the package and its bytes: the same code gives the same digest wherever it
-    is installed, and any edit changes it.
-    """
-    root, files = _package_files(module_name)
-    digest = hashlib.sha256()
-    for path in files:
-        digest.update(path.relative_to(root).as_posix().encode())
-        digest.update(path.read_bytes())
-    return digest.hexdigest()[:12]
-
-
-def core_version() -> str:
-    """masonryfw's version plus a digest of the core's code (what derives the comparable fields)."""
-    from . import __version__
-
-    return f"{__version__}+{code_digest(__name__)}"
-
-
-def record_version(item: _Contribution, function) -> str:
-    """The recorded version of a record: its declared version (else its distribution's) plus its code's digest.
-
-    Any change of the plugin's code changes it, so a store keyed on it never
-    returns the result of older code.
-    """
-    base = item.record.version or _plugin_version(item)
-    return f"{base}+{code_digest(function.__module__)}"
-
-
-def solver_version(name: str) -> str:
-    """The version :func:`solve` records for the solver called ``name`` (see :func:`record_version`)."""
-    item = _lookup("solver", name)
-    return record_version(item, item.record.solve)
-
-
 def _derive_comparable_fields(name: str, model: xr.Dataset, produced: xr.Dataset) -> xr.Dataset:
     """``produced`` with the fields :mod:`.semantics` derives from its ``block_displacement`` or ``qp_failure``
     and those :mod:`.damage` derives from its history."""
@@ -369,7 +118,7 @@ def _derive_comparable_fields(name: str, model: xr.Dataset, produced: xr.Dataset
     if primary == "qp_failure":
         indicator = plastic_crack_indicator(model, produced.qp_x.values, produced.qp_y.values,
                                             produced.qp_failure.values > 0)
-        return produced.assign(crack_indicator=("interface", indicator, variable_attrs("crack_indicator")))
+        return produced.assign(crack_indicator=("interface", indicator, indicator_attrs(CRACK_THRESHOLD)))
     for attribute, choices in (("rotations", ROTATIONS), ("flow_rule", FLOW_RULES)):
         if produced.attrs.get(attribute) not in choices:
             raise SolveError(
@@ -390,20 +139,26 @@ def estimate(model: xr.Dataset, plugin: str, options: Mapping[str, Any] | None =
     the check :func:`solve` makes before it starts.
     """
     model = checked_model(model)
-    solver: Solver = _lookup("solver", plugin).record
+    solver: Solver = lookup("solver", plugin).record
     resolved = resolve_options(f"solver {solver.name!r}", solver.options, dict(options or {}))
     return _checked_estimate(solver, model, resolved)
 
 
 def _checked_estimate(solver: Solver, model: xr.Dataset, resolved: Mapping[str, Any]) -> Estimate | None:
+    """The solver's estimate on a checked ``model``, made once per model contents and options (kept in the
+    model's encoding: the CLI's estimate and the solve's memory check are one call)."""
     if solver.estimate is None:
         return None
-    function = _call_plugin("solver", solver.name, resolved_function, solver.estimate)
-    expected = _call_plugin("solver", solver.name, function, model, resolved)
-    if not isinstance(expected, Estimate):
-        raise SolveError(f"solver {solver.name}'s estimate returned {type(expected).__name__}, not an Estimate")
-    require_memory(solver.name, expected)
-    return expected
+    key = (solver.name, options_json(resolved), checked_digest(model))
+    made = model.encoding.setdefault(_ESTIMATES, {})
+    if key not in made:
+        function = _call_plugin("solver", solver.name, resolved_function, solver.estimate)
+        expected = _call_plugin("solver", solver.name, function, model, resolved)
+        if not isinstance(expected, Estimate):
+            raise SolveError(f"solver {solver.name}'s estimate returned {type(expected).__name__}, not an Estimate")
+        made[key] = expected
+    require_memory(solver.name, made[key])
+    return made[key]
 
 
 def solve(
@@ -425,7 +180,7 @@ def solve(
     A ``KeyboardInterrupt`` the solver lets through propagates (nothing computed).
     """
     model = checked_model(model)
-    item = _lookup("solver", plugin)
+    item = lookup("solver", plugin)
     solver: Solver = item.record
     resolved = resolve_options(f"solver {solver.name!r}", solver.options, dict(options or {}))
     _checked_estimate(solver, model, resolved)  # a run that cannot fit in memory is refused here
@@ -445,7 +200,7 @@ def solve(
         masonryfw_format="result",
         masonryfw_format_version=FORMAT_VERSION,
         plugin=item.plugin,
-        plugin_version=_plugin_version(item),
+        plugin_version=plugin_version(item),
         solver=solver.name,
         solver_version=record_version(item, solver.solve),
         core_version=core_version(),
@@ -465,16 +220,6 @@ def solve(
     return result
 
 
-def options_json(options: Mapping[str, Any]) -> str:
-    """Resolved options as canonical JSON (sorted keys, tuples as lists): how results and stores record them."""
-    return json.dumps(options, sort_keys=True, default=str)
-
-
-def _input_hash(ds: xr.Dataset) -> str:
-    """The file's hash for a dataset read from a file, else the content hash."""
-    return str(ds.encoding.get("sha256") or content_sha256(ds))
-
-
 def compare(
     a: xr.Dataset,
     b: xr.Dataset,
@@ -488,7 +233,7 @@ def compare(
     ``input_b_sha256`` are the files' hashes when the results were read from
     files, otherwise their content hashes.
     """
-    item = _lookup("comparator", comparator)
+    item = lookup("comparator", comparator)
     record: Comparator = item.record
     resolved = resolve_options(f"comparator {record.name!r}", record.options, dict(options or {}))
     for label, ds in (("A", a), ("B", b)):
@@ -505,10 +250,10 @@ def compare(
         "comparator": record.name,
         "comparator_version": record_version(item, record.compare),
         "plugin": item.plugin,
-        "plugin_version": _plugin_version(item),
+        "plugin_version": plugin_version(item),
         "comparator_options": options_json(resolved),
-        "input_a_sha256": _input_hash(a),
-        "input_b_sha256": _input_hash(b),
+        "input_a_sha256": input_hash(a),
+        "input_b_sha256": input_hash(b),
         "input_a_solver": str(a.attrs.get("solver", "")),
         "input_b_solver": str(b.attrs.get("solver", "")),
     }
@@ -520,6 +265,8 @@ def compare(
 
 
 FIGURE_SIZE = (7.0, 4.5)  # inches, one panel
+
+
 PANEL_WIDTH = 4.5  # inches per dataset when several are drawn side by side
 
 
@@ -535,7 +282,7 @@ def render(
     (no pyplot, no GUI backend), one panel-width wider per dataset for a ``side_by_side`` kind.
     Returns the figure.
     """
-    record: Plotter = _lookup("plotter", kind).record
+    record: Plotter = lookup("plotter", kind).record
     resolved = resolve_options(f"plotter {record.name!r}", record.options, dict(options or {}))
     datasets = list(datasets)
     if ax is None:
@@ -554,9 +301,9 @@ def plot_table(
 
     Raises :class:`PluginError` for a kind that draws no curves, naming the kinds that do.
     """
-    record: Plotter = _lookup("plotter", kind).record
+    record: Plotter = lookup("plotter", kind).record
     if record.table is None:
-        with_tables = sorted(name for name, item in _by_name("plotter").items() if item.record.table is not None)
+        with_tables = sorted(name for name, item in by_name("plotter").items() if item.record.table is not None)
         raise PluginError(f"the {record.name} plot draws no curves to write as CSV; kinds with curves: "
                           f"{', '.join(with_tables) or 'none installed'}")
     resolved = resolve_options(f"plotter {record.name!r}", record.options, dict(options or {}))

@@ -1,0 +1,348 @@
+"""The one-result plot kinds drawn on the blocks: ``model``, ``mechanism``, ``cracks``, ``forces`` and
+``plastic`` (the drawing functions behind the ``Plotter`` records of :mod:`.records`).
+
+Cracks are the core's: a joint is drawn cracked where :func:`masonryfw.cracked_joints` says so at the
+plot's ``threshold``, and the mechanism's macro-blocks are derived at that threshold too.
+"""
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+import xarray as xr
+from matplotlib import colormaps
+from matplotlib.collections import LineCollection, PolyCollection
+from matplotlib.colors import Normalize
+from matplotlib.lines import Line2D
+from matplotlib.patches import Patch
+
+import masonryfw as mf
+
+from .figure_parts import (
+    SUPPORT_COLOUR,
+    block_vertices,
+    draw_blocks,
+    draw_outline,
+    finish_axes,
+    line_scale,
+    require_variables,
+    segment_array,
+    single_result,
+    supports_of,
+)
+from .shapes import deformed_nodes, deformed_points, largest_vertex_motion
+
+# Default amplification: the largest vertex displacement drawn as this share of the model size.
+DRAWN_MOTION_SHARE = 0.10
+STATE_COLOURS = {"open": "tab:red", "slide": "tab:blue", "open_slide": "tab:purple"}
+FAILURE_COLOURS = {"tensile": "tab:blue", "shear": "0.55", "tensile_shear": "navy"}
+SMALL_PIECE_COLOUR = "0.82"
+FRICTION_MAP = "plasma_r"  # dark: sliding; light: far from it
+DOMINANT_SHARE = 0.02  # a macro-block holding this share of the masonry area is numbered ...
+MOST_NUMBERED = 10  # ... up to this many
+THRUST_REFERENCE_PERCENTILE = 95.0
+
+
+
+@dataclass(frozen=True)
+class Pieces:
+    """The masonry's macro-blocks by size: ``number[block]`` is 1, 2, ... for the blocks of the
+    dominant pieces (largest first) and 0 for the small pieces and the supports."""
+
+    number: np.ndarray
+    dominant: int
+    small: int
+
+
+def dominant_pieces(ds: xr.Dataset, geo: xr.Dataset) -> Pieces:
+    """Number the macro-blocks holding at least :data:`DOMINANT_SHARE` of the masonry area (at most
+    :data:`MOST_NUMBERED`), largest first; the others are small pieces."""
+    masonry = mf.masonry_blocks(geo.block_role.values)
+    number = np.zeros(geo.sizes["block"], dtype=np.int64)
+    if "macro_block" not in ds or not masonry.any():
+        return Pieces(number, 0, 0)
+    labels, inverse = np.unique(ds.macro_block.values[masonry], return_inverse=True)
+    area = np.bincount(inverse, weights=np.abs(geo.block_area.values[masonry]))
+    order = np.argsort(-area, kind="stable")
+    big = order[area[order] >= DOMINANT_SHARE * area.sum()][:MOST_NUMBERED]
+    rank = np.zeros(labels.size, dtype=np.int64)
+    rank[big] = np.arange(1, big.size + 1)
+    number[masonry] = rank[inverse]
+    return Pieces(number, int(big.size), int(labels.size - big.size))
+
+
+def piece_colours(geo: xr.Dataset, pieces: Pieces) -> np.ndarray:
+    """Dominant pieces in tab10's colours (cycled), small pieces in one neutral grey."""
+    palette = colormaps["tab10"].colors
+    colours = np.array([SMALL_PIECE_COLOUR] * geo.sizes["block"], dtype=object)
+    for block in np.flatnonzero(pieces.number):
+        colours[block] = palette[(pieces.number[block] - 1) % len(palette)]
+    return colours
+
+
+def _number_pieces(ax, geo: xr.Dataset, pieces: Pieces, x: np.ndarray, y: np.ndarray) -> None:
+    """Write (1), (2), ... on each dominant piece, at its block nearest to the piece's area centroid (so the
+    label lies on the piece even when the piece is not convex), in the deformed configuration."""
+    owner = mf.node_block(geo.block_node_count.values)
+    count = np.bincount(owner, minlength=geo.sizes["block"])
+    bx = np.bincount(owner, weights=x, minlength=geo.sizes["block"]) / np.maximum(count, 1)
+    by = np.bincount(owner, weights=y, minlength=geo.sizes["block"]) / np.maximum(count, 1)
+    area = np.abs(geo.block_area.values)
+    for k in range(1, pieces.dominant + 1):
+        blocks = np.flatnonzero(pieces.number == k)
+        cx, cy = np.average(bx[blocks], weights=area[blocks]), np.average(by[blocks], weights=area[blocks])
+        at = blocks[np.argmin(np.hypot(bx[blocks] - cx, by[blocks] - cy))]
+        ax.text(bx[at], by[at], f"({k})", ha="center", va="center", fontsize="medium", fontweight="bold", zorder=5,
+                bbox={"boxstyle": "round,pad=0.15", "facecolor": "white", "edgecolor": "none", "alpha": 0.8})
+
+
+def _deformed_crack_faces(geo: xr.Dataset, u, amplification: float, cracked: np.ndarray) -> np.ndarray:
+    """The cracked joints as drawn on the deformed blocks: each joint once on either side's face
+    (the two faces of a crack part as the blocks move apart), shape (2 * cracked, 2, 2)."""
+    blocks = geo.interface_blocks.values[cracked].astype(np.int64)
+    px, py = geo.interface_x.values[cracked], geo.interface_y.values[cracked]
+    faces = [deformed_points(geo, u, amplification, px, py, blocks[:, [side, side]]) for side in (0, 1)]
+    return np.concatenate([segment_array(fx, fy) for fx, fy in faces])
+
+
+def default_amplification(geo: xr.Dataset, displacement) -> float:
+    """Factor that draws the largest vertex displacement as 10 % of the model size (1 if nothing moves)."""
+    largest = largest_vertex_motion(geo, displacement)
+    size = mf.model_scale(geo.node_x.values, geo.node_y.values)
+    return DRAWN_MOTION_SHARE * size / largest if largest > 0 else 1.0
+
+
+
+ROLE_COLOURS = {"unit": "#f3e3c8", "lintel": "#8c6d46", "fixed_support": SUPPORT_COLOUR, "moving_support": "#e0a020"}
+KIND_COLOURS = {"bed": "tab:blue", "head": "tab:green", "other": "tab:purple", "support": "tab:red"}
+
+
+def draw_model(datasets: Sequence[xr.Dataset], ax, options: Mapping[str, Any]) -> None:
+    """A model as imported: blocks by role (supports hatched, a moving one with an arrow along its
+    settlement direction), interfaces coloured by kind, block numbers on request."""
+    ds = single_result(datasets, "model")
+    geo = ds if "block_centroid_x" in ds else mf.derive_geometry(ds)
+    names = {value: name for name, value in mf.flags("block_role").items()}
+    roles = np.array([names[int(r)] for r in geo.block_role.values])
+    verts = block_vertices(geo, geo.node_x.values, geo.node_y.values)
+    support = supports_of(geo)
+    fill = np.array([ROLE_COLOURS[r] for r in roles], dtype=object)
+    ax.add_collection(PolyCollection(list(verts[~support]), facecolors=list(fill[~support]), edgecolors="0.35",
+                                     linewidths=0.4, zorder=1))
+    if support.any():
+        ax.add_collection(PolyCollection(list(verts[support]), facecolors=list(fill[support]), edgecolors="0.2",
+                                         linewidths=0.4, hatch="////", zorder=1))
+    kinds = {value: name for name, value in mf.flags("interface_kind").items()}
+    kind = np.array([kinds[int(k)] for k in geo.interface_kind.values]) if "interface_kind" in geo else np.array([])
+    handles = []
+    for name, colour in KIND_COLOURS.items():
+        chosen = kind == name
+        if chosen.any():
+            segments = segment_array(geo.interface_x.values[chosen], geo.interface_y.values[chosen])
+            ax.add_collection(LineCollection(segments, colors=colour, linewidths=1.2, zorder=2))
+            handles.append(Line2D([], [], color=colour, lw=1.5, label=f"{name} ({int(chosen.sum())})"))
+    size = mf.model_scale(geo.node_x.values, geo.node_y.values)
+    moving = np.flatnonzero(roles == "moving_support")
+    starts, motions = _ground_arrows(geo, moving)
+    fastest = float(np.linalg.norm(motions, axis=1).max(initial=0.0))
+    for start, motion in zip(starts, motions):  # as long as the rates: a settlement profile shows its shape
+        if np.linalg.norm(motion) > 0:
+            tip = start + 0.08 * size * motion / fastest
+            ax.annotate("", xy=tip, xytext=start,
+                        arrowprops={"arrowstyle": "-|>", "color": "#b00000", "lw": 1.2}, zorder=3)
+            ax.update_datalim([tip])
+    if options["numbers"]:
+        for block in range(geo.sizes["block"]):
+            ax.text(geo.block_centroid_x.values[block], geo.block_centroid_y.values[block], str(block),
+                    ha="center", va="center", fontsize=options["font_size"], zorder=4)
+    if handles:
+        ax.legend(handles=handles, title="interfaces", fontsize="small", loc="upper left", bbox_to_anchor=(1.01, 1.0))
+    finish_axes(ax, ds)
+
+
+def _ground_arrows(geo: xr.Dataset, moving: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Per moving support: the middle of its top edge and that point's motion per unit settlement (a
+    support that turns moves its centroid sideways, its top edge less)."""
+    xmin, xmax, _, ymax = mf.block_bounds(geo.node_x.values, geo.node_y.values, geo.block_node_count.values)
+    points = np.c_[0.5 * (xmin + xmax), ymax][moving]
+    d = geo.settlement_direction.values[moving]
+    arm = points - np.c_[geo.block_centroid_x.values[moving], geo.block_centroid_y.values[moving]]
+    return points, np.c_[d[:, 0] - d[:, 2] * arm[:, 1], d[:, 1] + d[:, 2] * arm[:, 0]]
+
+
+def mechanism_amplification(ds: xr.Dataset, options: Mapping[str, Any]) -> float:
+    """The factor the mechanism plot draws ``ds``'s displacements by: the option ``amplification``, or
+    :func:`default_amplification`."""
+    return options["amplification"] or default_amplification(mf.derive_geometry(ds), mf.block_motion(ds))
+
+
+def draw_mechanism(datasets: Sequence[xr.Dataset], ax, options: Mapping[str, Any]) -> None:
+    """The wall in its amplified deformed configuration: the dominant macro-blocks coloured and numbered
+    (1), (2), ... by size, the small pieces in one grey, the cracks drawn on the blocks' faces; macro-blocks
+    and cracks at the option ``threshold``."""
+    ds = single_result(datasets, "mechanism")
+    require_variables(ds, ["block_displacement"], "mechanism", "block displacements (la, fdem, jmm or jmm-limit)")
+    ds = mf.at_threshold(ds, options["threshold"])
+    geo = mf.derive_geometry(ds)
+    u = mf.block_motion(ds)
+    amplification = mechanism_amplification(ds, options)
+    scale = line_scale(geo)
+    draw_outline(ax, geo)
+    x, y = deformed_nodes(geo, u, amplification)
+    pieces = dominant_pieces(ds, geo)
+    draw_blocks(ax, geo, x, y, piece_colours(geo, pieces))
+    handles = [Patch(facecolor=colormaps["tab10"].colors[0], edgecolor="0.3",
+                     label=f"(1) .. ({pieces.dominant}) macro-blocks, largest first" if pieces.dominant > 1
+                     else "(1) the macro-block")] if pieces.dominant else []
+    if pieces.small:
+        handles.append(Patch(facecolor=SMALL_PIECE_COLOUR, edgecolor="0.3", label=f"small pieces ({pieces.small})"))
+    if "crack_indicator" in ds:
+        cracked = mf.cracked_joints(ds, options["threshold"])
+        ax.add_collection(LineCollection(_deformed_crack_faces(geo, u, amplification, cracked), colors="k",
+                                         linewidths=1.6 * scale + 0.4, zorder=3, capstyle="round"))
+        handles.append(Line2D([], [], color="k", lw=2.0, label=f"cracked joints ({int(cracked.sum())})"))
+    _number_pieces(ax, geo, pieces, x, y)
+    ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize="small", frameon=False,
+              title=f"displacements x {amplification:.3g}", title_fontsize="small")
+    finish_axes(ax, ds)
+
+
+def draw_cracks(datasets: Sequence[xr.Dataset], ax, options: Mapping[str, Any]) -> None:
+    """Joints coloured by how they fail (opening, sliding, or both) over the undeformed wall.
+
+    A joint is drawn where it is cracked at the option ``threshold``, in the state the core
+    derives there (:func:`masonryfw.at_threshold`), as the comparison counts cracks.
+    """
+    ds = single_result(datasets, "cracks")
+    require_variables(ds, ["interface_opening", "interface_slip"], "cracks",
+             "the relative motion at the joints (a result with block displacements: la, fdem)")
+    geo = mf.derive_geometry(ds)
+    state = mf.at_threshold(ds, options["threshold"]).interface_state.values
+    draw_blocks(ax, geo, geo.node_x.values, geo.node_y.values, np.array(["0.93"] * geo.sizes["block"], dtype=object))
+    segments = segment_array(geo.interface_x.values, geo.interface_y.values)
+    flag = mf.flags("interface_state")
+    handles = []
+    for meaning, colour in STATE_COLOURS.items():
+        chosen = state == flag[meaning]
+        ax.add_collection(LineCollection(segments[chosen], colors=colour, linewidths=2.2, zorder=3))
+        handles.append(Line2D([], [], color=colour, lw=2.2, label=f"{meaning.replace('_', ' + ')} ({chosen.sum()})"))
+    ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize="small", frameon=False)
+    finish_axes(ax, ds)
+
+
+def loaded_joints(normal: np.ndarray) -> np.ndarray:
+    """Interfaces whose resultant normal force is more than round-off (1e-9 of the largest)."""
+    total = normal[:, 0] + normal[:, 1]
+    return total > 1e-9 * max(np.max(np.abs(total), initial=0.0), np.finfo(float).tiny)
+
+
+def thrust_segments(geo: xr.Dataset, normal, shear, scale: float):
+    """Per loaded interface: point of application, resultant force on side 1, and its drawn segment.
+
+    The resultant normal force N = N0 + N1 acts at ``(N0 p0 + N1 p1) / N`` (the
+    centre of pressure of the linear distribution between the ends); the force on
+    side 1 is ``N n + V t``. Segments are centred on the point of application,
+    along the force, ``scale`` median interface lengths long at the 95th percentile
+    of the magnitudes and proportionally shorter below it; the few stronger forces
+    (typically a support corner) are drawn at that length, so that they do not
+    shrink every other segment to a dot.
+    """
+    n0, n1 = normal[:, 0], normal[:, 1]
+    total = n0 + n1
+    loaded = loaded_joints(normal)
+    w = n1[loaded] / total[loaded]
+    ix, iy = geo.interface_x.values[loaded], geo.interface_y.values[loaded]
+    px, py = ix[:, 0] + w * (ix[:, 1] - ix[:, 0]), iy[:, 0] + w * (iy[:, 1] - iy[:, 0])
+    v = shear[loaded].sum(axis=1)
+    fx = total[loaded] * geo.interface_normal_x.values[loaded] + v * geo.interface_tangent_x.values[loaded]
+    fy = total[loaded] * geo.interface_normal_y.values[loaded] + v * geo.interface_tangent_y.values[loaded]
+    magnitude = np.hypot(fx, fy)
+    if not magnitude.size:
+        return px, py, magnitude, np.zeros((0, 2, 2))
+    reference = float(np.percentile(magnitude, THRUST_REFERENCE_PERCENTILE))
+    drawn = scale * float(np.median(geo.interface_length.values)) * np.minimum(magnitude / reference, 1.0)
+    hx, hy = 0.5 * drawn * fx / magnitude, 0.5 * drawn * fy / magnitude
+    segments = np.stack([np.stack([px - hx, px + hx], -1), np.stack([py - hy, py + hy], -1)], axis=-1)
+    return px, py, magnitude, segments
+
+
+def friction_used(geo: xr.Dataset, normal, shear) -> np.ndarray:
+    """Per loaded interface (:func:`loaded_joints`): |V| / (mu N), 1 where it slides."""
+    total = normal[:, 0] + normal[:, 1]
+    loaded = loaded_joints(normal)
+    mu = geo.interface_friction.values[loaded]
+    v = np.abs(shear[loaded].sum(axis=1))
+    return np.where(mu > 0, v / np.maximum(mu * total[loaded], np.finfo(float).tiny), np.inf)
+
+
+def draw_forces(datasets: Sequence[xr.Dataset], ax, options: Mapping[str, Any]) -> None:
+    """Contact forces at collapse: a segment through each joint's centre of pressure along the joint's
+    resultant, its length and width growing with the force, its colour the share of the friction used."""
+    ds = single_result(datasets, "forces")
+    require_variables(
+        ds, ["interface_normal_force", "interface_shear_force"], "forces",
+        "contact forces (a limit analysis la result)",
+    )
+    geo = mf.derive_geometry(ds)
+    draw_blocks(ax, geo, geo.node_x.values, geo.node_y.values, np.array(["0.93"] * geo.sizes["block"], dtype=object))
+    normal, shear = ds.interface_normal_force.values, ds.interface_shear_force.values
+    px, py, magnitude, segments = thrust_segments(geo, normal, shear, options["scale"])
+    handles = []
+    if magnitude.size:
+        reference = float(np.percentile(magnitude, THRUST_REFERENCE_PERCENTILE))
+        width = (0.5 + 2.5 * np.minimum(magnitude / reference, 1.0)) * line_scale(geo)
+        used = np.minimum(friction_used(geo, normal, shear), 1.0)
+        lines = LineCollection(segments, cmap=FRICTION_MAP, norm=Normalize(0.0, 1.0), linewidths=width, zorder=3)
+        lines.set_array(used)
+        ax.add_collection(lines)
+        ax.scatter(px, py, s=1.5 * line_scale(geo) ** 2, c="0.35", zorder=4, linewidths=0)
+        bar = ax.figure.colorbar(lines, cax=ax.inset_axes((1.03, 0.1, 0.03, 0.8)))  # follows the equal-aspect box
+        bar.set_label("friction used |V| / (mu N); 1 = sliding", fontsize="small")
+        handles = [
+            Line2D([], [], color="0.3", lw=3.0, label=f"joint resultant, full length = {reference:.3g} N (95th pct.)"),
+            Line2D([], [], ls="none", marker=".", color="0.35", label="centre of pressure"),
+            Line2D([], [], ls="none", label=f"largest {magnitude.max():.3g} N, {magnitude.size} loaded joints"),
+        ]
+    ax.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, -0.14), ncol=2, fontsize="small",
+              frameon=False)
+    finish_axes(ax, ds)
+
+
+def _mesh_faces(ds: xr.Dataset) -> np.ndarray:
+    """(face, max_nodes, 2) vertices; padding (negative or fill) indices repeat the last valid node."""
+    faces = np.asarray(ds.mesh_face_nodes.to_masked_array().filled(-1), dtype=np.int64)
+    count = np.maximum((faces >= 0).sum(axis=1), 1)
+    idx = np.take_along_axis(faces, np.minimum(np.arange(faces.shape[1])[None, :], count[:, None] - 1), axis=1)
+    return np.stack([ds.mesh_node_x.values[idx], ds.mesh_node_y.values[idx]], axis=-1)
+
+
+def draw_plastic(datasets: Sequence[xr.Dataset], ax, options: Mapping[str, Any]) -> None:
+    """Plastic quadrature points over the mesh: blue tensile, grey shear, navy both."""
+    ds = single_result(datasets, "plastic")
+    require_variables(ds, ["qp_failure", "qp_x", "qp_y"], "plastic", "a continuum (jmm) result")
+    draw_outline(ax, mf.derive_geometry(ds))
+    if "mesh_face_nodes" in ds:
+        ax.add_collection(PolyCollection(list(_mesh_faces(ds)), facecolors="none", edgecolors="0.9", linewidths=0.3))
+    failure = ds.qp_failure.values
+    flag = mf.flags("qp_failure")
+    for meaning, colour in FAILURE_COLOURS.items():
+        chosen = failure == flag[meaning]
+        ax.scatter(ds.qp_x.values[chosen], ds.qp_y.values[chosen], s=options["marker_size"], c=colour,
+                   label=f"{meaning.replace('_', ' + ')} ({chosen.sum()})", zorder=3, linewidths=0)
+    ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize="small", frameon=False, markerscale=2)
+    finish_axes(ax, ds)
+
+
+#: The one-result kinds and the variable each needs (the first the drawing reads).
+SINGLE_RESULT_KINDS = {"mechanism": "block_displacement", "cracks": "interface_opening",
+                       "forces": "interface_normal_force", "plastic": "qp_failure"}
+
+
+def drawable_kinds(ds: xr.Dataset) -> list[str]:
+    """The one-result kinds ``ds`` can be drawn as, in the order of :data:`SINGLE_RESULT_KINDS`; then ``ltsm``
+    for a result over a settlement profile with a settlement to assess."""
+    kinds = [kind for kind, needs in SINGLE_RESULT_KINDS.items() if needs in ds]
+    assessed = ("step_settlement" in ds and ds.step_settlement.size) or "settlement_target" in ds
+    return kinds + (["ltsm"] if ds.attrs.get("settlement_profile") and assessed else [])

@@ -1,0 +1,145 @@
+"""The controls of a run: the options made non-dimensional on a scene (stiffness, time step, target,
+rates, tolerances), as the estimate and the solver both need them."""
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from .scene import Scene
+
+
+@dataclass(frozen=True)
+class Controls:
+    """Non-dimensional run parameters (resolved from the options by the solver)."""
+
+    kn: float  # normal stiffness per unit contact length
+    kt: float
+    min_half: float  # half the shortest overlap that is a contact
+    contact_damping: float
+    dt: float
+    dt_critical: float
+    damping: float
+    target: float  # settlement to reach (0: no settlement phase)
+    rate: float  # settlement velocity
+    ramp_time: float
+    load_ramp: float  # duration of the smooth load ramp at the start
+    gravity_time: float  # fixed duration of the gravity phase, 0: until at rest
+    rest_tolerance: float
+    max_steps: int
+    record_steps: int
+    buffer: float
+    max_penetration: float
+    min_cos: float
+    sleep_speed: float  # 0: no sleeping
+    sleep_steps: int
+    wake_force: float
+    plateau_tolerance: float
+    plateau_window: float
+    snapshots: tuple[float, ...]
+    search: bool = False  # the load-factor search instead of a settlement
+    search_first: float = 0.1
+    search_limit: float = 10.0
+    search_tolerance: float = 1e-3
+    search_step_time: float = 1.0  # ramp to a trial multiplier
+    search_trial_time: float = 20.0  # longest hold of one trial
+    collapse_motion: float = 0.0  # block motion (centroid + rotation x radius) that makes a trial unstable
+
+
+SEARCH_STEP_TIME = 1.0
+SEARCH_TRIAL_TIME = 20.0
+
+
+def critical_time_step(scene: Scene, kn: float) -> float:
+    """2 / omega_max, omega^2 bounded per free block by the stiffness of springs all round
+    its perimeter: kn P / m in translation, kn P R^2 / I in rotation."""
+    free = ~scene.driven
+    translation = kn * scene.perimeter[free] / scene.mass[free, 0]
+    rotation = kn * scene.perimeter[free] * scene.radius[free] ** 2 / scene.mass[free, 2]
+    omega = np.sqrt(max(translation.max(initial=0.0), rotation.max(initial=0.0)))
+    return 2.0 / omega if omega > 0 else np.inf
+
+
+def masonry_height(scene: Scene) -> float:
+    """Height of the masonry (non-dimensional): top of the highest minus bottom of the lowest free block."""
+    y = scene.pos0[:, 1][np.repeat(np.arange(scene.driven.size), np.diff(scene.offs))] + scene.ly
+    free_nodes = ~np.repeat(scene.driven, np.diff(scene.offs))
+    return float(np.ptp(y[free_nodes]))
+
+
+#: The reaction plateau that stops a run when the target is not the model's own (share of the dead reaction).
+PLATEAU_TOLERANCE = 0.005
+
+
+def target_settlement(scene: Scene, options: Mapping[str, Any]) -> float:
+    """The settlement a run goes to [m]: the option, else the model's settlement_target, else a share of the
+    masonry height."""
+    if options["settlement"] is not None:
+        return options["settlement"]
+    if "settlement_target" in scene.model:
+        return float(scene.model.settlement_target.values)
+    return options["settlement_ratio"] * masonry_height(scene) * scene.scales.length
+
+
+def plateau_tolerance(scene: Scene, options: Mapping[str, Any]) -> float:
+    """The option, else none when the run goes to the model's settlement_target (the damage there is the
+    answer), else :data:`PLATEAU_TOLERANCE`."""
+    if options["plateau_tolerance"] is not None:
+        return options["plateau_tolerance"]
+    return 0.0 if options["settlement"] is None and "settlement_target" in scene.model else PLATEAU_TOLERANCE
+
+
+def make_controls(scene: Scene, options: Mapping[str, Any]) -> Controls:
+    length, force = scene.scales.length, scene.scales.force
+    if options["contact_stiffness"] is not None:
+        kn = options["contact_stiffness"] * length**2 / force
+    else:
+        base_pressure = 1.0 / scene.support_length
+        kn = base_pressure / (options["penetration_ratio"] * scene.unit_height)
+    dt_critical = critical_time_step(scene, kn)
+    dt = options["dt_safety"] * dt_critical
+    height = masonry_height(scene)
+    target = target_settlement(scene, options) / length
+    rate = options["loading_rate"] * np.sqrt(height)
+    target_time = target / rate if rate > 0 else 0.0
+    record_steps = max(1, int(target_time / dt / options["records"])) if target > 0 else 2000
+    return Controls(
+        kn=kn,
+        kt=options["shear_stiffness_ratio"] * kn,
+        min_half=0.5 * options["min_contact_length"] * scene.unit_height,
+        contact_damping=options["contact_damping"],
+        dt=dt,
+        dt_critical=dt_critical,
+        damping=options["damping"],
+        target=target,
+        rate=rate,
+        ramp_time=max(options["ramp_fraction"] * target_time, dt),
+        load_ramp=options["load_ramp"] / scene.scales.time,
+        gravity_time=(options["gravity_time"] or 0.0) / scene.scales.time,
+        rest_tolerance=options["rest_tolerance"],
+        max_steps=options["max_steps"],
+        record_steps=record_steps,
+        buffer=options["buffer_ratio"] * scene.unit_height,
+        max_penetration=0.25 * scene.unit_height,
+        min_cos=float(np.cos(np.radians(options["max_contact_angle"]))),
+        sleep_speed=options["sleep"] * rate,
+        sleep_steps=options["sleep_steps"],
+        wake_force=options["wake_force"],
+        plateau_tolerance=plateau_tolerance(scene, options),
+        plateau_window=options["plateau_window"],
+        snapshots=tuple(v / length for v in options["snapshots"]),
+        search=searches(scene, options),
+        search_first=options["search_first"],
+        search_limit=options["search_limit"],
+        search_tolerance=options["search_tolerance"],
+        search_step_time=SEARCH_STEP_TIME,
+        search_trial_time=SEARCH_TRIAL_TIME,
+        collapse_motion=options["collapse_motion"] * scene.unit_height,
+    )
+
+
+def searches(scene: Scene, options: Mapping[str, Any]) -> bool:
+    """The load-factor search runs when load_factor is auto, no support moves and the masonry has a live load."""
+    return options["load_factor"] is None and not scene.moving.any() and bool(np.any(scene.live != 0))

@@ -1,0 +1,77 @@
+"""The core's shape: its modules import one another at the top only and in one direction (no cycle), and
+its public API is the curated, documented list of docs/api.md."""
+from __future__ import annotations
+
+import ast
+import inspect
+import re
+from pathlib import Path
+
+import masonryfw as mf
+
+CORE = Path(mf.__file__).resolve().parent
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def core_imports() -> tuple[dict[str, set[str]], list[str]]:
+    """Per core module, the core modules it imports at module level; and every import of a core module made
+    inside a function (``module:line``)."""
+    modules = {p.stem for p in CORE.glob("*.py")} | {"datasets"}
+    graph, deferred = {}, []
+    for path in sorted(CORE.glob("*.py")):
+        tree = ast.parse(path.read_text())
+        top = set()
+        for node in ast.walk(tree):
+            if not isinstance(node, ast.ImportFrom) or node.level == 0 and not (node.module or "").startswith("masonryfw"):
+                continue
+            name = (node.module or "").removeprefix("masonryfw").lstrip(".").split(".")[0]
+            targets = {name} if name else {alias.name for alias in node.names}
+            targets &= modules
+            if not targets:
+                continue
+            if any(node in ast.walk(f) for f in ast.walk(tree) if isinstance(f, (ast.FunctionDef, ast.AsyncFunctionDef))):
+                deferred.append(f"{path.stem}:{node.lineno}")
+            else:
+                top |= targets
+        graph[path.stem] = top - {path.stem}
+    return graph, deferred
+
+
+def cycles(graph: dict[str, set[str]]) -> list[list[str]]:
+    found, state = [], {}
+
+    def visit(node: str, path: list[str]) -> None:
+        state[node] = "open"
+        for nxt in sorted(graph.get(node, ())):
+            if state.get(nxt) == "open":
+                found.append(path[path.index(nxt):] + [nxt])
+            elif nxt not in state:
+                visit(nxt, path + [nxt])
+        state[node] = "done"
+
+    for node in sorted(graph):
+        if node not in state:
+            visit(node, [node])
+    return found
+
+
+def test_core_modules_import_each_other_at_the_top_and_without_a_cycle():
+    graph, deferred = core_imports()
+    assert {"api", "registry", "provenance", "options", "sources", "model", "semantics"} <= set(graph)
+    assert deferred == []
+    assert cycles(graph) == []
+    # the layers the architecture names: the lowest know nothing of the plugins or of the builder
+    for low in ("model", "semantics", "options", "geometry", "schema", "errors"):
+        assert not graph[low] & {"api", "registry", "provenance", "builder", "sources", "cli"}, (low, graph[low])
+    assert "builder" in graph["sources"] and "sources" not in graph["builder"]
+
+
+def test_the_public_api_is_the_documented_list():
+    documented = set(re.findall(r"^\| `([A-Za-z_][A-Za-z0-9_]*)`", (ROOT / "docs" / "api.md").read_text(), re.M))
+    assert set(mf.__all__) == documented
+    assert len(mf.__all__) == len(set(mf.__all__))
+    assert all(hasattr(mf, name) for name in mf.__all__)
+    assert not [name for name in mf.__all__ if type(getattr(mf, name)).__name__ == "module"]
+    undocumented = [name for name in mf.__all__ if (inspect.isfunction(getattr(mf, name)) or inspect.isclass(
+        getattr(mf, name))) and not getattr(mf, name).__doc__]
+    assert undocumented == []

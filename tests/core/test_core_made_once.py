@@ -1,0 +1,76 @@
+"""What the core does once, and when it must do it again: a model checked once is checked again when
+its contents change (even in place); a solve makes the solver's estimate once; a comparison checks
+each input once."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import xarray as xr
+
+import masonryfw as mf
+from masonryfw import api, registry
+
+
+class Plugin:
+    def __init__(self, solver):
+        self.solver = solver
+
+    @mf.hookimpl
+    def masonryfw_solvers(self):
+        return [self.solver]
+
+
+@pytest.fixture
+def counting_solver():
+    """A solver that stays still, and counts the calls of its estimate."""
+    calls = []
+
+    def still(model, options, progress):
+        return xr.Dataset(mf.motion_variables(np.zeros((model.sizes["block"], 3))),
+                          attrs={"rotations": "small", "flow_rule": "associative"})
+
+    def estimate(model, options):
+        calls.append(options["scale"])
+        return mf.Estimate(seconds=0.1, memory=1e6, basis="counted")
+
+    registry.reset()
+    solver = mf.Solver("still", "nothing moves", still, estimate=estimate,
+                       options=(mf.Option("scale", float, 1.0, "unused", above=0.0),))
+    mf.plugin_manager().register(Plugin(solver), name="still")
+    yield calls
+    registry.reset()
+
+
+def test_an_array_edited_in_place_is_checked_again():
+    model = mf.open_model("test-12c")
+    assert mf.checked_model(model) is not None
+    model.block_unit_weight.values[3] = -1.0  # in place: the same array object
+    with pytest.raises(mf.ModelError, match="block_unit_weight"):
+        mf.checked_model(model)
+
+
+def test_a_solve_makes_the_estimate_once_per_model_and_options(counting_solver):
+    model = mf.checked_model(mf.open_model("test-12c"))
+    assert mf.estimate(model, "still").basis == "counted"
+    mf.solve(model, "still")
+    assert counting_solver == [1.0]
+    mf.solve(model, "still", {"scale": 2.0})  # other options: a new estimate
+    assert counting_solver == [1.0, 2.0]
+    edited = model.copy(deep=True)
+    edited.block_unit_weight.values[3] *= 1.5  # other contents: a new estimate
+    mf.solve(edited, "still")
+    assert counting_solver == [1.0, 2.0, 1.0]
+
+
+def test_a_comparison_of_n_results_checks_each_once(monkeypatch):
+    model = mf.open_model("test-12c")
+    results = [mf.solve(model, "la", {"solver": backend}) for backend in ("ipm", "clarabel", "highs")]
+    checked = []
+    real = api.check
+    monkeypatch.setattr(api, "check", lambda ds, **kw: checked.append(kw.get("kind")) or real(ds, **kw))
+    for other in results[1:]:
+        mf.compare(results[0], other)
+    assert checked.count("result") == 3  # the first result once, not once per comparison
+    results[0].block_unit_weight.values[3] = -1.0  # edited in place: checked again, and refused
+    with pytest.raises(mf.ModelError, match="block_unit_weight"):
+        mf.compare(results[0], results[1])
