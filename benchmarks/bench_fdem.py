@@ -54,7 +54,7 @@ def throughput_row(case: str, options: dict) -> str:
     steps = result.attrs["fdem_steps"]
     pairs = result.attrs["fdem_face_pairs"]
     settled = 1e3 * result.step_settlement.values[-1]
-    return (f"| {case} | {int((model.block_role.values < 2).sum())} | {options or 'defaults'} | {settled:.1f} | "
+    return (f"| {case} | {int(mf.masonry_blocks(model.block_role.values).sum())} | {options or 'defaults'} | {settled:.1f} | "
             f"{result.attrs['stop_reason']} | {steps} | {result.attrs['fdem_dt_s']:.2e} | {seconds:.1f} | "
             f"{seconds / steps * 1e6:.0f} | {pairs * steps / seconds / 1e6:.1f} |")
 

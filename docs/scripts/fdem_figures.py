@@ -28,12 +28,11 @@ PAPER_MACRO_BLOCKS = {"test-8c": "3", "test-12c": "2", "panel-1": "many", "panel
 
 
 def masonry_macro_blocks(result) -> int:
-    masonry = result.block_role.values < 2
-    return int(np.unique(result.macro_block.values[masonry]).size)
+    return int({number.name: number.value for number in mf.key_numbers(result)}["macro_blocks"])
 
 
 def largest_share(result, count: int) -> float:
-    masonry = result.block_role.values < 2
+    masonry = mf.masonry_blocks(result.block_role.values)
     sizes = np.sort(np.bincount(result.macro_block.values[masonry]))[::-1]
     return float(sizes[:count].sum() / masonry.sum())
 
@@ -68,7 +67,7 @@ def run_case(case: str, options: dict) -> dict:
     phase = fdem.step_phase.values == 1
     return {
         "case": case,
-        "blocks": int((model.block_role.values < 2).sum()),
+        "blocks": int(mf.masonry_blocks(model.block_role.values).sum()),
         "time_s": seconds,
         "steps": int(fdem.attrs["fdem_steps"]),
         "stop": fdem.attrs["stop_reason"],

@@ -4,8 +4,8 @@ Scores (each present only where both results carry what it needs; see
 docs/agreement.md for the definitions and the choice of the threshold):
 
 - ``crack_indicator`` (per interface): counts, precision, recall, F1 and Jaccard
-  of the cracked sets (indicator > ``threshold``), the length-weighted overlap
-  ``sum(L min) / sum(L max)`` and the Spearman rank correlation (threshold-free);
+  of the cracked sets (the core's, at ``threshold``), the length-weighted overlap
+  ``sum(L min) / sum(L max)`` and the Spearman rank correlation of the indicators;
 - ``macro_block``: adjusted Rand index of the two partitions of the masonry blocks;
 - ``block_displacement``: cosine of the two rigid displacement fields;
 - the failure locus (cracked joints, or plastic points of a continuum result):

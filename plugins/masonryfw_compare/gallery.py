@@ -294,8 +294,9 @@ of a pair.
 - **F1** = 2|A and B| / (|A| + |B|), **Jaccard** = |A and B| / |A or B| of the cracked
   sets (precision |A and B|/|B| and recall |A and B|/|A| are in the comparison dataset too).
 - **overlap** = sum(L min(a, b)) / sum(L max(a, b)) over the interfaces, L the joint
-  length, a and b the indicators: threshold-free, the length-weighted Jaccard of 0/1 patterns.
-- **Spearman**: rank correlation of the two indicators over all interfaces (threshold-free).
+  length, a and b the indicators (each 0 on intact joints): the length-weighted Jaccard of 0/1 patterns,
+  weighted by how much each joint moves.
+- **Spearman**: rank correlation of the two indicators over all interfaces.
 - **ARI**: adjusted Rand index of the two `macro_block` partitions of the masonry
   blocks (support blocks left out: they are boundary conditions); 1 = the same
   macro-blocks, about 0 = chance.
