@@ -18,6 +18,7 @@ import masonryfw as mf
 
 from . import scenarios
 from .diagnosis import EXPLAINED, KEPT, PLAUSIBLE_MARGIN, Diagnosis, profile_of
+from .scoring import SURVEY_THRESHOLD
 
 TABLE_KEYS = ("start", "end", "center", "width")
 
@@ -58,7 +59,8 @@ def _kept_variables(diagnosis: Diagnosis) -> dict:
         "kept_block_displacement": (("kept", "block", "axis"),
                                     np.stack([c.result.block_displacement.values for c in kept])),
         "kept_block_rotation": (("kept", "block"), np.stack([c.result.block_rotation.values for c in kept])),
-        "kept_crack_indicator": (("kept", "interface"), np.stack([c.result.crack_indicator.values for c in kept])),
+        "kept_crack_indicator": (("kept", "interface"), np.stack(
+            [mf.at_threshold(c.result, SURVEY_THRESHOLD).crack_indicator.values for c in kept])),
     }
     return {name: (dims, values, mf.variable_attrs(name, "diagnosis")) for name, (dims, values) in columns.items()}
 
