@@ -43,9 +43,10 @@ def random_case(seed: int) -> dict:
                      diagnosis.extent, diagnosis.segment)
 
 
+@pytest.mark.slow  # 11-13 s; the bundled walls' diagnoses run by default (test_diagnose.py)
 def test_random_walls_point_back_to_their_scenario():
-    """Seeds 0-2 of the study: the family right and the truth in the plausible set in each (``-m slow`` adds
-    seeds 3-5, where seed 3's one-unit step at the end reads as a trough beyond it, and the thirty)."""
+    """Seeds 0-2 of the study: the family right and the truth in the plausible set in each (seeds 3-5,
+    where seed 3's one-unit step at the end reads as a trough beyond it, and the thirty are slow too)."""
     verdicts = [random_case(seed) for seed in range(3)]
     assert all(v["family"] for v in verdicts), verdicts
     assert all(v["in_plausible"] for v in verdicts), verdicts
