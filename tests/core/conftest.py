@@ -117,3 +117,27 @@ def model_file(tmp_path):
     path = tmp_path / "hand_wall.nc"
     hand_model().to_netcdf(path)
     return path
+
+
+class _SolverPlugin:
+    def __init__(self, solver):
+        self.solver = solver
+
+    @mf.hookimpl
+    def masonryfw_solvers(self):
+        return [self.solver]
+
+
+@pytest.fixture
+def registered():
+    """``register(solve, name, **record)``: a hand-made solver registered as a plugin for one test."""
+    from masonryfw import registry
+
+    registry.reset()
+    manager = mf.plugin_manager()
+
+    def register(solve, name="tipping", **record):
+        manager.register(_SolverPlugin(mf.Solver(name, "hand mechanism", solve, **record)), name=name)
+    yield register
+    registry.reset()
+

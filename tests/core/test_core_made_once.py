@@ -8,20 +8,11 @@ import pytest
 import xarray as xr
 
 import masonryfw as mf
-from masonryfw import api, registry
-
-
-class Plugin:
-    def __init__(self, solver):
-        self.solver = solver
-
-    @mf.hookimpl
-    def masonryfw_solvers(self):
-        return [self.solver]
+from masonryfw import api
 
 
 @pytest.fixture
-def counting_solver():
+def counting_solver(registered):
     """A solver that stays still, and counts the calls of its estimate."""
     calls = []
 
@@ -33,12 +24,8 @@ def counting_solver():
         calls.append(options["scale"])
         return mf.Estimate(seconds=0.1, memory=1e6, basis="counted")
 
-    registry.reset()
-    solver = mf.Solver("still", "nothing moves", still, estimate=estimate,
-                       options=(mf.Option("scale", float, 1.0, "unused", above=0.0),))
-    mf.plugin_manager().register(Plugin(solver), name="still")
-    yield calls
-    registry.reset()
+    registered(still, "still", estimate=estimate, options=(mf.Option("scale", float, 1.0, "unused", above=0.0),))
+    return calls
 
 
 def test_an_array_edited_in_place_is_checked_again():

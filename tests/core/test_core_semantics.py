@@ -211,28 +211,6 @@ def test_macro_blocks_are_the_groups_joined_by_intact_joints(seed):
 
 # ---------------------------------------------------------------- derived once by mf.solve, for any solver
 
-class Plugin:
-    def __init__(self, solver):
-        self.solver = solver
-
-    @mf.hookimpl
-    def masonryfw_solvers(self):
-        return [self.solver]
-
-
-@pytest.fixture
-def registered(monkeypatch):
-    from masonryfw import registry
-
-    registry.reset()
-    manager = mf.plugin_manager()
-
-    def register(solve, name="tipping"):
-        manager.register(Plugin(mf.Solver(name, "hand mechanism", solve)), name=name)
-    yield register
-    registry.reset()
-
-
 def test_a_third_party_mechanism_gets_the_core_s_fields(registered):
     """B tips about its left corner: its bed joint opens (state open, indicator 1), B is its own macro-block."""
     theta = 0.01
