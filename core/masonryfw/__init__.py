@@ -64,6 +64,7 @@ from .semantics import (
     crack_indicator,
     cracked_joints,
     dead_reaction,
+    indicator_at,
     interface_states,
     joint_motion,
     key_numbers,
@@ -124,7 +125,7 @@ __all__ = [
     "ProgressCallback", "interruptible", "no_progress", "progress_bar",
     # What results mean: one definition for every solver
     "CRACK_THRESHOLD", "KeyNumber", "ModelScales", "at_threshold", "connected_components", "crack_indicator",
-    "cracked_joints", "dead_reaction", "interface_states", "joint_motion", "key_numbers", "macro_blocks",
+    "cracked_joints", "dead_reaction", "indicator_at", "interface_states", "joint_motion", "key_numbers", "macro_blocks",
     "masonry_blocks", "masonry_joints", "model_scales", "nearest_interface", "plastic_crack_indicator",
     "point_motion", "polar_moment", "refuse_rigid_settlement", "relative_motion", "rigid_fit", "settlement_reaction",
     "settlement_weights", "support_blocks",

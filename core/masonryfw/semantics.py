@@ -338,43 +338,52 @@ def indicator_attrs(threshold: float) -> dict:
     return {**variable_attrs("crack_indicator"), "crack_threshold": float(threshold)}
 
 
+def indicator_at(result: xr.Dataset, threshold: float = CRACK_THRESHOLD) -> np.ndarray:
+    """``result``'s ``crack_indicator`` at a crack threshold: as stored when it was derived there (its
+    attribute ``crack_threshold``), else from the relative motion at the joints of a block result, from the
+    plastic points of a continuum one, or, for a result with only an indicator, the part of it above the
+    threshold. The cheap part of :func:`at_threshold` (no states, no macro-blocks)."""
+    indicator = np.asarray(result.crack_indicator.values, dtype=float)
+    if result.crack_indicator.attrs.get("crack_threshold") == threshold:
+        return indicator
+    if "interface_opening" in result and "interface_slip" in result:
+        motion = joint_motion(result.interface_opening.values, result.interface_slip.values)
+        return crack_indicator(motion, masonry_joints(result.block_role.values, result.interface_blocks.values),
+                               threshold)
+    if "qp_failure" in result:
+        return plastic_crack_indicator(result, result.qp_x.values, result.qp_y.values, result.qp_failure.values > 0,
+                                       threshold)
+    return np.where(indicator > threshold, indicator, 0.0)
+
+
 def at_threshold(result: xr.Dataset, threshold: float = CRACK_THRESHOLD) -> xr.Dataset:
-    """``result`` with ``interface_state``, ``crack_indicator`` and ``macro_block`` derived at another crack
-    threshold (a user's ``threshold`` option): from the relative motion at the joints of a block result,
-    from the plastic points of a continuum one; a result with only an indicator keeps the part of it
-    above the threshold. A result whose ``crack_indicator`` says it was derived at ``threshold``
-    (its attribute ``crack_threshold``) is returned as it is."""
-    derived = "crack_indicator" in result and result.crack_indicator.attrs.get("crack_threshold") == threshold
+    """``result`` with ``crack_indicator`` (:func:`indicator_at`), ``interface_state`` and ``macro_block``
+    (from the relative motion at the joints, when the result has it) derived at another crack threshold (a
+    user's ``threshold`` option). A result derived at ``threshold`` already is returned as it is."""
+    if "crack_indicator" not in result:
+        return result
+    derived = result.crack_indicator.attrs.get("crack_threshold") == threshold
     if derived and ("interface_state" in result or "interface_opening" not in result):
         return result
+    fields = {"crack_indicator": ("interface", indicator_at(result, threshold), indicator_attrs(threshold))}
     if "interface_opening" in result and "interface_slip" in result:
         opening, slip = result.interface_opening.values, result.interface_slip.values
-        motion = joint_motion(opening, slip)
         masonry = masonry_joints(result.block_role.values, result.interface_blocks.values)
         rule = str(result.attrs.get("flow_rule", "nonassociative"))
-        state = interface_states(opening, slip, dilatancy(result, rule), intact_threshold(motion, masonry, threshold))
+        limit = intact_threshold(joint_motion(opening, slip), masonry, threshold)
+        state = interface_states(opening, slip, dilatancy(result, rule), limit)
         labels = macro_blocks(result.sizes["block"], result.interface_blocks.values, state)
-        return result.assign(
-            interface_state=("interface", state, variable_attrs("interface_state")),
-            crack_indicator=("interface", crack_indicator(motion, masonry, threshold), indicator_attrs(threshold)),
-            macro_block=("block", labels.astype(np.int32), variable_attrs("macro_block")))
-    if "qp_failure" in result and "crack_indicator" in result:
-        indicator = plastic_crack_indicator(result, result.qp_x.values, result.qp_y.values,
-                                            result.qp_failure.values > 0, threshold)
-        return result.assign(crack_indicator=("interface", indicator, indicator_attrs(threshold)))
-    if "crack_indicator" in result:
-        indicator = np.asarray(result.crack_indicator.values, dtype=float)
-        return result.assign(crack_indicator=("interface", np.where(indicator > threshold, indicator, 0.0),
-                                              indicator_attrs(threshold)))
-    return result
+        fields.update(interface_state=("interface", state, variable_attrs("interface_state")),
+                      macro_block=("block", labels.astype(np.int32), variable_attrs("macro_block")))
+    return result.assign(fields)
 
 
 def cracked_joints(result: xr.Dataset, threshold: float = CRACK_THRESHOLD) -> np.ndarray:
-    """bool per interface: the joints ``result`` has cracked at ``threshold`` (``crack_indicator > 0`` once
-    derived there); every plot, comparison, report and diagnosis counts cracks through this."""
+    """bool per interface: the joints ``result`` has cracked at ``threshold`` (:func:`indicator_at` > 0); every
+    plot, comparison, report and diagnosis counts cracks through this."""
     if "crack_indicator" not in result:
         return np.zeros(result.sizes.get("interface", 0), dtype=bool)
-    return np.asarray(at_threshold(result, threshold).crack_indicator.values) > 0
+    return indicator_at(result, threshold) > 0
 
 
 # ---------------------------------------------------------------- the numbers a user came for

@@ -60,7 +60,7 @@ def _kept_variables(diagnosis: Diagnosis) -> dict:
                                     np.stack([c.result.block_displacement.values for c in kept])),
         "kept_block_rotation": (("kept", "block"), np.stack([c.result.block_rotation.values for c in kept])),
         "kept_crack_indicator": (("kept", "interface"), np.stack(
-            [mf.at_threshold(c.result, SURVEY_THRESHOLD).crack_indicator.values for c in kept])),
+            [mf.indicator_at(c.result, SURVEY_THRESHOLD) for c in kept])),
     }
     return {name: (dims, values, mf.variable_attrs(name, "diagnosis")) for name, (dims, values) in columns.items()}
 

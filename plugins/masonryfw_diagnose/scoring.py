@@ -6,7 +6,7 @@ height ``h`` (the median masonry block height):
 - a **joint is observed** when at least half of its points lie within the tolerance (default h / 2) of a
   surveyed line; a **line matches no joint** when none of its points does;
 - **predicted cracks** are the joints within the masonry that the scenario's mechanism opens or slides,
-  read at :data:`SURVEY_THRESHOLD` (the core's definition, :func:`masonryfw.at_threshold`), each point
+  read at :data:`SURVEY_THRESHOLD` (the core's definition, :func:`masonryfw.indicator_at`), each point
   weighted by its joint's ``crack_indicator``;
 - a point at distance d from the other side counts ``w(d) = exp(-(d / 0.7 h)^2 / 2)``: 1 on it, 0.78 half a
   joint off, 0.36 a joint (one unit height) off, 0.02 two joints off. **Recall** is the mean ``w`` of the surveyed points (how much
@@ -140,7 +140,7 @@ class Score:
 
 def score(wall: Wall, observed: Observed, result: xr.Dataset, widths_mm, levelling: np.ndarray | None) -> Score:
     """How well ``result`` (a mechanism per unit settlement) explains the survey (module docstring)."""
-    indicator = mf.at_threshold(result, SURVEY_THRESHOLD).crack_indicator.values
+    indicator = mf.indicator_at(result, SURVEY_THRESHOLD)
     predicted = wall.inner[wall.joints.owner] & (indicator[wall.joints.owner] > 0)
     pred_xy = wall.joints.xy[predicted]
     c = indicator[wall.joints.owner][predicted] * wall.joints.length[predicted]
