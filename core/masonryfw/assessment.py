@@ -31,13 +31,16 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
-import xarray as xr
 
 from .geometry import block_bounds
 from .profiles import Profile, model_profile
 from .schema import flags, variable_attrs
+
+if TYPE_CHECKING:  # annotations only
+    import xarray as xr
 
 #: Limiting tensile strains of LTSM categories 1 to 4 (Boscardin & Cording 1989; Burland 1995).
 LTSM_LIMITS = (5.0e-4, 7.5e-4, 1.5e-3, 3.0e-3)

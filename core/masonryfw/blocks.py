@@ -35,24 +35,13 @@ from .dofs import block_loads, load_variables
 from .errors import SpecError
 from .geometry import polygon_area_centroid
 from .interfaces import detect_interfaces
+from .material import Material
 from .schema import FORMAT_VERSION, flags, variable_attrs
 
 DOF_NAMES = ("ux", "uy", "rz")
 #: Position tolerance of the interface kinds, relative to the interface length.
 KIND_TOLERANCE = 1.0e-9
 LOADINGS = ("settlement", "tilt")
-
-
-@dataclass(frozen=True)
-class Material:
-    """What every masonry block and joint of a model is made of (SI)."""
-
-    unit_weight: float  # N m-3
-    friction: float  # mu = tan(phi)
-    cohesion: float = 0.0  # Pa
-    tensile_strength: float = 0.0  # Pa
-    young_modulus: float | None = None  # Pa
-    poisson_ratio: float | None = None
 
 
 @dataclass(frozen=True)

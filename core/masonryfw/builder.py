@@ -36,9 +36,9 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, replace
+from typing import TYPE_CHECKING
 
 import numpy as np
-import xarray as xr
 
 from . import blocks
 from .errors import SpecError
@@ -57,6 +57,9 @@ from .spec import (
     read_motion,
     read_spec,
 )
+
+if TYPE_CHECKING:  # annotations only
+    import xarray as xr
 
 #: Relative tolerance on "a whole number of courses" (heights divided by the unit height).
 COURSE_TOLERANCE = 1.0e-6

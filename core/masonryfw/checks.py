@@ -21,9 +21,9 @@ from __future__ import annotations
 
 import json
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
-import xarray as xr
 
 from .dofs import upgrade
 from .geometry import (
@@ -39,6 +39,9 @@ from .geometry import (
     vertex_turns,
 )
 from .schema import FORMAT_VERSION, KINDS, READABLE_VERSIONS, load_schema
+
+if TYPE_CHECKING:  # annotations only
+    import xarray as xr
 
 RELATIVE_TOLERANCE = 1e-6  # lengths below this fraction of the model scale count as zero
 

@@ -30,13 +30,16 @@ categories and the distortion of the imposed settlement profile.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
-import xarray as xr
 
 from .assessment import ltsm_variables
 from .schema import variable_attrs
 from .semantics import masonry_blocks, relative_motion, support_blocks
+
+if TYPE_CHECKING:  # annotations only
+    import xarray as xr
 
 #: Upper crack widths [m] of damage categories 0 to 4 (category 5 beyond the last).
 DAMAGE_LIMITS = (1.0e-4, 1.0e-3, 5.0e-3, 15.0e-3, 25.0e-3)

@@ -8,10 +8,14 @@ block together; these functions convert between the two forms.
 """
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
-import xarray as xr
 
 from .schema import load_schema, variable_attrs
+
+if TYPE_CHECKING:  # annotations only
+    import xarray as xr
 
 #: Variable pairs holding one block vector: (in-plane part (block, axis), rotational part (block,)).
 LOAD_VARIABLES = {"dead": ("dead_load", "dead_moment"), "live": ("live_load", "live_moment")}

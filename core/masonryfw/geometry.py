@@ -13,8 +13,12 @@ Conventions (used by every solver):
 """
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
-import xarray as xr
+
+if TYPE_CHECKING:  # annotations only
+    import xarray as xr
 
 
 def block_offsets(block_node_count: np.ndarray) -> np.ndarray:

@@ -9,14 +9,18 @@ interfaces: what a settlement diagnosis does hundreds of times.
 """
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
-import xarray as xr
 
 from . import blocks
 from .errors import SpecError
 from .geometry import block_bounds, derive_geometry
 from .profiles import Profile, node_motion, with_profile
 from .schema import flags
+
+if TYPE_CHECKING:  # annotations only
+    import xarray as xr
 
 _ROLE = flags("block_role")
 

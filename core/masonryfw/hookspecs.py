@@ -22,14 +22,16 @@ from __future__ import annotations
 import importlib
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import pluggy
-import xarray as xr
 
 from .errors import PluginError
 from .options import Option
 from .progress import ProgressCallback
+
+if TYPE_CHECKING:  # annotations only: listing the plugins does not import xarray
+    import xarray as xr
 
 PROJECT = "masonryfw"
 hookspec = pluggy.HookspecMarker(PROJECT)

@@ -33,9 +33,9 @@ import os
 import re
 from dataclasses import dataclass, replace
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
-import xarray as xr
 
 from . import blocks
 from .drawing import DRAWING_UNITS, Drawing, read_drawing
@@ -46,6 +46,9 @@ from .model import checked_model
 from .profiles import SETTLEMENT_KEYS, profile_segments, read_profile, with_profile
 from .schema import flags
 from .spec import LENGTH_UNITS, SpecTable, check_pivot, read_loading, read_material, read_motion
+
+if TYPE_CHECKING:  # annotations only
+    import xarray as xr
 
 LAYER_ROLES = ("unit", "lintel", "ignore")
 _BLOCK = re.compile(r"\bblock (\d+)\b")

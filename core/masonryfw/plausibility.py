@@ -25,12 +25,15 @@ from __future__ import annotations
 
 import math
 import warnings
+from typing import TYPE_CHECKING
 
 import numpy as np
-import xarray as xr
 
 from .geometry import block_bounds
 from .schema import flags
+
+if TYPE_CHECKING:  # annotations only
+    import xarray as xr
 
 UNIT_WEIGHT = (5.0e3, 40.0e3)  # N m-3
 UNIT_SIZE = (0.01, 2.0)  # m, each side of the median masonry block

@@ -41,13 +41,16 @@ from __future__ import annotations
 import json
 import math
 from dataclasses import asdict, dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
-import xarray as xr
 
 from .errors import SpecError
 from .schema import variable_attrs
 from .spec import SpecTable
+
+if TYPE_CHECKING:  # annotations only
+    import xarray as xr
 
 PROFILES = ("gaussian", "tunnel", "linear", "table", "step")
 SETTLEMENT_KEYS = ("profile", "center", "width", "start", "end", "points", "segment", "cutoff", "depth",

@@ -9,13 +9,14 @@ import json
 import sys
 from collections.abc import Mapping
 from pathlib import Path
-from typing import Any
-
-import xarray as xr
+from typing import TYPE_CHECKING, Any
 
 from .io import content_sha256
 from .registry import Contribution, distribution, lookup
 from .version import __version__
+
+if TYPE_CHECKING:  # annotations only
+    import xarray as xr
 
 
 def plugin_version(item: Contribution) -> str:

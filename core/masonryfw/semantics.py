@@ -35,15 +35,18 @@ histories); :func:`masonryfw.solve` derives the comparable fields below from
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
-import xarray as xr
 
 from .assessment import assess
 from .dofs import block_loads
 from .errors import ModelError
 from .geometry import block_offsets, model_scale, node_block
 from .schema import flags, variable_attrs
+
+if TYPE_CHECKING:  # annotations only
+    import xarray as xr
 
 #: A joint is cracked where it moves more than this share of the largest masonry-joint motion
 #: (``crack_indicator > CRACK_THRESHOLD``), intact otherwise.

@@ -6,8 +6,7 @@ from __future__ import annotations
 
 import os
 from pathlib import Path
-
-import xarray as xr
+from typing import TYPE_CHECKING
 
 from .builder import build
 from .datasets import BUNDLED_NAMES, bundled_spec_path
@@ -15,6 +14,9 @@ from .errors import ModelError
 from .geometry import DERIVED_GEOMETRY_VARIABLES, derive_geometry
 from .io import open_dataset
 from .model import checked_model, model_part
+
+if TYPE_CHECKING:  # annotations only
+    import xarray as xr
 
 #: The suffixes of a spec file (anything else that exists is read as a dataset file).
 SPEC_SUFFIXES = (".toml",)

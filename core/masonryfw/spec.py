@@ -13,9 +13,9 @@ import os
 import re
 from pathlib import Path
 
-from . import blocks
 from .errors import SpecError
 from .inputs import read_text
+from .material import Material
 
 try:  # Python >= 3.11
     import tomllib
@@ -135,7 +135,7 @@ _MATERIAL_KEYS = ("unit_weight", "friction_angle", "friction", "cohesion", "tens
                   "young_modulus", "poisson_ratio")
 
 
-def read_material(top: SpecTable) -> blocks.Material:
+def read_material(top: SpecTable) -> Material:
     """The ``[material]`` table."""
     material = top.sub("material", _MATERIAL_KEYS)
     if material.has("friction_angle") and material.has("friction"):
@@ -146,7 +146,7 @@ def read_material(top: SpecTable) -> blocks.Material:
         raise SpecError("missing spec key 'material.friction_angle' (or 'material.friction')")
     else:
         friction = math.tan(math.radians(material.number("friction_angle", minimum=0.0, below=90.0)))
-    return blocks.Material(
+    return Material(
         unit_weight=material.number("unit_weight", positive=True),
         friction=friction,
         cohesion=material.number("cohesion", 0.0, minimum=0.0),

@@ -12,12 +12,15 @@ import io
 import json
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
-import xarray as xr
 
 from .schema import flags
 from .semantics import key_numbers
+
+if TYPE_CHECKING:  # annotations only
+    import xarray as xr
 
 MISSING = "-"
 #: Scores a comparison table shows first, in this order; then any other scalar score of the comparator ...

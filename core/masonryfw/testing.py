@@ -31,11 +31,10 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping, Sequence
-from typing import Any, ClassVar
+from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
 import pytest
-import xarray as xr
 
 from . import blocks
 from .api import estimate, solve
@@ -45,6 +44,9 @@ from .model import checked_model
 from .registry import get_solver
 from .schema import flags, load_schema
 from .semantics import key_numbers
+
+if TYPE_CHECKING:  # annotations only
+    import xarray as xr
 
 ROLES = flags("block_role")
 

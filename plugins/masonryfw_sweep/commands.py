@@ -11,8 +11,6 @@ import click
 
 import masonryfw as mf
 
-from .store import Store
-
 #: At most this many failed points are listed on the terminal (all are in the output file).
 LISTED_FAILURES = 10
 
@@ -64,6 +62,7 @@ def sweep_command(spec: str, solver: str, params: tuple[str, ...], zipped: bool,
     Writes one dataset with the swept keys as dimensions, and every point's
     result to a content-addressed store; a re-run reuses what the store holds.
     """
+    from .store import Store  # imported here, as the rest: the CLI starts without xarray or dask
     from .sweep import dask_client, failed_points, plan_sweep, run_sweep
 
     if scheduler and workers:

@@ -5,6 +5,8 @@ from __future__ import annotations
 import ast
 import inspect
 import re
+import subprocess
+import sys
 from pathlib import Path
 
 import masonryfw as mf
@@ -75,3 +77,23 @@ def test_the_public_api_is_the_documented_list():
     undocumented = [name for name in mf.__all__ if (inspect.isfunction(getattr(mf, name)) or inspect.isclass(
         getattr(mf, name))) and not getattr(mf, name).__doc__]
     assert undocumented == []
+
+
+def test_the_lazy_api_is_the_stub_and_import_loads_no_science():
+    """``import masonryfw`` resolves names on first use from ``__init__.pyi``: the stub's ``__all__`` is the
+    runtime one, every name comes from the module the stub says, and a fresh interpreter that imports the
+    package and lists the plugins has loaded no xarray, SciPy, numba or matplotlib (NumPy it may: the
+    comparator's default threshold is the core's constant)."""
+    stub = ast.parse((CORE / "__init__.pyi").read_text())
+    declared = next(node.value for node in stub.body if isinstance(node, ast.Assign)
+                    and node.targets[0].id == "__all__")
+    assert sorted(ast.literal_eval(declared)) == sorted(mf.__all__)
+    sources = {alias.asname or alias.name: node.module for node in stub.body if isinstance(node, ast.ImportFrom)
+               for alias in node.names}
+    assert set(sources) == set(mf.__all__)
+    for name, module in sources.items():
+        assert getattr(mf, name) is getattr(__import__(f"masonryfw.{module}", fromlist=[name]), name), name
+    probe = ("import sys, masonryfw\nfrom masonryfw.registry import installed_plugins\ninstalled_plugins()\n"
+             "print(sorted({'xarray', 'scipy', 'numba', 'matplotlib', 'dask'} & set(sys.modules)))")
+    loaded = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, check=True).stdout
+    assert loaded.strip() == "[]"

@@ -192,7 +192,7 @@ def test_result_carries_the_model_and_the_provenance(manager, model):
 
 
 def test_statics_refuses_a_wall_that_touches_no_support(model):
-    from masonryfw_example import solve_statics
+    from masonryfw_example.statics import solve_statics
 
     floating = mf.derive_geometry(model.isel(interface=[0, 1, 2]))  # bed and head joints only
     with pytest.raises(SolveError, match="statics: no wall block rests on a support block"):
