@@ -129,7 +129,9 @@ class Report(NamedTuple):
     stored: float
     unbalanced: float
 
-# error_model="numpy": float division by zero gives inf/nan instead of a checked branch (3x faster)
+# error_model="numpy": float division by zero gives inf/nan instead of a checked branch (3x faster).
+# Lengths are sqrt(x * x + y * y), not np.hypot: libm's hypot guards against overflow, which lengths of
+# order one (non-dimensional) never reach, and it made a step of the 2,432-block wall 1.3x slower.
 jit = njit(cache=True, error_model="numpy")
 pjit = njit(cache=True, error_model="numpy", parallel=True)
 
@@ -160,13 +162,14 @@ def face_geometry(vx, vy, offs, a, ea, b, eb):
     ka, kb = next_node(ea, a, offs), next_node(eb, b, offs)
     ax0, ay0, ax1, ay1 = vx[ea], vy[ea], vx[ka], vy[ka]
     bx0, by0, bx1, by1 = vx[eb], vy[eb], vx[kb], vy[kb]
-    la = np.hypot(ax1 - ax0, ay1 - ay0)
-    lb = np.hypot(bx1 - bx0, by1 - by0)
-    nax, nay = (ay1 - ay0) / la, -(ax1 - ax0) / la
-    nbx, nby = (by1 - by0) / lb, -(bx1 - bx0) / lb
+    la = np.sqrt((ax1 - ax0) ** 2 + (ay1 - ay0) ** 2)
+    lb = np.sqrt((bx1 - bx0) ** 2 + (by1 - by0) ** 2)
+    inv_a, inv_b = 1.0 / la, 1.0 / lb
+    nax, nay = (ay1 - ay0) * inv_a, -(ax1 - ax0) * inv_a
+    nbx, nby = (by1 - by0) * inv_b, -(bx1 - bx0) * inv_b
     cos_angle = nax * nbx + nay * nby
     nx, ny = nax - nbx, nay - nby
-    nn = np.hypot(nx, ny)
+    nn = np.sqrt(nx * nx + ny * ny)
     if cos_angle > -0.1:  # faces at more than ~84 degrees: never a face pair
         return 0.0, 0.0, 0.0, 0.0, 0.0, -1.0, 1e300, 1e300, 0.0, 0.0, cos_angle
     nx, ny = nx / nn, ny / nn
@@ -188,10 +191,12 @@ def face_geometry(vx, vy, offs, a, ea, b, eb):
         e_lo, e_hi = mid, mid
     else:
         e_lo, e_hi = s_lo, s_hi
-    ka_lo = ha0 + (ha1 - ha0) * (e_lo - sa0) / (sa1 - sa0)
-    ka_hi = ha0 + (ha1 - ha0) * (e_hi - sa0) / (sa1 - sa0)
-    kb_lo = hb0 + (hb1 - hb0) * (e_lo - sb0) / (sb1 - sb0)
-    kb_hi = hb0 + (hb1 - hb0) * (e_hi - sb0) / (sb1 - sb0)
+    slope_a = (ha1 - ha0) / (sa1 - sa0)
+    slope_b = (hb1 - hb0) / (sb1 - sb0)
+    ka_lo = ha0 + slope_a * (e_lo - sa0)
+    ka_hi = ha0 + slope_a * (e_hi - sa0)
+    kb_lo = hb0 + slope_b * (e_lo - sb0)
+    kb_hi = hb0 + slope_b * (e_hi - sb0)
     return (nx, ny, ox, oy, s_lo, s_hi, kb_lo - ka_lo, kb_hi - ka_hi,
             0.5 * (ka_lo + kb_lo), 0.5 * (ka_hi + kb_hi), cos_angle)
 
@@ -325,7 +330,7 @@ def wake_sleepers(bodies, pairs, law, motion, vx, vy, wake_speed):
             dvy = (vel[b, 1] + vel[b, 2] * (px - pos[b, 0])) - (vel[a, 1] + vel[a, 2] * (px - pos[a, 0]))
             fn_elastic = -kn * half * (g[6] if e == 0 else g[7])
             losing = normal[f, e] > 0.0 and fn_elastic < 0.5 * normal[f, e]
-            if losing or np.hypot(dvx, dvy) > wake_speed:
+            if losing or dvx * dvx + dvy * dvy > wake_speed * wake_speed:
                 active[sleeper] = 1
                 calm[sleeper] = 0
                 break
@@ -417,7 +422,7 @@ def contact_forces(bodies, pairs, law, motion, vx, vy, force, dt, update_history
                 normal[f, e] = 0.0
                 energy[f, e] = 0.0
                 continue
-            if wake_speed > 0.0 and np.hypot(dvx, dvy) > wake_speed:
+            if wake_speed > 0.0 and dvx * dvx + dvy * dvy > wake_speed * wake_speed:
                 calm[a] = calm[b] = 0  # touched by something moving: neither may fall asleep
             fn = fn_elastic - dashpot * opening_rate
             if not bonded[f, e] and fn < 0.0:
@@ -567,7 +572,7 @@ def move_blocks(bodies, motion, stepping, settlement, sleeping):
             for d in range(3):
                 pos[i, d] += dt * vel[i, d]
             if sleeping:
-                speed = np.hypot(vel[i, 0], vel[i, 1]) + abs(vel[i, 2]) * radius[i]
+                speed = np.sqrt(vel[i, 0] ** 2 + vel[i, 1] ** 2) + abs(vel[i, 2]) * radius[i]
                 calm[i] = calm[i] + 1 if speed < sleep_speed else 0
                 if calm[i] >= sleep_steps:
                     active[i] = 0
@@ -582,8 +587,8 @@ def farthest_move(pos, pos_detect, radius):
     """The largest motion of a block since the last detection (centroid plus rotation times radius)."""
     moved = np.empty(pos.shape[0])
     for i in prange(pos.shape[0]):
-        moved[i] = np.hypot(pos[i, 0] - pos_detect[i, 0], pos[i, 1] - pos_detect[i, 1]) \
-            + abs(pos[i, 2] - pos_detect[i, 2]) * radius[i]
+        dx, dy = pos[i, 0] - pos_detect[i, 0], pos[i, 1] - pos_detect[i, 1]
+        moved[i] = np.sqrt(dx * dx + dy * dy) + abs(pos[i, 2] - pos_detect[i, 2]) * radius[i]
     return moved.max()
 
 
