@@ -5,8 +5,8 @@ The number of time steps to the target settlement is known from the controls (ta
 time (H the masonry's height; measured 0.23-0.68 on six bundled walls, from the 0.6 m Test 12C
 to the 6 m tunnel facade: a fixed share of the settlement steps was 5 % where it is 25-80 % for a
 short target); a step costs about ``STEP_SECONDS_PER_BLOCK`` a block on one thread (2-core AMD
-EPYC, 2026-11-27: 0.45 us on the 1,035-block scale wall, 0.47 and 0.51 us on the two 2,432-block walls of
-docs/benchmarks.md "Where users wait"), ``PARALLEL_EFFICIENCY`` of that less per added thread, times
+EPYC, 2026-11-27, after the kernels dropped ``np.hypot``: 0.38-0.42 us on the 2,432-block wall of
+docs/benchmarks.md "Where users wait", 1,035-block scale wall below), ``PARALLEL_EFFICIENCY`` of that less per added thread, times
 ``DEFORMABLE_FACTOR`` in the (serial) CST mode. A reaction plateau often stops the run earlier: the
 estimate is the longest. The shared machine's speed itself varies from day to day: the same code ran the
 1,035-block wall 1.65x faster on 2026-11-25 (same steps, same reactions), so no constant holds to 25 %
@@ -25,7 +25,7 @@ import masonryfw as mf
 from .controls import make_controls, masonry_height
 from .scene import build_scene
 
-STEP_SECONDS_PER_BLOCK = 0.48e-6  # 2026-11-27: 0.45e-6 (1,035 blocks) to 0.51e-6 (2,432); 0.29e-6 on 2026-11-25
+STEP_SECONDS_PER_BLOCK = 0.40e-6  # 2026-11-27: 0.38e-6 to 0.42e-6 (2,432 blocks, two runs); 0.29e-6 on 2026-11-25
 PARALLEL_EFFICIENCY = 0.95
 # two threads add ~20 us a step of start-up and save ~0.145 us a block: whole processes in alternating pairs,
 # Test 12C (72 blocks) 0.86x on two threads, Facade 3 (480 blocks) 1.59x (docs/benchmarks.md, fdem)
