@@ -44,6 +44,7 @@ from . import blocks
 from .errors import SpecError
 from .imported import build_drawn, is_drawn, parse_drawn_spec, resolved_drawing
 from .inputs import fits_in_memory
+from .material import Material
 from .model import checked_model
 from .plausibility import warn_implausible
 from .profiles import SETTLEMENT_KEYS, Profile, profile_segments, read_profile, with_profile
@@ -151,7 +152,7 @@ class Wall:
     unit_height: float
     pattern: str
     first_course: str
-    material: blocks.Material
+    material: Material
     openings: tuple[Opening, ...]
     supports: tuple[Support, ...]
     loading: str

@@ -16,6 +16,7 @@ import numpy as np
 from . import blocks
 from .errors import SpecError
 from .geometry import block_bounds, derive_geometry
+from .material import Material
 from .profiles import Profile, node_motion, with_profile
 from .schema import flags
 
@@ -60,10 +61,10 @@ def ground_pieces(areas, carried, edges: np.ndarray, tol: float) -> list[tuple]:
     return pieces
 
 
-def masonry_material(model: xr.Dataset) -> blocks.Material:
+def masonry_material(model: xr.Dataset) -> Material:
     """The material of a model's masonry, its median unit weight and joint strengths."""
     masonry = np.isin(model.block_role.values, (_ROLE["unit"], _ROLE["lintel"]))
-    return blocks.Material(
+    return Material(
         unit_weight=float(np.median(model.block_unit_weight.values[masonry])),
         friction=float(np.median(model.interface_friction.values)),
         cohesion=float(np.median(model.interface_cohesion.values)),

@@ -42,6 +42,7 @@ from .drawing import DRAWING_UNITS, Drawing, read_drawing
 from .errors import ModelError, SpecError
 from .geometry import block_bounds, polygon_area_centroid
 from .ground import ground_pieces, made_ground, polygons
+from .material import Material
 from .model import checked_model
 from .profiles import SETTLEMENT_KEYS, profile_segments, read_profile, with_profile
 from .schema import flags
@@ -93,7 +94,7 @@ class DrawnSpec:
     snap_tolerance: float | None
     layers: dict[str, str]
     thickness: float
-    material: blocks.Material
+    material: Material
     supports: tuple[DrawnSupport, ...]
     loading: str
     tilt_direction: int

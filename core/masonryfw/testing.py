@@ -40,6 +40,7 @@ from . import blocks
 from .api import estimate, solve
 from .checks import check
 from .errors import PluginError
+from .material import Material
 from .model import checked_model
 from .registry import get_solver
 from .schema import flags, load_schema
@@ -90,7 +91,7 @@ def rectangles_model(
             motion, pivot = motions.get(int(b), ("translation", None))
             pivot = None if pivot is None else (pivot[0] * length_unit, pivot[1] * length_unit)
             supports.append(blocks.Support(f"support block {b}", "moving", motion, pivot))
-    material = blocks.Material(unit_weight / length_unit**3, friction, cohesion / length_unit**2,
+    material = Material(unit_weight / length_unit**3, friction, cohesion / length_unit**2,
                                tensile_strength / length_unit**2,
                                None if young_modulus is None else young_modulus / length_unit**2, poisson_ratio)
     x0, y0, x1, y1 = rects.T
