@@ -19,25 +19,10 @@ import click
 import numpy as np
 
 import masonryfw as mf
+from masonryfw import signals
 from masonryfw.locks import release_all
 from masonryfw.registry import command_plugin, installed_plugins, plugin_commands
 
-#: The signals that stopped this command: the exit status is 128 + the first (130 after Ctrl-C, 143 after SIGTERM),
-#: as shells report it.
-_SIGNALS: list[int] = []
-
-
-class Terminated(KeyboardInterrupt):
-    """SIGTERM, taken as Ctrl-C is: what an interrupted command keeps, it keeps; temporary files are removed."""
-
-
-def _terminate(signum, frame) -> None:
-    _SIGNALS.append(signum)
-    raise Terminated
-
-
-def _interrupted_status() -> int:
-    return 128 + (_SIGNALS[0] if _SIGNALS else signal.SIGINT)
 LONG_RUN = 60.0  # seconds: the solve command prints the estimate of a run longer than this
 
 
@@ -84,7 +69,7 @@ class _MasonryGroup(click.Group):
                 return super().invoke(ctx)
         except mf.Interrupted as exc:
             click.echo(str(exc), err=True)
-            ctx.exit(_interrupted_status())
+            ctx.exit(signals.exit_status())
         except (mf.MasonryError, OSError) as exc:
             if ctx.params.get("debug"):
                 raise
@@ -327,7 +312,7 @@ def _open_input(path_or_name: str, validate: bool = True):
 @click.option("-o", "--output", type=click.Path(dir_okay=False), help="[default: <model>.<plugin>.nc]")
 @_OPTION
 @click.option("--progress/--no-progress", default=None,
-              help="Draw a progress bar on stderr [default: when stderr is a terminal].")
+              help="Progress on stderr [default: a bar on a terminal, a line a stage or 10 % elsewhere].")
 def solve(model: str, solver: str, output: str | None, options: dict[str, str], progress: bool | None) -> None:
     """Solve MODEL (a model file, a spec file or a bundled case name) with a solver plugin.
 
@@ -348,7 +333,8 @@ def solve(model: str, solver: str, output: str | None, options: dict[str, str], 
     try:
         result = mf.solve(dataset, solver, options, progress=bar)
     except KeyboardInterrupt:
-        raise mf.Interrupted(f"solve {solver}: interrupted before its first step: nothing written") from None
+        raise mf.Interrupted(f"solve {solver}: interrupted before the solver had a result to keep: nothing written") \
+            from None
     finally:
         if bar is not None:
             bar.close()
@@ -467,7 +453,7 @@ def main(argv: list[str] | None = None) -> None:
     """
     if hasattr(signal, "SIGPIPE"):
         signal.signal(signal.SIGPIPE, signal.SIG_DFL)
-    signal.signal(signal.SIGTERM, _terminate)
+    signals.install()
     try:
         code = cli.main(args=argv, prog_name="masonryfw", standalone_mode=False)
     except click.ClickException as exc:  # usage errors: exit 2
@@ -475,10 +461,8 @@ def main(argv: list[str] | None = None) -> None:
         sys.exit(exc.exit_code)
     except click.exceptions.Abort as exc:  # click's form of a KeyboardInterrupt outside a solve
         cause = exc.__cause__ or exc.__context__
-        written = cause if isinstance(cause, mf.WriteInterrupted) else None
-        if written is not None and written.signum not in _SIGNALS:
-            _SIGNALS.append(written.signum)
-        click.echo(f"interrupted after writing {written.path} (complete)" if written else "interrupted: nothing written",
-                   err=True)
-        sys.exit(_interrupted_status())
+        if isinstance(cause, mf.WriteInterrupted) and cause.signum not in signals.RECEIVED:
+            signals.RECEIVED.append(cause.signum)
+        click.echo(signals.kept(), err=True)
+        sys.exit(signals.exit_status())
     sys.exit(code if isinstance(code, int) else 0)

@@ -349,6 +349,7 @@ def write_atomically(writes: dict[Path, Callable[[Path], object]], shown: str | 
                     shutil.copymode(target, temporaries[target])
             for target, temporary in temporaries.items():
                 os.replace(temporary, target)
+                signals.WRITTEN.append(target)
         except BaseException as exc:
             for temporary in temporaries.values():
                 temporary.unlink(missing_ok=True)

@@ -5,9 +5,11 @@ A solver receives a plain callable ``progress(fraction, message)`` with
 """
 from __future__ import annotations
 
+import re
 import shutil
 import sys
 import threading
+import time
 from collections.abc import Callable
 from typing import TypeVar
 
@@ -83,7 +85,37 @@ def fitted(message: str, room: int) -> str:
     return message[:keep - tail] + "..." + message[len(message) - tail:]
 
 
-def progress_bar(wanted: bool | None) -> StderrBar | None:
-    """A bar on stderr: with ``--progress`` always, with ``--no-progress`` never, else when stderr is a terminal."""
-    show = sys.stderr.isatty() if wanted is None else wanted
-    return StderrBar(sys.stderr) if show else None
+class StderrLines:
+    """``progress(fraction, message)`` as whole lines ``[ 40%] message`` on a stream nobody watches as a terminal (a
+    log file, a CI job, a pipe): the first message, every change of stage (the message without its numbers), and
+    otherwise a line each ``step`` of the fraction or each ``interval`` seconds, whichever comes first."""
+
+    def __init__(self, stream, step: float = 0.1, interval: float = 10.0, clock: Callable[[], float] = time.monotonic):
+        self.stream, self.step, self.interval, self.clock = stream, step, interval, clock
+        self.stage: str | None = None
+        self.fraction = 0.0
+        self.when = 0.0
+
+    def __call__(self, fraction: float, message: str = "") -> None:
+        done = min(max(float(fraction), 0.0), 1.0)
+        stage = _NUMBER.sub("#", message)
+        now = self.clock()
+        if stage == self.stage and done < self.fraction + self.step and now < self.when + self.interval:
+            return
+        self.stage, self.fraction, self.when = stage, done, now
+        self.stream.write(f"[{done:4.0%}] {message}\n")
+        self.stream.flush()
+
+    def close(self) -> None:
+        """Nothing to end: every line is whole."""
+
+
+_NUMBER = re.compile(r"[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?")
+
+
+def progress_bar(wanted: bool | None) -> StderrBar | StderrLines | None:
+    """Progress on stderr: with ``--no-progress`` none; with ``--progress``, or by default on a terminal, a bar;
+    by default elsewhere (a log, a pipe), lines (:class:`StderrLines`)."""
+    if wanted is False:
+        return None
+    return StderrBar(sys.stderr) if wanted or sys.stderr.isatty() else StderrLines(sys.stderr)

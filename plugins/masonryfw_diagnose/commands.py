@@ -96,7 +96,7 @@ def _table_lines(table: dict) -> list[str]:
 @click.option("--json", "as_json", is_flag=True, help="Print the diagnosis as one JSON object on stdout.")
 @click.option("-o", "--output", type=click.Path(dir_okay=False), help="[default: <wall>.diagnosis.nc]")
 @click.option("--progress/--no-progress", default=None,
-              help="Draw a progress bar on stderr [default: when stderr is a terminal].")
+              help="Progress on stderr [default: a bar on a terminal, a line a stage or 10 % elsewhere].")
 def diagnose_command(wall: str, cracks: str, cracks_layer: str | None, levelling: str | None, unit: str | None,
                      families: tuple[str, ...], segment: float | None, tolerance: float | None, solver: str,
                      options: tuple[str, ...], verify_with: str | None, top: int, as_json: bool,

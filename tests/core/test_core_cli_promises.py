@@ -2,7 +2,7 @@
 
 - an output path is checked (folder, not an input, writable) before any work, by every command that writes;
 - Ctrl-C keeps an incremental solver's partial result, says where it stopped and exits with 130; a run
-  stopped before its first step writes nothing and says so;
+  stopped before it has a result to keep writes nothing and says so;
 - a closed pipe ends a listing quietly;
 - a missing spec file is called missing; a spec file solves directly;
 - the cracks plot honours its threshold;
@@ -15,12 +15,10 @@ from __future__ import annotations
 import json
 import os
 import re
-import select
 import signal
 import subprocess
 import sys
 import textwrap
-import time
 from pathlib import Path
 
 import numpy as np
@@ -184,44 +182,16 @@ def test_every_writing_command_checks_its_output_folder_first(la_files, args):
 
 # ---------------------------------------------------------------- Ctrl-C
 
-def default_sigint() -> None:
-    """A process started in the background inherits SIGINT ignored, and Python then never raises
-    KeyboardInterrupt: give the child the default disposition, as a terminal would."""
-    signal.signal(signal.SIGINT, signal.SIG_DFL)
-
-
-def start(args, cwd):
-    return subprocess.Popen([sys.executable, "-m", "masonryfw", *map(str, args)], cwd=cwd, text=True,
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, preexec_fn=default_sigint)
-
-
-def wait_for(process, pattern: str, timeout: float = 240.0) -> str:
-    """Read the process's stderr (the progress bar) until ``pattern`` appears."""
-    seen, deadline = "", time.monotonic() + timeout
-    fd = process.stderr.fileno()
-    while time.monotonic() < deadline:
-        ready, _, _ = select.select([fd], [], [], 1.0)
-        if ready:
-            chunk = os.read(fd, 4096).decode(errors="replace")
-            if not chunk:
-                break
-            seen += chunk
-            if re.search(pattern, seen):
-                return seen
-    raise AssertionError(f"never saw {pattern!r} in: {seen[-500:]}")
-
-
 @pytest.mark.parametrize("solver, options, stepping", [
     ("fdem", ["--option", "loading_rate=2e-5"], r"settlement \d+% of target"),
     ("jmm", ["--option", "max_steps=400", "--option", "first_increment=0.002", "--option", "max_increment=0.002"],
      r"step 2: settlement"),
 ])
-def test_ctrl_c_keeps_the_partial_result_and_exits_130(tmp_path, solver, options, stepping):
-    process = start(["solve", "test-12c", "--plugin", solver, "--progress", *options, "-o", "part.nc"], tmp_path)
-    wait_for(process, stepping)
-    process.send_signal(signal.SIGINT)
-    out, err = process.communicate(timeout=120)
-    assert process.returncode == 130, err
+def test_ctrl_c_keeps_the_partial_result_and_exits_130(tmp_path, command, solver, options, stepping):
+    running = command(["solve", "test-12c", "--plugin", solver, "--progress", *options, "-o", "part.nc"], tmp_path)
+    running.wait_for(stepping)
+    status, err, _ = running.signal(signal.SIGINT)
+    assert status == 130, err
     match = re.search(r"interrupted at settlement ([0-9.e+-]+) m: partial result written to part.nc", err)
     assert match, err
     result = mf.open_dataset(tmp_path / "part.nc")
@@ -231,14 +201,13 @@ def test_ctrl_c_keeps_the_partial_result_and_exits_130(tmp_path, solver, options
     assert "Traceback" not in err
 
 
-def test_ctrl_c_before_the_first_step_writes_nothing_and_says_so(tmp_path):
-    process = start(["solve", "test-12c", "--plugin", "jmm", "--progress", "--option", "mesh_size=0.008",
-                     "-o", "none.nc"], tmp_path)
-    wait_for(process, "gravity")
-    process.send_signal(signal.SIGINT)
-    _, err = process.communicate(timeout=120)
-    assert process.returncode == 130, err
-    assert "interrupted before its first step: nothing written" in err
+def test_ctrl_c_before_the_first_step_writes_nothing_and_says_so(tmp_path, command):
+    running = command(["solve", "test-12c", "--plugin", "jmm", "--progress", "--option", "mesh_size=0.008",
+                       "-o", "none.nc"], tmp_path)
+    running.wait_for("gravity")
+    status, err, _ = running.signal(signal.SIGINT)
+    assert status == 130, err
+    assert "interrupted before the solver had a result to keep: nothing written" in err
     assert not (tmp_path / "none.nc").exists() and not list(tmp_path.glob(".*tmp*"))
 
 
