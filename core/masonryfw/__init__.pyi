@@ -25,7 +25,7 @@ from .geometry import (
 )
 from .ground import ground_model, over_profile
 from .hookspecs import Comparator, Estimate, Plotter, Solver, Variant, hookimpl, lazy
-from .inputs import InputError, read_text, regular_file
+from .inputs import InputError, fits_in_memory, read_text, regular_file
 from .interfaces import detect_interfaces
 from .io import (
     check_output_path,
@@ -77,7 +77,7 @@ from .semantics import (
     support_blocks,
 )
 from .signals import WriteInterrupted
-from .sources import SPEC_SUFFIXES, is_spec, open_model, source_path
+from .sources import SPEC_SUFFIXES, input_files, is_spec, open_checked, open_model, source_path
 from .spec import dump_toml
 from .summary import (
     DIAGNOSIS_COLUMNS,
@@ -98,7 +98,7 @@ from .version import __version__ as __version__
 __all__ = [
     # Models: from a spec, a drawing, a file or a bundled case
     "STAND_IN_GROUND", "build", "load_spec", "load_wall",
-    "SPEC_SUFFIXES", "is_spec", "open_model", "source_path",
+    "SPEC_SUFFIXES", "input_files", "is_spec", "open_checked", "open_model", "source_path",
     "checked_model",
     "BUNDLED_NAMES", "CASE_NAMES", "DRAWN_NAMES", "PROFILE_NAMES", "bundled_cases", "bundled_spec_path",
     "DxfLines", "read_dxf_lines",
@@ -130,7 +130,7 @@ __all__ = [
     # Reading and writing files
     "check_output_path", "content_sha256", "open_dataset", "save", "save_figure", "save_text", "sha256_file",
     "write_atomically",
-    "read_text", "regular_file",
+    "fits_in_memory", "read_text", "regular_file",
     "claim", "release",
     "FORMAT_VERSION", "flags", "load_schema", "variable_attrs",
     # Tables and text: what the CLI prints and a report shows

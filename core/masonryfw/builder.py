@@ -189,10 +189,11 @@ def parse_spec(spec: dict) -> Wall:
     unit_height = unit.number("height", length=True, positive=True)
     courses = _whole_courses(height, unit_height, wall.key("height"), wall.raw("height"))
     blocks_expected = courses * (math.ceil(width / unit_length) + 1)
-    fits_in_memory(blocks_expected * BYTES_PER_BLOCK,
-                   f"spec: {wall.key('width')} = {wall.raw('width')!r} {unit_name} and {wall.key('height')} = "
-                   f"{wall.raw('height')!r} {unit_name} in units of {unit.raw('length')!r} x {unit.raw('height')!r} "
-                   f"{unit_name} (about {blocks_expected:.3g} blocks)", "is the size or the length_unit what was meant?")
+    sized = (f"spec: {wall.key('width')} = {wall.raw('width')!r} {unit_name} and {wall.key('height')} = "
+             f"{wall.raw('height')!r} {unit_name} in units of {unit.raw('length')!r} x {unit.raw('height')!r} "
+             f"{unit_name}")
+    fits_in_memory(blocks_expected * BYTES_PER_BLOCK, f"{sized} (about {blocks_expected:.3g} blocks)",
+                   "is the size or the length_unit what was meant?")
     bond = top.sub("bond", ("pattern", "first_course"), {})
 
     material = read_material(top)
@@ -221,6 +222,11 @@ def parse_spec(spec: dict) -> Wall:
     if top.has("settlement"):
         table = top.sub("settlement", SETTLEMENT_KEYS)
         result = replace(result, profile=read_profile(table, 0.0, result.width, result.unit_length))
+        segments = round(result.width / result.profile.segment)
+        fits_in_memory((blocks_expected + segments) * BYTES_PER_BLOCK,
+                       f"{sized} over {segments:,} ground segments of {table.key('segment')} = "
+                       f"{result.profile.segment:.3g} m (about {blocks_expected + segments:.3g} blocks)",
+                       "a longer segment")
         result = replace(result, supports=_profile_supports(result))
     return result
 

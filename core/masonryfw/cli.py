@@ -19,11 +19,15 @@ import click
 import numpy as np
 
 import masonryfw as mf
-from masonryfw import signals
+from masonryfw import inputs, signals
+from masonryfw.command_kit import OPTIONS, PROGRESS, command_line
 from masonryfw.locks import release_all
 from masonryfw.registry import command_plugin, installed_plugins, plugin_commands
 
 LONG_RUN = 60.0  # seconds: the solve command prints the estimate of a run longer than this
+#: Seconds: a run estimated longer starts only with --force or its end set (--option settlement=): a volume loss typed
+#: as 1e6 % made fdem start a run of 785 hours.
+UNASKED_RUN = 12 * 3600.0
 
 
 def _error_message(exc: BaseException) -> str:
@@ -86,25 +90,6 @@ def cli(debug: bool) -> None:
     """Failure analysis of dry-joint masonry walls under foundation settlements."""
 
 
-def _command_line() -> str:
-    return click.get_current_context().obj["command_line"]
-
-
-def _is_path(path_or_name: str) -> bool:
-    return Path(path_or_name).exists()
-
-
-def _option_pairs(ctx, param, value) -> dict[str, str]:
-    try:
-        return mf.parse_option_pairs(value)
-    except mf.PluginError as exc:  # a malformed pair is a usage error (exit 2)
-        raise click.BadParameter(str(exc)) from None
-
-
-_OPTION = click.option(
-    "--option", "options", multiple=True, metavar="KEY=VALUE", callback=_option_pairs,
-    help="A plugin option (repeatable).",
-)
 
 
 # ---------------------------------------------------------------- progress
@@ -117,16 +102,12 @@ _OPTION = click.option(
 def build(spec: str, output: str | None) -> None:
     """Build a model from SPEC (a TOML file or a bundled case name)."""
     spec_path = mf.source_path(spec)
-    inputs = _input_files(spec)
+    inputs = mf.input_files(spec)
     out = Path(output) if output else Path(f"{Path(spec).stem}.nc")
     mf.check_output_path(out, inputs)
     model = mf.build(spec_path)
-    mf.save(model, out, command=_command_line(), protect=inputs)
+    mf.save(model, out, command=command_line(), protect=inputs)
     click.echo(f"wrote {out}: {model.sizes['block']} blocks, {model.sizes.get('interface', 0)} interfaces")
-
-
-def _input_files(*names: str) -> list[Path]:
-    return [Path(n) for n in names if _is_path(n)]
 
 
 @cli.command(name="check")
@@ -302,7 +283,7 @@ def _open_input(path_or_name: str, validate: bool = True):
     (not checked with ``validate`` False: to draw a model that is wrong)."""
     path = Path(path_or_name)
     if path.is_file() and not mf.is_spec(path):
-        return mf.open_dataset(path)
+        return mf.open_checked(path) if validate else mf.open_dataset(path)
     return mf.open_model(path_or_name, validate=validate)
 
 
@@ -310,10 +291,11 @@ def _open_input(path_or_name: str, validate: bool = True):
 @click.argument("model")
 @click.option("--plugin", "solver", required=True, help="Name of the solver (see `masonryfw plugins`).")
 @click.option("-o", "--output", type=click.Path(dir_okay=False), help="[default: <model>.<plugin>.nc]")
-@_OPTION
-@click.option("--progress/--no-progress", default=None,
-              help="Progress on stderr [default: a bar on a terminal, a line a stage or 10 % elsewhere].")
-def solve(model: str, solver: str, output: str | None, options: dict[str, str], progress: bool | None) -> None:
+@OPTIONS
+@PROGRESS
+@click.option("--force", is_flag=True, help=f"Start a run estimated longer than {UNASKED_RUN / 3600:g} h.")
+def solve(model: str, solver: str, output: str | None, options: dict[str, str], progress: bool | None,
+          force: bool) -> None:
     """Solve MODEL (a model file, a spec file or a bundled case name) with a solver plugin.
 
     Prints the headline numbers: alpha and the reaction at collapse (limit
@@ -321,11 +303,15 @@ def solve(model: str, solver: str, output: str | None, options: dict[str, str], 
     (incremental solvers); else the solver's scalar outputs. Ctrl-C keeps what an incremental solver has computed
     so far (exit status 130).
     """
-    inputs = _input_files(model)
+    inputs = mf.input_files(model)
     out = Path(output) if output else Path(f"{Path(model).stem if inputs else model}.{solver}.nc")
     mf.check_output_path(out, inputs)
     dataset = mf.checked_model(mf.open_model(model))  # checked once, for the estimate and the solve
     expected = mf.estimate(dataset, solver, options)
+    if expected is not None and expected.seconds > UNASKED_RUN and not force and "settlement" not in options:
+        raise mf.MasonryError(f"{solver}: expect about {mf.duration_text(expected.seconds)} ({expected.basis}), over "
+                              f"the {UNASKED_RUN / 3600:g} h a run starts without asking; is the model what was meant "
+                              f"(see its warnings)? Run it with --force, or end it sooner with --option settlement=...")
     if expected is not None and expected.seconds > LONG_RUN:
         click.echo(f"{solver}: expect about {mf.duration_text(expected.seconds)} and "
                    f"{mf.size_text(expected.memory)} ({expected.basis}); Ctrl-C keeps what is computed", err=True)
@@ -338,7 +324,7 @@ def solve(model: str, solver: str, output: str | None, options: dict[str, str], 
     finally:
         if bar is not None:
             bar.close()
-    mf.save(result, out, command=_command_line(), protect=inputs)
+    mf.save(result, out, command=command_line(), protect=inputs)
     if int(result.attrs.get("interrupted", 0)):
         raise mf.Interrupted(f"interrupted at settlement {_last_settlement(result)}: partial result written to {out}")
     numbers = ", ".join(map(str, mf.key_numbers(result))) or _scalar_summary(
@@ -362,7 +348,7 @@ def _last_settlement(result) -> str:
 @click.option("--comparator", help="Name of the comparator [default: the only one installed].")
 @click.option("-o", "--output", type=click.Path(dir_okay=False),
               help="Write the comparison dataset here (two results only).")
-@_OPTION
+@OPTIONS
 @click.option("--json", "as_json", is_flag=True, help="Print the scalar scores as JSON.")
 def compare(
     results: tuple[str, ...], comparator: str | None, output: str | None, options: dict[str, str], as_json: bool
@@ -382,7 +368,7 @@ def compare(
     pairs = list(itertools.combinations(range(len(results)), 2))
     comparisons = [mf.compare(datasets[i], datasets[j], comparator, options) for i, j in pairs]
     if output:
-        mf.save(comparisons[0], output, command=_command_line(), protect=list(results))
+        mf.save(comparisons[0], output, command=command_line(), protect=list(results))
     if as_json:
         click.echo(json.dumps(_comparison_json(results, pairs, comparisons), default=str))
         return
@@ -417,14 +403,14 @@ def _comparison_json(results, pairs, comparisons) -> dict:
               help="Image file (png, svg, pdf), or a .csv file of the curves' numbers.")
 @click.option("--format", "file_format", type=click.Choice(["png", "svg", "pdf", "csv"]), default=None,
               help="[default: from the output's suffix] csv: the numbers behind the curves (history).")
-@_OPTION
+@OPTIONS
 def plot(results: tuple[str, ...], kind: str | None, output: str, file_format: str | None,
          options: dict[str, str]) -> None:
     """Plot one or more RESULTS (result or model files, spec files, bundled case names) with a plotter plugin.
 
     Kinds that overlay (history) or set side by side (compare) take several results.
     """
-    inputs = _input_files(*results)
+    inputs = mf.input_files(*results)
     wanted = f".{file_format}" if file_format else Path(output).suffix.lower()
     if wanted != Path(output).suffix.lower():
         raise mf.MasonryError(f"{output}: --format {file_format} needs a file ending in {wanted}")
@@ -454,6 +440,7 @@ def main(argv: list[str] | None = None) -> None:
     if hasattr(signal, "SIGPIPE"):
         signal.signal(signal.SIGPIPE, signal.SIG_DFL)
     signals.install()
+    inputs.guard_reads()
     try:
         code = cli.main(args=argv, prog_name="masonryfw", standalone_mode=False)
     except click.ClickException as exc:  # usage errors: exit 2

@@ -17,7 +17,7 @@ from . import blocks
 from .errors import SpecError
 from .geometry import block_bounds, derive_geometry
 from .material import Material
-from .profiles import Profile, node_motion, with_profile
+from .profiles import Profile, node_motion, segment_count, with_profile
 from .schema import flags
 
 if TYPE_CHECKING:  # annotations only
@@ -76,13 +76,14 @@ def masonry_material(model: xr.Dataset) -> Material:
     )
 
 
-def ground_model(model: xr.Dataset, segment: float) -> xr.Dataset:
+def ground_model(model: xr.Dataset, segment: float, key: str = "segment") -> xr.Dataset:
     """The masonry of ``model`` (its units and lintels; its support kinematics, loads and any profile set aside)
     on its ground cut into vertical strips about ``segment`` long [m], every piece a held support, with its derived
     geometry (not checked: with every segment held it has no live load; a profile makes it whole,
     :func:`over_profile`). The ground is the model's support blocks (the drawn base, a spec's supports), or
     one made under the lowest masonry edges for a model without any. Refused for a wall with no masonry
-    resting on that ground."""
+    resting on that ground, and for a ``segment`` that leaves fewer than two pieces or is finer than a hundredth of
+    the median unit length (:func:`masonryfw.profiles.segment_count`; ``key`` names the segment in the message)."""
     import shapely
 
     role = model.block_role.values
@@ -101,7 +102,8 @@ def ground_model(model: xr.Dataset, segment: float) -> xr.Dataset:
         areas = [made_ground(node_x, node_y, counts, np.ones(counts.size, dtype=bool))]
     bounds = shapely.bounds(areas)
     x0, x1 = float(bounds[:, 0].min()), float(bounds[:, 2].max())
-    edges = np.linspace(x0, x1, max(1, round((x1 - x0) / segment)) + 1)
+    xmin, xmax, _, _ = block_bounds(node_x, node_y, counts)
+    edges = np.linspace(x0, x1, segment_count(x1 - x0, segment, float(np.median(xmax - xmin)), key) + 1)
     carried = shapely.union_all(polygons(node_x, node_y, counts)).boundary
     tol = 1e-6 * float(np.hypot(np.ptp(node_x), np.ptp(node_y)))
     pieces = ground_pieces(areas, carried, edges, tol)

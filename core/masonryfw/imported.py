@@ -274,6 +274,8 @@ def _ground_model(spec: DrawnSpec, drawing: Drawing, kept: np.ndarray, path: Pat
     masonry = np.flatnonzero(kept & ~np.isin(np.arange(kept.size), ground))
     if masonry.size == 0:
         raise SpecError(f"drawing {path.name!r}: every block is ground or ignored; nothing to analyse")
+    if ground.size:
+        _refuse_a_ground_above(spec.settlement, drawing, ground, masonry)
     drawn = polygons(drawing.node_x, drawing.node_y, drawing.block_node_count)
     xmin, xmax, _, _ = block_bounds(drawing.node_x, drawing.node_y, drawing.block_node_count)
     is_masonry = np.isin(np.arange(kept.size), masonry)
@@ -285,6 +287,7 @@ def _ground_model(spec: DrawnSpec, drawing: Drawing, kept: np.ndarray, path: Pat
     tol = 1e-6 * float(np.hypot(np.ptp(drawing.node_x), np.ptp(drawing.node_y)))
     pieces = ground_pieces(areas, shapely.union_all(drawn[masonry]).boundary,
                            np.array([s.start for s in segments] + [segments[-1].end]), tol)
+    _refuse_a_still_ground(spec.settlement, [(shapely.bounds(piece), segments[k].moving) for piece, k in pieces])
     described, labels = [], []
     for piece, k in pieces:
         segment = segments[k]
@@ -304,6 +307,29 @@ def _ground_model(spec: DrawnSpec, drawing: Drawing, kept: np.ndarray, path: Pat
     ds = blocks.model_from_blocks(node_x, node_y, counts, roles, spec.thickness, spec.material, described,
                                   spec.loading, spec.tilt_direction, attrs)
     return with_profile(ds, profile), [drawing.label(b) for b in masonry] + labels
+
+
+def _refuse_a_still_ground(table: SpecTable, pieces: list[tuple[np.ndarray, bool]]) -> None:
+    """A profile that moves none of the ground pieces carrying masonry (a step over a gap of the drawn ground)
+    would settle nothing: refused, naming the keys and where the masonry rests."""
+    if any(moving for _, moving in pieces):
+        return
+    resting = ", ".join(f"{b[0]:.4g}..{b[2]:.4g}" for b, _ in pieces)
+    raise SpecError(f"spec table {table.path!r}: the profile moves none of the ground "
+                    f"that carries masonry (it rests on the ground over x = {resting} m): nothing would settle; "
+                    "move its keys (start, end, center) over those, or fill the gap in the drawn ground")
+
+
+def _refuse_a_ground_above(table: SpecTable, drawing: Drawing, ground: np.ndarray, masonry: np.ndarray) -> None:
+    """The ground chosen by ``ground_layer``/``ground_select`` must lie under the masonry (a layer of bricks given as
+    the ground built a wall upside down that ``check`` passed)."""
+    _, _, ymin, ymax = block_bounds(drawing.node_x, drawing.node_y, drawing.block_node_count)
+    low, high = ymin[masonry].min(), ymax[masonry].max()
+    if ymax[ground].max() > low + 0.5 * (high - low):
+        key = table.key("ground_layer" if table.has("ground_layer") else "ground_select")
+        raise SpecError(f"spec key {key!r}: its blocks reach y = {ymax[ground].max():.4g} m, above the middle of the "
+                        f"masonry (y {low:.4g}..{high:.4g} m); the ground lies under the wall: is it the masonry's "
+                        "layer?")
 
 
 def _ground_blocks(table: SpecTable, drawing: Drawing, kept: np.ndarray) -> np.ndarray:

@@ -6,6 +6,10 @@ through here. Only a regular file is read: a FIFO would block forever, a device
 :data:`TEXT_LIMIT`, and it must be UTF-8; a netCDF file given where text is expected
 is named for what it is. Messages quote positions (line, column, row, feature), never
 the contents of a file that may not be the user's (a spec key can point at any file).
+
+Within a command (:func:`guard_reads`), every file read here is remembered by its device and inode, and no
+output is written onto it, whatever path (link, relative, hard link) the output is given by
+(:func:`was_read`, used by :mod:`masonryfw.io`): a drawn spec's ``-o wall.dxf`` replaced its own drawing.
 """
 from __future__ import annotations
 
@@ -29,6 +33,33 @@ _KINDS = ((stat.S_ISFIFO, "a FIFO (named pipe)"), (stat.S_ISCHR, "a character de
           (stat.S_ISBLK, "a block device"), (stat.S_ISSOCK, "a socket"), (stat.S_ISDIR, "a directory"))
 
 
+#: The (device, inode) of every file read since :func:`guard_reads`; None outside a command (the Python API may
+#: write over what it read, as a user's script asks).
+_READ: set[tuple[int, int]] | None = None
+
+
+def guard_reads() -> None:
+    """A command begins: from now on the files read through this module are never written (:func:`was_read`)."""
+    global _READ
+    _READ = set()
+
+
+def _note_read(info: os.stat_result) -> None:
+    if _READ is not None:
+        _READ.add((info.st_dev, info.st_ino))
+
+
+def was_read(path: str | os.PathLike) -> bool:
+    """Whether the file at ``path`` (through links) was read since :func:`guard_reads`."""
+    if not _READ:
+        return False
+    try:
+        info = os.stat(path)
+    except OSError:
+        return False
+    return (info.st_dev, info.st_ino) in _READ
+
+
 class InputError(MasonryError):
     """A user's file cannot be read as what it is given for; the message names the file and why."""
 
@@ -42,7 +73,8 @@ def regular_file(path: str | os.PathLike, what: str) -> Path:
     """``path`` if it is (or links to) a regular file; else an :class:`InputError` saying what it is."""
     file = Path(path)
     try:
-        mode = file.stat().st_mode
+        info = file.stat()
+        mode = info.st_mode
     except FileNotFoundError:
         broken = " (a broken symbolic link)" if file.is_symlink() else ""
         raise InputError(f"{path}: no such file{broken}") from None
@@ -50,11 +82,12 @@ def regular_file(path: str | os.PathLike, what: str) -> Path:
         raise InputError(f"{path}: cannot be read ({exc.strerror or exc})") from None
     if not stat.S_ISREG(mode):
         raise InputError(f"{path}: is {file_kind(mode)}, not a regular file; a {what} must be a file")
+    _note_read(info)
     return file
 
 
 def fits_in_memory(nbytes: float, what: str, advice: str = "") -> None:
-    """Refuse work that would need more than :func:`available_memory` (``MASONRYFW_MEMORY_LIMIT``)."""
+    """Refuse work that would need more than the memory available (``MASONRYFW_MEMORY_LIMIT``)."""
     available = available_memory()
     if nbytes > available:
         raise InputError(f"{what} needs about {size_text(nbytes)} of memory and {size_text(available)} is available "

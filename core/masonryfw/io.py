@@ -29,7 +29,7 @@ from . import locks, signals
 from .dofs import upgrade
 from .errors import MasonryError, ModelError
 from .geometry import DERIVED_GEOMETRY_VARIABLES
-from .inputs import HDF5_SIGNATURE, file_kind, fits_in_memory, is_netcdf
+from .inputs import HDF5_SIGNATURE, file_kind, fits_in_memory, is_netcdf, regular_file, was_read
 from .schema import load_schema, variable_attrs
 from .version import __version__
 
@@ -174,6 +174,7 @@ def open_dataset(path: str | os.PathLike) -> xr.Dataset:
         raise ModelError(f"{file}: cannot be read ({exc.strerror or exc})") from exc
     if problem:
         raise ModelError(f"{file}: {problem}")
+    regular_file(file, "netCDF file")  # noted as read: never written over by the command (inputs.guard_reads)
     try:
         with xr.open_dataset(file, engine="netcdf4", decode_times=False, decode_timedelta=False) as src:
             _fits_in_memory(src, file)
@@ -191,14 +192,20 @@ def open_dataset(path: str | os.PathLike) -> xr.Dataset:
     return ds
 
 
+#: Memory to check a model and derive its geometry, per block (a model of a million blocks peaked at 2.9 GB).
+CHECK_BYTES_PER_BLOCK = 3000
+
+
 def _fits_in_memory(lazy: xr.Dataset, file: Path) -> None:
-    """Refuse a file whose variables would not fit in memory once read (before reading them: a file of a
-    few MB can hold gigabytes of compressed zeros), naming the largest."""
+    """Refuse a file whose variables would not fit in memory once read, with the work of checking its blocks
+    (before reading them: a file of a few MB can hold gigabytes of compressed zeros), naming the largest."""
     sizes = {name: v.size * (v.dtype.itemsize if v.dtype.kind != "O" else 64) for name, v in lazy.variables.items()}
     largest = max(sizes, key=sizes.__getitem__, default=None)
     if largest is not None:
         dims = ", ".join(f"{d} = {n:,}" for d, n in zip(lazy[largest].dims, lazy[largest].shape))
-        fits_in_memory(sum(sizes.values()), f"{file}: reading it",
+        blocks = lazy.sizes.get("block", 0)
+        fits_in_memory(sum(sizes.values()) + CHECK_BYTES_PER_BLOCK * blocks,
+                       f"{file}: reading it" + (f" and checking its {blocks:,} blocks" if blocks else ""),
                        f"its largest variable is {largest!r} ({dims}); is the file what it should be?")
 
 
@@ -300,6 +307,10 @@ def _refusal(target: Path, ds: xr.Dataset, protect) -> str | None:
     return None
 
 
+def _read_refusal(target: Path) -> str | None:
+    return f"{target.name}, a file this command read" if was_read(target) else None
+
+
 def _writable_target(path: str | os.PathLike, refusal: str | None) -> Path:
     """The absolute target of a write, or a ModelError saying why it must not be written."""
     target = Path(path).resolve()
@@ -310,6 +321,7 @@ def _writable_target(path: str | os.PathLike, refusal: str | None) -> Path:
     if target.exists() and not target.is_file():  # a device or FIFO would be replaced by the rename
         raise ModelError(f"{path}: cannot write: is {file_kind(target.stat().st_mode)}, not a regular file; "
                          "results are written to regular files only")
+    refusal = refusal or _read_refusal(target)
     if refusal:
         raise ModelError(f"{path}: refusing to overwrite {refusal}; write to another path")
     if not os.access(target.parent, os.W_OK | os.X_OK):
@@ -340,6 +352,12 @@ def write_atomically(writes: dict[Path, Callable[[Path], object]], shown: str | 
     temporaries = {target: target.with_name(f".{target.name}.{secrets.token_hex(6)}.tmp{target.suffix}")
                    for target in writes}
     last = list(writes)[-1]
+    read = next((f"{target}: refusing to overwrite {_read_refusal(target)}" for target in writes if was_read(target)),
+                None)
+    if read:  # read after its path was checked (a drawing named in a spec): the work is lost, the input is not
+        for target in writes:
+            locks.release(target)
+        raise ModelError(f"{read}; write to another path")
     with signals.deferred(last):
         try:
             for target, write in writes.items():

@@ -13,7 +13,9 @@ from, what it is and the nearest plausible reading:
   recognised), at most 1 km (a drawing in the wrong unit);
 - friction angles 10-60 degrees (a coefficient or radians typed as degrees is
   recognised);
-- Young's modulus 0.1-100 GPa (MPa or GPa typed as Pa is recognised).
+- Young's modulus 0.1-100 GPa (MPa or GPa typed as Pa is recognised);
+- a tunnel's volume loss 0.1-5 % (a fraction typed for a percentage is recognised), its diameter 1-20 m, and
+  its greenfield S_max at most the wall's height.
 
 They are warnings, not errors: a laboratory model or a deliberately extreme
 study may step outside. ``masonryfw build`` and ``solve`` print them,
@@ -30,6 +32,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from .geometry import block_bounds
+from .profiles import model_profile
 from .schema import flags
 
 if TYPE_CHECKING:  # annotations only
@@ -41,6 +44,8 @@ WALL_SIZE = 0.1  # m, the masonry's smallest extent
 WALL_SIZE_MAX = 1000.0  # m, its largest
 FRICTION_ANGLE = (10.0, 60.0)  # degrees
 YOUNG_MODULUS = (0.1e9, 100.0e9)  # Pa
+VOLUME_LOSS = (0.1, 5.0)  # %: 0.5-3 % is common, soft ground up to about 5 % (Mair et al. 1996)
+TUNNEL_DIAMETER = (1.0, 20.0)  # m: a micro-tunnel to the largest bored tunnels
 GRAVITY = 9.81  # m s-2
 
 
@@ -110,6 +115,7 @@ def plausibility(model: xr.Dataset) -> list[str]:
             messages.append(f"{measured}, more than {WALL_SIZE_MAX:g} m (the longest buildings are a few hundred "
                             f"metres){unit}")
     messages += _friction(model)
+    messages += _tunnel(model, extent["height"])
     if "block_young_modulus" in model:
         young = float(np.median(model.block_young_modulus.values[masonry]))
         if young > 0 and not _within(young, YOUNG_MODULUS):
@@ -140,6 +146,25 @@ def _friction(model: xr.Dataset) -> list[str]:
     advice = f"; probably {' or '.join(readings)}" if readings else ""
     return [f"material.friction_angle (or friction) = {angle:.3g} deg (interface_friction mu = {mu:.6g}): masonry "
             f"joints have {FRICTION_ANGLE[0]:g}-{FRICTION_ANGLE[1]:g} deg{advice}"]
+
+
+def _tunnel(model: xr.Dataset, height: float) -> list[str]:
+    """A tunnel's volume loss, diameter and greenfield S_max against those of real tunnels and the wall."""
+    profile = model_profile(model)
+    if profile is None or profile.kind != "tunnel":
+        return []
+    messages = []
+    if not _within(profile.volume_loss, VOLUME_LOSS):
+        advice = _reading(profile.volume_loss, VOLUME_LOSS, [(100.0, "a fraction was given for a percentage")])
+        messages.append(f"settlement.volume_loss = {profile.volume_loss:.6g} %: tunnels lose {VOLUME_LOSS[0]:g}-"
+                        f"{VOLUME_LOSS[1]:g} % (0.5-3 % is common){advice}")
+    if not _within(profile.diameter, TUNNEL_DIAMETER):
+        messages.append(f"settlement.diameter = {profile.diameter:.6g} m: tunnels are {TUNNEL_DIAMETER[0]:g}-"
+                        f"{TUNNEL_DIAMETER[1]:g} m across")
+    if profile.target > height:
+        messages.append(f"the greenfield S_max = {profile.target:.6g} m of the tunnel (settlement.volume_loss, "
+                        f"diameter, depth, trough_width_factor) is more than the wall's height ({height:.6g} m)")
+    return messages
 
 
 def warn_implausible(model: xr.Dataset) -> None:

@@ -59,6 +59,9 @@ SETTLEMENT_KEYS = ("profile", "center", "width", "start", "end", "points", "segm
 DEFAULT_CUTOFF = 0.01
 #: The default segment length in unit lengths (the convergence study of docs/settlements.md).
 DEFAULT_SEGMENT_UNITS = 0.25
+#: The finest ground: a hundredth of a unit length (the damage converged at a quarter unit, docs/settlements.md; a
+#: segment of 1e-5 m under a 1.1 m wall took 23 GB).
+MAX_SEGMENTS_PER_UNIT = 100
 #: K, the trough width factor of a tunnel (i = K z0) when the spec does not give it: clays (Mair et al. 1996).
 DEFAULT_TROUGH_WIDTH_FACTOR = 0.5
 _TUNNEL_ONLY = ("volume_loss", "diameter", "trough_width_factor", "horizontal")
@@ -130,6 +133,7 @@ def read_profile(table: SpecTable, x0: float, x1: float, unit_length: float) -> 
             raise SpecError(f"spec key {table.key(key)!r} only applies to profile = "
                             f"{' or '.join(map(repr, kinds))}")
     segment = table.number("segment", DEFAULT_SEGMENT_UNITS * unit_length / table.scale, length=True, positive=True)
+    segment_count(x1 - x0, segment, unit_length, f"spec key {table.key('segment')!r}")
     cutoff = table.number("cutoff", DEFAULT_CUTOFF, minimum=0.0, below=1.0)
     if kind == "gaussian":
         return Profile(kind, segment, cutoff, center=table.number("center", length=True),
@@ -169,7 +173,14 @@ def _tunnel(table: SpecTable, segment: float, cutoff: float) -> Profile:
                         f"the ground (the depth of its axis must exceed half its diameter, {table.raw('diameter')!r})")
     factor = table.number("trough_width_factor", DEFAULT_TROUGH_WIDTH_FACTOR, positive=True)
     width = factor * depth
-    s_max = volume_loss / 100.0 * math.pi * diameter**2 / 4.0 / (math.sqrt(2.0 * math.pi) * width)
+    try:
+        s_max = volume_loss / 100.0 * math.pi * diameter**2 / 4.0 / (math.sqrt(2.0 * math.pi) * width)
+    except OverflowError:  # a diameter of 1e200
+        s_max = math.inf
+    if not (math.isfinite(width) and math.isfinite(s_max) and s_max > 0):
+        raise SpecError(f"spec keys {table.key('volume_loss')!r}, {table.key('diameter')!r} and {table.key('depth')!r} "
+                        f"= {table.raw('volume_loss')!r}, {table.raw('diameter')!r}, {table.raw('depth')!r}: the "
+                        f"trough's i = {width:.3g} m and S_max = {s_max:.3g} m are not finite lengths")
     return Profile("tunnel", segment, cutoff, center=table.number("center", length=True), width=width, depth=depth,
                    sideways=table.flag("horizontal", True), target=s_max, volume_loss=volume_loss, diameter=diameter,
                    trough_width_factor=factor)
@@ -216,6 +227,25 @@ def node_motion(profile: Profile, x: np.ndarray) -> tuple[np.ndarray, np.ndarray
 def segment_edges(profile: Profile, x0: float, x1: float) -> np.ndarray:
     """The ends of the ``round((x1 - x0) / segment)`` equal segments from ``x0`` to ``x1`` (at least one)."""
     return np.linspace(x0, x1, max(1, round((x1 - x0) / profile.segment)) + 1)
+
+
+def segment_count(length: float, segment: float, unit_length: float, key: str) -> int:
+    """How many equal segments about ``segment`` long [m] cut a ground ``length`` long: refused, naming ``key``,
+    when ``segment`` is not a positive finite length, leaves fewer than two pieces (the ground would move as one
+    body) or is finer than :data:`MAX_SEGMENTS_PER_UNIT` a unit length ``unit_length``."""
+    if not (math.isfinite(segment) and segment > 0):
+        raise SpecError(f"{key} = {segment!r}: must be a positive, finite length")
+    count = round(length / segment)
+    if count < 2:
+        raise SpecError(f"{key} = {segment:.6g} m: the {length:.6g} m ground would be {max(count, 1)} piece, moving "
+                        f"as one body; give at most {length / 2:.6g} m")
+    finest = unit_length / MAX_SEGMENTS_PER_UNIT
+    if segment < finest * (1 - 1e-9):
+        shown = f"{count:,}" if count < 1e12 else f"{count:.3g}"
+        raise SpecError(f"{key} = {segment:.3g} m: it would cut the {length:.6g} m ground into {shown} segments, "
+                        f"finer than a hundredth of a unit ({unit_length:.6g} m), which no convergence needs (a "
+                        f"quarter unit is the default); give at least {finest:.3g} m")
+    return count
 
 
 def segment_motions(profile: Profile, edges: np.ndarray) -> list[Segment]:

@@ -9,11 +9,14 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from .builder import build
+from .checks import check
 from .datasets import BUNDLED_NAMES, bundled_spec_path
-from .errors import ModelError
+from .errors import MasonryError, ModelError
 from .geometry import DERIVED_GEOMETRY_VARIABLES, derive_geometry
+from .imported import is_drawn, parse_drawn_spec, resolved_drawing
 from .io import open_dataset
 from .model import checked_model, model_part
+from .spec import read_spec
 
 if TYPE_CHECKING:  # annotations only
     import xarray as xr
@@ -43,6 +46,41 @@ def source_path(path_or_name: str | os.PathLike) -> Path:
     if _looks_like_a_path(where):
         raise ModelError(f"{where}: no such file")
     raise ModelError(f"{where}: no such file, and not a bundled case; bundled cases: {', '.join(BUNDLED_NAMES)}")
+
+
+def input_files(*names: str | os.PathLike | None) -> list[Path]:
+    """The user's files that ``names`` (paths, or bundled case names, as commands take them) stand for, and the
+    files those read: a spec and its drawing, a dataset file. A command checks its output against them before
+    its work (:func:`masonryfw.check_output_path`); what it reads later is guarded too (``inputs.guard_reads``)."""
+    files = []
+    for name in names:
+        path = Path(name) if name is not None else None
+        if path is None or not path.is_file():  # a bundled case's files are the package's
+            continue
+        files.append(path)
+        if is_spec(path):
+            files.extend(_drawing_of(path))
+    return files
+
+
+def _drawing_of(spec_path: Path) -> list[Path]:
+    try:
+        spec, _, base_dir = read_spec(spec_path)
+        return [resolved_drawing(parse_drawn_spec(spec), base_dir)] if is_drawn(spec) else []
+    except MasonryError:  # a spec that cannot be read is refused, with its message, by the build
+        return []
+
+
+def open_checked(path: str | os.PathLike) -> xr.Dataset:
+    """A dataset file (a model, result, comparison or diagnosis) read and checked against its format; a
+    :class:`ModelError` lists every problem. What draws or reports a file reads it so: a file can hold anything
+    (NaN scores in a diagnosis ended a report deep in matplotlib)."""
+    ds = open_dataset(path)
+    problems = check(ds)
+    if problems:
+        raise ModelError(f"{path}: not a valid {ds.attrs.get('masonryfw_format', 'masonryfw')} dataset "
+                         f"({len(problems)} problem(s))", problems)
+    return ds
 
 
 def open_model(path_or_name: str | os.PathLike, *, validate: bool = True) -> xr.Dataset:

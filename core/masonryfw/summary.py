@@ -79,13 +79,34 @@ def stages_text(result: xr.Dataset) -> str:
         own = f"{_damage_name(numbers['damage_category'])}, widest crack {_crack_text(numbers)}"
     else:
         own = f"alpha {numbers['alpha']:.4f}, collapse reaction {numbers.get('collapse_reaction', float('nan')):.4g} N"
-    return (f"at S = {_mm(numbers['assessed_settlement'])}: stage 1 {_stage_1(numbers)}; stage 2 (LTSM) "
-            f"{_stage_2(numbers)}; stage 3 ({result_label(result)}) {own}")
+    return (f"at S = {_mm(numbers['assessed_settlement'])}{_short_of_target(result)}: stage 1 {_stage_1(numbers)}; "
+            f"stage 2 (LTSM) {_stage_2(numbers)}; stage 3 ({result_label(result)}) {own}")
+
+
+def _short_of_target(result: xr.Dataset) -> str:
+    """``, reached, short of the model's 15 mm (step limit)`` for a run that stopped before the model's
+    ``settlement_target`` (a tunnel's S_max): its stages are at the settlement reached, not at the target."""
+    reached = short_of_target(result)
+    if reached is None:
+        return ""
+    target = float(result.settlement_target.values)
+    return f", reached, short of the model's {_mm(target)} ({result.attrs.get('stop_reason') or 'stopped'})"
+
+
+def short_of_target(result: xr.Dataset) -> float | None:
+    """The settlement a run reached when it stopped short of its model's ``settlement_target`` [m], else None."""
+    if "settlement_target" not in result or "step_settlement" not in result or not result.step_settlement.size:
+        return None
+    target, reached = float(result.settlement_target.values), float(result.step_settlement.values[-1])
+    return reached if reached < target * (1 - 1e-3) else None
 
 
 def _slope(radians: float) -> str:
-    """``1/830`` (the engineers' way of writing a small slope), ``0`` for none."""
-    return f"1/{1 / abs(radians):.0f}" if radians else "0"
+    """``1/830`` (the engineers' way of writing a small slope), ``0`` for none, ``2.4/1`` for one steeper than
+    1/1 (which the 1/N form wrote as 1/0)."""
+    if not radians:
+        return "0"
+    return f"1/{1 / abs(radians):.0f}" if abs(radians) < 1 else f"{abs(radians):.3g}/1"
 
 
 def _damage_name(category: float) -> str:

@@ -6,6 +6,7 @@ from pathlib import Path
 import click
 
 import masonryfw as mf
+from masonryfw.command_kit import PROGRESS
 
 
 @click.command("gallery")
@@ -54,8 +55,7 @@ def export_command(result: str, file_format: str, output: str | None) -> None:
 @click.command("report")
 @click.argument("results", nargs=-1, required=True, type=click.Path(dir_okay=False, exists=True))
 @click.option("-o", "--output", type=click.Path(dir_okay=False), required=True, help="The HTML file to write.")
-@click.option("--progress/--no-progress", default=None,
-              help="Progress on stderr [default: a bar on a terminal, a line a stage or 10 % elsewhere].")
+@PROGRESS
 def report_command(results: tuple[str, ...], output: str, progress: bool | None) -> None:
     """Write one self-contained HTML report of RESULTS (one model): the wall, its spec, the key numbers,
     every figure, the agreement of the results and their provenance; a diagnosis file (`masonryfw diagnose`)

@@ -51,8 +51,16 @@ def _png(figure) -> str:
 
 def _figure(datasets: Sequence[xr.Dataset], kind: str, caption: str, options: dict | None = None) -> str:
     src = _png(mf.render(list(datasets), kind, options or {}))
-    return (f'<figure data-kind="{kind}"><img src="{src}" alt="{html.escape(caption)}">'
+    return (f'<figure data-kind="{html.escape(kind)}"><img src="{src}" alt="{html.escape(caption)}">'
             f"<figcaption>{html.escape(caption)}</figcaption></figure>")
+
+
+def _number(value, spec: str) -> str:
+    """An attribute of a file as a number in format ``spec``; ``?`` when it is not one (a file can hold anything)."""
+    try:
+        return format(float(value), spec)
+    except (TypeError, ValueError):
+        return "?"
 
 
 def _value_attribute(value: float | None) -> str:
@@ -181,7 +189,7 @@ def _provenance_section(paths: Sequence[str], datasets: Sequence[xr.Dataset], le
             "file": path, "file sha256": digest, "solver": ds.attrs.get("solver", "?"),
             "solver version": ds.attrs.get("solver_version", "?"), "core version": ds.attrs.get("core_version", "?"),
             "options": ds.attrs.get("solver_options", "{}"), "model sha256": ds.attrs.get("model_sha256", "?"),
-            "wall time": f"{float(ds.attrs.get('wall_time_s', 'nan')):.3g} s",
+            "wall time": f"{_number(ds.attrs.get('wall_time_s'), '.3g')} s",
             "stop reason": ds.attrs.get("stop_reason", ""), "history": ds.attrs.get("history", ""),
         }
         cells = "".join(f"<tr><th>{html.escape(k)}</th><td><code>{html.escape(str(v))}</code></td></tr>"
@@ -199,12 +207,13 @@ def _diagnosis_section(path: str, ds: xr.Dataset) -> list[str]:
     columns = list(mf.DIAGNOSIS_COLUMNS)
     source = ", ".join(f"{k} <code>{html.escape(str(ds.attrs[a]))}</code>" for k, a in
                        (("cracks", "source_cracks"), ("levelling", "source_levelling")) if ds.attrs.get(a))
-    facts = (f"{ds.sizes['candidate']} scenarios solved by {ds.attrs.get('solver', '?')} on ground segments of "
-             f"{float(ds.attrs.get('segment', 'nan')):.4g} m ({int(ds.attrs.get('failed_candidates', 0))} could not be "
-             f"solved), scored against the survey ({source}); a surveyed line follows a joint within "
-             f"{float(ds.attrs.get('tolerance', 'nan')):.3g} m. The plausible set: every candidate within "
-             f"{float(ds.attrs.get('plausible_margin', 'nan')):g} of the best score. File sha256 "
-             f"{mf.sha256_file(path)}; made by: {(str(ds.attrs.get('history', '')).splitlines() or [''])[-1]}")
+    made_by = (str(ds.attrs.get("history", "")).splitlines() or [""])[-1]
+    facts = (f"{ds.sizes['candidate']} scenarios solved by {html.escape(str(ds.attrs.get('solver', '?')))} on ground "
+             f"segments of {_number(ds.attrs.get('segment'), '.4g')} m "
+             f"({int(ds.attrs.get('failed_candidates', 0))} could not be solved), scored against the survey "
+             f"({source}); a surveyed line follows a joint within {_number(ds.attrs.get('tolerance'), '.3g')} m. "
+             f"The plausible set: every candidate within {_number(ds.attrs.get('plausible_margin'), 'g')} of the "
+             f"best score. File sha256 {mf.sha256_file(path)}; made by: <code>{html.escape(made_by)}</code>")
     return [f"<h2>Diagnosis: {html.escape(path)}</h2>",
             f"<p><strong>{html.escape(str(ds.attrs.get('verdict', '')))}</strong></p>", f"<p>{facts}</p>",
             _table(["rank", *columns], mf.diagnosis_rows(ds, 10), "diagnosis", columns),
@@ -217,7 +226,7 @@ def report_html(paths: Sequence[str], command: str, progress: Callable[[float, s
     """The report of the results at ``paths`` (one model), and of any diagnosis among them, as one HTML
     document."""
     step = progress or (lambda fraction, message: None)
-    opened = [mf.open_dataset(p) for p in paths]
+    opened = [mf.open_checked(p) for p in paths]
     for path, ds in zip(paths, opened):
         if ds.attrs.get("masonryfw_format") not in ("result", "diagnosis"):
             raise mf.MasonryError(f"{path}: not a result or diagnosis file (masonryfw_format = "

@@ -2,21 +2,13 @@
 from __future__ import annotations
 
 import json
-import shlex
-import sys
 import time
 from pathlib import Path
 
 import click
 
 import masonryfw as mf
-
-
-def _command_line() -> str:
-    obj = click.get_current_context().find_root().obj
-    if isinstance(obj, dict) and obj.get("command_line"):
-        return obj["command_line"]
-    return shlex.join(["masonryfw", *sys.argv[1:]])
+from masonryfw.command_kit import LENGTH, PROGRESS, command_line
 
 
 def _families(ctx, param, value: str) -> tuple[str, ...]:
@@ -80,9 +72,9 @@ def _table_lines(table: dict) -> list[str]:
                    "are always mm.")
 @click.option("--profiles", "families", default="step,gaussian,linear", show_default=True, callback=_families,
               help="The scenario families to try, comma separated.")
-@click.option("--segment", type=click.FloatRange(min=0.0, min_open=True),
+@click.option("--segment", type=LENGTH,
               help="Length of the ground segments [m] [default: the median unit length].")
-@click.option("--tolerance", type=click.FloatRange(min=0.0, min_open=True),
+@click.option("--tolerance", type=LENGTH,
               help="How far a surveyed line may lie from the joint it follows [m] [default: half the median unit "
                    "height].")
 @click.option("--plugin", "solver", default="la", show_default=True,
@@ -95,8 +87,7 @@ def _table_lines(table: dict) -> list[str]:
               help="Candidates listed (the JSON also lists every plausible one).")
 @click.option("--json", "as_json", is_flag=True, help="Print the diagnosis as one JSON object on stdout.")
 @click.option("-o", "--output", type=click.Path(dir_okay=False), help="[default: <wall>.diagnosis.nc]")
-@click.option("--progress/--no-progress", default=None,
-              help="Progress on stderr [default: a bar on a terminal, a line a stage or 10 % elsewhere].")
+@PROGRESS
 def diagnose_command(wall: str, cracks: str, cracks_layer: str | None, levelling: str | None, unit: str | None,
                      families: tuple[str, ...], segment: float | None, tolerance: float | None, solver: str,
                      options: tuple[str, ...], verify_with: str | None, top: int, as_json: bool,
@@ -111,10 +102,10 @@ def diagnose_command(wall: str, cracks: str, cracks_layer: str | None, levelling
     was ranked so far (exit status 130).
     """
     from . import dataset
-    from .diagnosis import KEPT, diagnose, verify, wall_model
+    from .diagnosis import KEPT, prepare, search, verify, wall_model
     from .survey import read_cracks, read_levelling
 
-    inputs = [Path(p) for p in (wall, cracks, levelling) if p and Path(p).is_file()]
+    inputs = mf.input_files(wall, cracks, levelling)
     out = Path(output) if output else _default_output(wall)
     mf.check_output_path(out, inputs)
     survey = read_cracks(cracks, unit, cracks_layer)
@@ -125,22 +116,31 @@ def diagnose_command(wall: str, cracks: str, cracks_layer: str | None, levelling
     if verify_with:
         mf.get_solver(verify_with)
     model = wall_model(wall)
+    diagnosis = prepare(model, survey, families, segment, solver, solver_options, tolerance)
+    expected = f"; expect about {mf.duration_text(diagnosis.expected.seconds)}" if diagnosis.expected else ""
+    click.echo(f"diagnose: {len(diagnosis.tables):,} scenarios ({', '.join(families)}) with {solver} on "
+               f"{len(diagnosis.model.block) - int(mf.masonry_blocks(diagnosis.model.block_role.values).sum())} "
+               f"ground pieces{expected}; Ctrl-C keeps the ranking of those tried", err=True)
     bar = mf.progress_bar(progress)
     started = time.perf_counter()
     try:
-        diagnosis = diagnose(model, survey, families, segment, solver, solver_options, tolerance,
-                             progress=bar or mf.no_progress)
-        if verify_with:
+        search(diagnosis, solver_options, progress=bar or mf.no_progress)
+        if verify_with and not diagnosis.interrupted:
             verify(diagnosis, verify_with, min(top, KEPT), progress=bar or mf.no_progress)
     finally:
         if bar is not None:
             bar.close()
     seconds = time.perf_counter() - started
-    mf.save(dataset.to_dataset(diagnosis, wall), out, command=_command_line(), protect=inputs)
+    mf.save(dataset.to_dataset(diagnosis, wall), out, command=command_line(), protect=inputs)
     _report(diagnosis, wall, top, as_json, seconds, out)
     if diagnosis.interrupted:
         raise mf.Interrupted(f"interrupted after {len(diagnosis.candidates) + len(diagnosis.failed)} scenario(s): "
                              f"the ranking of those is written to {out}")
+    if diagnosis.verify_interrupted:
+        done = sum(c.verified is not None for c in diagnosis.candidates)
+        raise mf.Interrupted(f"the verification with {verify_with} was interrupted: {done} candidate(s) verified "
+                             f"before it; the run cut short is not kept as a verification; the ranking and those are "
+                             f"written to {out}")
 
 
 def _report(diagnosis, wall: str, top: int, as_json: bool, seconds: float, out: Path) -> None:

@@ -22,7 +22,7 @@ import xarray as xr
 import masonryfw as mf
 
 from . import scenarios, scoring
-from .survey import Survey
+from .survey import UNITS, Survey
 
 #: A candidate within this score of the best is plausible.
 PLAUSIBLE_MARGIN = 0.05
@@ -30,6 +30,9 @@ PLAUSIBLE_MARGIN = 0.05
 EXPLAINED = 0.5
 #: The best candidates whose mechanisms are kept (and drawn, and verified).
 KEPT = 3
+#: The most scenarios a search tries: Facade 3's full search tries 1,339; the steps grow with the square of the
+#: ground pieces (a millimetre's segment under a 1.5 m wall would make 1.1 million).
+MAX_SCENARIOS = 20_000
 
 
 @dataclass
@@ -58,6 +61,9 @@ class Diagnosis:
     failed: list[tuple[dict, str]] = field(default_factory=list)
     verified_with: str = ""
     interrupted: bool = False  # Ctrl-C stopped the search: the candidates are those tried before
+    tables: list[dict] = field(default_factory=list)  # the scenarios to try
+    expected: mf.Estimate | None = None  # the search's time, before it starts
+    verify_interrupted: bool = False  # Ctrl-C stopped the verification: the verified are those finished before
 
     @property
     def best(self) -> Candidate:
@@ -135,6 +141,31 @@ def check_survey(survey: Survey, model: xr.Dataset, margin: float) -> None:
         x, y = survey.levelling[row, :2] / scale
         raise mf.SpecError(f"levelling {survey.sources.get('levelling', '')!r} row {row + 2}: the point ({x:.6g}, "
                            f"{y:.6g}) {unit} is off the wall ({extent})")
+    height = wall[3] - wall[2]
+    if survey.levelling is not None and (np.abs(survey.levelling[:, 2]) > height).any():
+        row = int(np.argmax(np.abs(survey.levelling[:, 2]) > height))
+        raise mf.SpecError(f"levelling {survey.sources.get('levelling', '')!r} row {row + 2}: dy = "
+                           f"{survey.levelling[row, 2] / scale:.6g} {unit} is more than the wall is high "
+                           f"({height / scale:.6g} {unit}); a levelling measures millimetres")
+    _refuse_a_map_in_another_unit(survey, wall, unit, scale)
+
+
+def _refuse_a_map_in_another_unit(survey: Survey, wall: tuple, unit: str, scale: float) -> None:
+    """A map a thousand (or a hundred) times smaller than the wall, which would fit the wall in another unit, was
+    given in that unit: every line then lies in a corner, far from the wall's joints, and nothing explains it."""
+    points = np.concatenate(survey.cracks)
+    span = np.ptp(points, axis=0).max()
+    size = max(wall[1] - wall[0], wall[3] - wall[2])
+    if span >= size / 50:
+        return
+    for other, factor in UNITS.items():
+        moved = points * factor / scale
+        fits = (moved[:, 0].min() >= wall[0] - 0.01 * size and moved[:, 0].max() <= wall[1] + 0.01 * size
+                and moved[:, 1].min() >= wall[2] - 0.01 * size and moved[:, 1].max() <= wall[3] + 0.01 * size)
+        if factor > scale and fits and np.ptp(moved, axis=0).max() >= size / 10:
+            raise mf.SpecError(f"crack map {survey.sources.get('cracks', '')!r}: read in {unit}, its lines span "
+                               f"{span / scale:.3g} {unit} of a wall {size / scale:.6g} {unit} across, far from its "
+                               f"joints; in {other} they cover the wall: give --unit {other}")
 
 
 def ground_pieces(model: xr.Dataset) -> np.ndarray:
@@ -148,7 +179,15 @@ def ground_pieces(model: xr.Dataset) -> np.ndarray:
 def diagnose(model: xr.Dataset, survey: Survey, families=scenarios.FAMILIES, segment: float | None = None,
              solver: str = "la", options: dict | None = None, tolerance: float | None = None,
              progress=mf.no_progress) -> Diagnosis:
-    """Try every scenario of ``families`` on ``model``'s wall and rank them against ``survey`` (module docstring).
+    """Try every scenario of ``families`` on ``model``'s wall and rank them against ``survey`` (module docstring):
+    :func:`search` of :func:`prepare`."""
+    return search(prepare(model, survey, families, segment, solver, options, tolerance), options, progress)
+
+
+def prepare(model: xr.Dataset, survey: Survey, families=scenarios.FAMILIES, segment: float | None = None,
+            solver: str = "la", options: dict | None = None, tolerance: float | None = None) -> Diagnosis:
+    """The wall on its ground, the survey matched to its joints, the scenarios to try and the search's estimated
+    time: nothing solved yet. Refused beyond :data:`MAX_SCENARIOS` scenarios, saying which ``--segment`` fits.
 
     ``segment`` defaults to the median masonry block length (about a unit length); ``tolerance`` (how far a
     surveyed line may lie from the joint it follows) to half the median block height.
@@ -158,14 +197,40 @@ def diagnose(model: xr.Dataset, survey: Survey, families=scenarios.FAMILIES, seg
     unit_length = float(np.median(xmax[masonry] - xmin[masonry]))
     segment_given = segment is not None
     segment = unit_length if segment is None else segment
-    ground = mf.ground_model(model, segment)
+    ground = mf.ground_model(model, segment, "--segment")
+    pieces = ground_pieces(ground)
+    _refuse_too_many(scenarios.count(pieces, tuple(families)), pieces, segment, families)
     wall = scoring.wall_joints(ground, tolerance)
     check_survey(survey, ground, max(wall.tolerance, wall.unit_height))
     observed = scoring.observe(wall, survey.cracks)
-    pieces = ground_pieces(ground)
     diagnosis = Diagnosis(ground, survey, wall, observed, [], solver, segment, tuple(families),
                           (float(pieces.min()), float(pieces.max())), unit_length, segment_given)
-    tables = scenarios.candidates(pieces, diagnosis.families, segment)
+    diagnosis.tables = scenarios.candidates(pieces, diagnosis.families, segment)
+    one = mf.estimate(mf.over_profile(ground, profile_of(diagnosis, diagnosis.tables[0])), solver, options or {})
+    if one is not None:
+        diagnosis.expected = dataclasses.replace(
+            one, seconds=one.seconds * len(diagnosis.tables),
+            basis=f"{len(diagnosis.tables):,} scenarios of {one.basis}")
+    return diagnosis
+
+
+def _refuse_too_many(count: int, pieces: np.ndarray, segment: float, families) -> None:
+    if count <= MAX_SCENARIOS:
+        return
+    n = len(pieces)
+    per_piece = (count - (n * (n + 1) // 2 - 1)) / n  # the troughs and tilts grow with the pieces, the steps as n^2/2
+    fits = -(0.5 + per_piece) + math.sqrt((0.5 + per_piece) ** 2 + 2 * (MAX_SCENARIOS + 1))
+    fitting = 1.05 * segment * n / fits  # the pieces a segment leaves round to whole ones: a margin
+    raise mf.SpecError(f"diagnose: --segment = {segment:.3g} m cuts the ground into {len(pieces):,} pieces, which "
+                       f"make about {count:,} scenarios of {', '.join(families)} (the steps grow with the square of "
+                       f"the pieces), over the {MAX_SCENARIOS:,} a search tries; give --segment of at least "
+                       f"{fitting:.3g} m, or fewer --profiles")
+
+
+def search(diagnosis: Diagnosis, options: dict | None = None, progress=mf.no_progress) -> Diagnosis:
+    """Solve and score every scenario of a prepared ``diagnosis``, then rank them; Ctrl-C ends the search with
+    those tried (``interrupted``), or propagates when none was."""
+    tables = diagnosis.tables
     try:
         for k, table in enumerate(tables):
             progress(k / len(tables), f"diagnose: {scenarios.describe(table)} ({k + 1} of {len(tables)})")
@@ -174,8 +239,8 @@ def diagnose(model: xr.Dataset, survey: Survey, families=scenarios.FAMILIES, seg
             except mf.MasonryError as exc:
                 diagnosis.failed.append((table, str(exc).splitlines()[0]))
                 continue
-            diagnosis.candidates.append(
-                Candidate(table, scoring.score(wall, observed, result, survey.widths_mm, survey.levelling)))
+            diagnosis.candidates.append(Candidate(table, scoring.score(
+                diagnosis.wall, diagnosis.observed, result, diagnosis.survey.widths_mm, diagnosis.survey.levelling)))
     except KeyboardInterrupt:
         if not diagnosis.candidates:
             raise
@@ -220,7 +285,14 @@ def verify(diagnosis: Diagnosis, solver: str = "fdem", count: int = KEPT, progre
             continue
         progress(k / count, f"verify: {scenarios.describe(candidate.table)} with {solver} to {1e3 * magnitude:.3g} mm")
         profile = dataclasses.replace(profile_of(diagnosis, candidate.table), target=magnitude)
-        result = mf.solve(mf.over_profile(diagnosis.model, profile), solver, {})
+        try:
+            result = mf.solve(mf.over_profile(diagnosis.model, profile), solver, {})
+        except KeyboardInterrupt:
+            diagnosis.verify_interrupted = True
+            return
+        if int(result.attrs.get("interrupted", 0)):  # a run cut short verifies nothing: not kept
+            diagnosis.verify_interrupted = True
+            return
         numbers = {n.name: n.value for n in mf.key_numbers(result)}
         candidate.verified = {key: numbers.get(key) for key in ("crack_width", "damage_category", "minimum_reaction",
                                                                 "dead_reaction", "final_settlement")}

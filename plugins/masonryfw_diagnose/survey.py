@@ -24,6 +24,15 @@ import masonryfw as mf
 UNITS = {"m": 1.0, "cm": 0.01, "mm": 0.001}
 INSUNITS = {4: "mm", 5: "cm", 6: "m"}
 CRACK_FORMATS = (".geojson", ".json", ".csv", ".dxf")
+#: The most lines and points a crack map may hold, and points a levelling: a survey draws tens to hundreds of
+#: cracks and levels a point or a few a unit; a map of 300,000 lines took 2.3 GB and 4.5 minutes.
+MAX_CRACKS = 10_000
+MAX_CRACK_POINTS = 200_000
+MAX_LEVELLING_POINTS = 10_000
+#: The widest crack width a map may give [mm]: Burland's worst category starts at 25 mm.
+MAX_WIDTH_MM = 1000.0
+#: Memory while reading, per byte of a GeoJSON crack map (json.loads of a 53 MB map took 4.6 times its size).
+JSON_BYTES_FACTOR = 6
 
 
 @dataclass(frozen=True)
@@ -57,18 +66,48 @@ def read_cracks(path: str | Path, unit: str | None = None, layer: str | None = N
         unit = unit or "m"
     if not lines:
         raise mf.SpecError(f"crack map {path.name!r}: no crack in it" + (f" on layer {layer!r}" if layer else ""))
+    _check_size(path, len(lines), sum(len(line) for line in lines))
     scale = UNITS[unit]
-    return Survey(tuple(np.asarray(line, dtype=float) * scale for line in lines), tuple(widths), tuple(names),
-                  sources={"cracks": path.name, "unit": unit})
+    cracks = tuple(np.asarray(line, dtype=float) * scale for line in lines)
+    for name, line in zip(names, cracks):
+        _check_line(path, name, line, unit)
+    return Survey(cracks, tuple(widths), tuple(names), sources={"cracks": path.name, "unit": unit})
+
+
+def _check_size(path: Path, lines: int, points: int) -> None:
+    if lines > MAX_CRACKS or points > MAX_CRACK_POINTS:
+        raise mf.SpecError(f"crack map {path.name!r}: {lines:,} lines of {points:,} points; a survey has tens to "
+                           f"hundreds of cracks, and at most {MAX_CRACKS:,} lines of {MAX_CRACK_POINTS:,} points are "
+                           "read: is it a crack map?")
+
+
+def _check_line(path: Path, name: str, line: np.ndarray, unit: str) -> None:
+    """A crack is a line of finite points (a DXF may hold NaN) with a length."""
+    where = f"crack map {path.name!r}: crack {name!r}"
+    if not np.isfinite(line).all():
+        raise mf.SpecError(f"{where}: a coordinate is not a finite number")
+    if not np.hypot(*np.diff(line, axis=0).T).sum() > 0:
+        x, y = line[0] / UNITS[unit]
+        raise mf.SpecError(f"{where}: has no length (its points all lie at ({x:.6g}, {y:.6g}) {unit}); a crack is a line")
+
+
+def _number(value, where: str, what: str) -> float:
+    """``value`` (a JSON number) as a finite float; a :class:`SpecError` naming ``what`` otherwise (an integer of
+    400 digits overflows a float)."""
+    shown = f"{str(value)[:20]}..." if len(str(value)) > 24 else repr(value)
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise mf.SpecError(f"{where}: {what} {shown} is not a number")
+    try:
+        number = float(value)
+    except OverflowError:
+        number = math.inf
+    if not math.isfinite(number):
+        raise mf.SpecError(f"{where}: {what} {shown} is not a finite number")
+    return number
 
 
 def _coordinate(value, where: str) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float)):
-        raise mf.SpecError(f"{where}: coordinate {value!r} is not a number")
-    number = float(value)
-    if not math.isfinite(number):
-        raise mf.SpecError(f"{where}: coordinate {value!r} is not finite")
-    return number
+    return _number(value, where, "coordinate")
 
 
 def _points(raw, where: str) -> list[tuple[float, float]]:
@@ -85,17 +124,25 @@ def _points(raw, where: str) -> list[tuple[float, float]]:
 def _width(value, where: str) -> float | None:
     if value is None:
         return None
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) or value < 0:
-        raise mf.SpecError(f"{where}: width_mm = {value!r} must be a number >= 0")
-    return float(value)
+    width = _number(value, where, "width_mm")
+    if not 0 <= width <= MAX_WIDTH_MM:
+        raise mf.SpecError(f"{where}: width_mm = {width:.6g} is not a crack width in mm (0 to {MAX_WIDTH_MM:g})")
+    return width
 
 
 def _geojson_cracks(path: Path):
+    text = mf.read_text(path, "crack map")
+    mf.fits_in_memory(JSON_BYTES_FACTOR * len(text), f"crack map {path.name!r}: reading it")
     try:
-        data = json.loads(mf.read_text(path, "crack map"))
-    except ValueError as exc:
+        data = json.loads(text)
+    except (ValueError, RecursionError) as exc:  # RecursionError: arrays nested thousands deep
         raise mf.SpecError(f"crack map {path.name!r}: not readable JSON ({type(exc).__name__})") from None
     features = data.get("features") if isinstance(data, dict) and data.get("type") == "FeatureCollection" else [data]
+    if not isinstance(features, list):
+        raise mf.SpecError(f"crack map {path.name!r}: its features are a JSON {type(features).__name__}, not a list "
+                           "of Feature objects")
+    if len(features) > MAX_CRACKS:
+        _check_size(path, len(features), len(features))
     lines, widths, names = [], [], []
     for index, feature in enumerate(features or []):
         where = f"crack map {path.name!r} feature {index}"
@@ -119,36 +166,47 @@ def _geojson_cracks(path: Path):
     return lines, widths, names
 
 
-def _csv_cracks(path: Path):
+def _csv_rows(path: Path, what: str, needed: tuple[str, ...], limit: int):
+    """``(row number, {column: text})`` of a CSV file whose first row names ``needed`` columns (others kept),
+    read one row at a time; refused past ``limit`` rows."""
     try:
-        rows = list(csv.DictReader(io.StringIO(mf.read_text(path, "crack map"), newline="")))
-        columns = [c.strip() for c in (rows[0].keys() if rows else [])]
+        reader = csv.reader(io.StringIO(mf.read_text(path, what), newline=""))
+        header = [c.strip() for c in next(reader, [])]
+        missing = [c for c in needed if c not in header]
+        if header and missing:
+            raise mf.SpecError(f"{what} {path.name!r}: needs the columns {', '.join(needed)} in its first row; "
+                               f"{', '.join(missing)} missing")
+        for number, row in enumerate(reader, start=2):
+            if number - 1 > limit:
+                raise mf.SpecError(f"{what} {path.name!r}: over {limit:,} rows; at most {limit:,} are read (a survey "
+                                   "has a point or a few a unit): is it the right file?")
+            yield number, {name: value.strip() for name, value in zip(header, row)}
     except csv.Error as exc:
-        raise mf.SpecError(f"crack map {path.name!r}: not a readable CSV file ({type(exc).__name__})") from None
-    missing = [c for c in ("crack", "x", "y") if c not in columns]
-    if rows and missing:
-        raise mf.SpecError(f"crack map {path.name!r}: needs the columns crack, x, y (and optionally width_mm) in its "
-                           f"first row; {', '.join(missing)} missing")
+        raise mf.SpecError(f"{what} {path.name!r}: not a readable CSV file ({type(exc).__name__})") from None
+
+
+def _csv_number(text: str, where: str, name: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise mf.SpecError(f"{where}: {name} = {text[:24]!r} is not a number") from None
+    if not math.isfinite(value):
+        raise mf.SpecError(f"{where}: {name} = {text[:24]!r} is not finite")
+    return value
+
+
+def _csv_cracks(path: Path):
     points: dict[str, list] = {}
     widths: dict[str, float | None] = {}
-    for number, row in enumerate(rows, start=2):
-        row = {str(k).strip(): (v or "").strip() for k, v in row.items() if k is not None}
+    for number, row in _csv_rows(path, "crack map", ("crack", "x", "y"), MAX_CRACK_POINTS):
         where = f"crack map {path.name!r} row {number}"
-        name = row["crack"]
+        name = row.get("crack", "")
         if not name:
             raise mf.SpecError(f"{where}: the crack column is empty")
-        try:
-            x, y = float(row["x"]), float(row["y"])
-        except ValueError:
-            raise mf.SpecError(f"{where}: x = {row['x']!r}, y = {row['y']!r} are not numbers") from None
-        if not (math.isfinite(x) and math.isfinite(y)):
-            raise mf.SpecError(f"{where}: x = {row['x']!r}, y = {row['y']!r} are not finite")
-        points.setdefault(name, []).append((x, y))
+        points.setdefault(name, []).append((_csv_number(row.get("x", ""), where, "x"),
+                                            _csv_number(row.get("y", ""), where, "y")))
         if row.get("width_mm"):
-            try:
-                widths[name] = _width(float(row["width_mm"]), where)
-            except ValueError:
-                raise mf.SpecError(f"{where}: width_mm = {row['width_mm']!r} is not a number") from None
+            widths[name] = _width(_csv_number(row["width_mm"], where, "width_mm"), where)
     for name, line in points.items():
         if len(line) < 2:
             raise mf.SpecError(f"crack map {path.name!r}: crack {name!r} has one point; a line needs two")
@@ -169,25 +227,11 @@ def _dxf_cracks(path: Path, unit: str | None, layer: str | None):
 
 def read_levelling(path: str | Path, unit: str = "m") -> np.ndarray:
     """``(m, 3)`` x, y, dy [m] of a levelling CSV (module docstring)."""
-    path = Path(path)
-    try:
-        rows = list(csv.DictReader(io.StringIO(mf.read_text(path, "levelling"), newline="")))
-    except csv.Error as exc:
-        raise mf.SpecError(f"levelling {path.name!r}: not a readable CSV file ({type(exc).__name__})") from None
+    path = mf.regular_file(path, "levelling")
     values = []
-    for number, row in enumerate(rows, start=2):
-        row = {str(k).strip(): (v or "").strip() for k, v in row.items() if k is not None}
-        missing = [c for c in ("x", "y", "dy") if c not in row]
-        if missing:
-            raise mf.SpecError(f"levelling {path.name!r}: needs the columns x, y, dy; {', '.join(missing)} missing")
-        try:
-            point = [float(row["x"]), float(row["y"]), float(row["dy"])]
-        except ValueError:
-            raise mf.SpecError(f"levelling {path.name!r} row {number}: x, y, dy must be numbers, got "
-                               f"{row['x']!r}, {row['y']!r}, {row['dy']!r}") from None
-        if not all(math.isfinite(v) for v in point):
-            raise mf.SpecError(f"levelling {path.name!r} row {number}: x, y, dy must be finite")
-        values.append(point)
+    for number, row in _csv_rows(path, "levelling", ("x", "y", "dy"), MAX_LEVELLING_POINTS):
+        where = f"levelling {path.name!r} row {number}"
+        values.append([_csv_number(row.get(name, ""), where, name) for name in ("x", "y", "dy")])
     if len(values) < 3:
         raise mf.SpecError(f"levelling {path.name!r}: {len(values)} point(s); a levelling needs at least three")
     return np.asarray(values) * UNITS[unit]

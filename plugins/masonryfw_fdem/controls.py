@@ -8,6 +8,7 @@ from typing import Any
 
 import numpy as np
 
+from .costs import call_steps
 from .scene import Scene
 
 
@@ -30,6 +31,7 @@ class Controls:
     rest_tolerance: float
     max_steps: int
     record_steps: int
+    call_steps: int  # the most steps of one kernel call (Ctrl-C is taken between calls)
     buffer: float
     max_penetration: float
     min_cos: float
@@ -121,6 +123,7 @@ def make_controls(scene: Scene, options: Mapping[str, Any]) -> Controls:
         rest_tolerance=options["rest_tolerance"],
         max_steps=options["max_steps"],
         record_steps=record_steps,
+        call_steps=call_steps(scene.driven.size),
         buffer=options["buffer_ratio"] * scene.unit_height,
         max_penetration=0.25 * scene.unit_height,
         min_cos=float(np.cos(np.radians(options["max_contact_angle"]))),

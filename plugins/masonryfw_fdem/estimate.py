@@ -23,15 +23,14 @@ import xarray as xr
 import masonryfw as mf
 
 from .controls import make_controls, masonry_height
+from .costs import DEFORMABLE_FACTOR, STEP_SECONDS_PER_BLOCK
 from .scene import build_scene
 
-STEP_SECONDS_PER_BLOCK = 0.40e-6  # 2026-11-27: 0.38e-6 to 0.42e-6 (2,432 blocks, two runs); 0.29e-6 on 2026-11-25
 PARALLEL_EFFICIENCY = 0.95
 # two threads add ~20 us a step of start-up and save ~0.145 us a block: whole processes in alternating pairs,
 # Test 12C (72 blocks) 0.86x on two threads, Facade 3 (480 blocks) 1.59x (docs/benchmarks.md, fdem)
 PARALLEL_MIN_BLOCKS = 300
 GRAVITY_TIME = 0.4  # the gravity phase in units of sqrt(masonry height / g)
-DEFORMABLE_FACTOR = 6.0  # Test 12C: 14.4 s against 2.3 s (docs/benchmarks.md, fdem-deformable)
 BASE_MEMORY = 250 * 2**20
 MEMORY_PER_BLOCK = 20e3
 

@@ -143,54 +143,13 @@ def registered():
 
 
 
-class Command:
-    """``python -m masonryfw ARGS`` started in ``cwd`` as a user's terminal would (SIGINT at its default: a
-    process started in the background inherits it ignored), its stderr read as it comes."""
-
-    def __init__(self, args, cwd, env=None, python=()):
-        import os
-        import signal
-        import subprocess
-        import sys
-
-        self.process = subprocess.Popen(
-            [sys.executable, *python, "-m", "masonryfw", *map(str, args)], cwd=cwd, text=True,
-            stdout=subprocess.PIPE, stderr=subprocess.PIPE, env={**os.environ, **(env or {})},
-            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
-        self.seen = ""
-
-    def wait_for(self, pattern: str, timeout: float = 240.0) -> str:
-        """Read stderr until ``pattern`` (a regular expression) appears in it; what was read."""
-        import os
-        import re
-        import select
-        import time
-
-        deadline, fd = time.monotonic() + timeout, self.process.stderr.fileno()
-        while time.monotonic() < deadline:
-            if re.search(pattern, self.seen):
-                return self.seen
-            if select.select([fd], [], [], 1.0)[0]:
-                chunk = os.read(fd, 65536).decode(errors="replace")
-                if not chunk:
-                    break
-                self.seen += chunk
-        raise AssertionError(f"never saw {pattern!r} in: {self.seen[-800:]}")
-
-    def signal(self, signum: int, timeout: float = 120.0) -> tuple[int, str, float]:
-        """Send ``signum``; the exit status, the whole stderr and the seconds the process took to end."""
-        import time
-
-        sent = time.monotonic()
-        self.process.send_signal(signum)
-        _, rest = self.process.communicate(timeout=timeout)
-        return self.process.returncode, self.seen + rest, time.monotonic() - sent
-
 
 @pytest.fixture
 def command():
-    """``command(args, cwd, env=None, python=())``: a :class:`Command` started; killed if the test leaves it
-    running."""
+    """``command(args, cwd, env=None, python=())``: a :class:`support.Command` started; killed if the test leaves
+    it running."""
+    from support import Command
+
     started = []
 
     def start(args, cwd, env=None, python=()):
@@ -198,6 +157,4 @@ def command():
         return started[-1]
     yield start
     for each in started:
-        if each.process.poll() is None:
-            each.process.kill()
-            each.process.communicate()
+        each.stop()

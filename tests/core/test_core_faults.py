@@ -17,6 +17,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from support import cli, hidden, peak_memory, refused
 
 import masonryfw as mf
 
@@ -45,37 +46,6 @@ motion = "translation"
 type = "settlement"
 """
 MB = 2**20
-
-
-def cli(args, cwd, env=None, timeout=120) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-m", "masonryfw", *map(str, args)], cwd=cwd, capture_output=True,
-                          text=True, timeout=timeout, env={**os.environ, **(env or {})})
-
-
-def refused(done: subprocess.CompletedProcess, *words: str) -> None:
-    """Exit 1, a one-line ``error:`` message holding ``words``, no traceback."""
-    assert done.returncode == 1, (done.returncode, done.stderr[-2000:])
-    assert "Traceback" not in done.stderr and done.stderr.startswith("error: "), done.stderr[-2000:]
-    for word in words:
-        assert word in done.stderr, (word, done.stderr)
-
-
-def peak_memory(args, cwd, env=None, timeout=120) -> tuple[subprocess.CompletedProcess, float]:
-    """Run the CLI under a watcher process; return the result and the CLI's peak resident memory [bytes]."""
-    watcher = ("import resource, subprocess, sys\n"
-               "done = subprocess.run(sys.argv[1:])\n"
-               "print(resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss, file=sys.stderr)\n"
-               "sys.exit(done.returncode)\n")
-    done = subprocess.run([sys.executable, "-c", watcher, sys.executable, "-m", "masonryfw", *map(str, args)],
-                          cwd=cwd, capture_output=True, text=True, timeout=timeout, env={**os.environ, **(env or {})})
-    *message, peak = done.stderr.rstrip("\n").splitlines()
-    done.stderr = "\n".join(message) + "\n"
-    return done, float(peak) * 1024
-
-
-def hidden(folder: Path) -> list[str]:
-    """Temporary and lock files left in ``folder``."""
-    return sorted(p.name for p in folder.iterdir() if p.name.startswith("."))
 
 
 # ---------------------------------------------------------------- 1. a signal while a file is written

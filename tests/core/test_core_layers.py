@@ -57,10 +57,16 @@ def cycles(graph: dict[str, set[str]]) -> list[list[str]]:
     return found
 
 
+#: The one deferred import, by design: the command's entry installs the signal handlers before the command line's
+#: imports (about a second), so that a Ctrl-C during them is answered (docs/faults.md).
+ENTRY_IMPORT = "__main__"
+
+
 def test_core_modules_import_each_other_at_the_top_and_without_a_cycle():
     graph, deferred = core_imports()
     assert {"api", "registry", "provenance", "options", "sources", "model", "semantics"} <= set(graph)
-    assert deferred == []
+    assert [where for where in deferred if where.split(":")[0] != ENTRY_IMPORT] == []
+    assert len(deferred) == 1 and graph[ENTRY_IMPORT] == {"signals"}
     assert cycles(graph) == []
     # the layers the architecture names: the lowest know nothing of the plugins or of the builder
     for low in ("model", "semantics", "options", "geometry", "schema", "errors"):

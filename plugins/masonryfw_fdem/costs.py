@@ -1,0 +1,13 @@
+"""What a time step costs, as measured on the 2-core machine of docs/benchmarks.md (the estimate's basis, and the
+length of a kernel call)."""
+
+STEP_SECONDS_PER_BLOCK = 0.40e-6  # 2026-11-27: 0.38e-6 to 0.42e-6 (2,432 blocks, two runs); 0.29e-6 on 2026-11-25
+DEFORMABLE_FACTOR = 6.0  # Test 12C: 14.4 s against 2.3 s (docs/benchmarks.md, fdem-deformable)
+#: Seconds a kernel call runs at most, as estimated: Python takes Ctrl-C between calls.
+CALL_SECONDS = 0.25
+
+
+def call_steps(blocks: int, deformable: bool = False) -> int:
+    """The steps of a kernel call of about :data:`CALL_SECONDS` on one thread."""
+    step = blocks * STEP_SECONDS_PER_BLOCK * (DEFORMABLE_FACTOR if deformable else 1.0)
+    return max(1, int(CALL_SECONDS / step))

@@ -1,0 +1,83 @@
+"""What the tests share to run ``python -m masonryfw`` as a user would and look at it from outside: its exit
+status and stderr (:func:`cli`, :func:`refused`), its peak memory (:func:`peak_memory`), the hidden files it
+leaves (:func:`hidden`), and a command signalled when its stderr says a phase has begun (:class:`Command`)."""
+from __future__ import annotations
+
+import os
+import re
+import select
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+
+def cli(args, cwd, env=None, timeout=120) -> subprocess.CompletedProcess:
+    """``python -m masonryfw ARGS`` in ``cwd``, run to its end."""
+    return subprocess.run([sys.executable, "-m", "masonryfw", *map(str, args)], cwd=cwd, capture_output=True,
+                          text=True, timeout=timeout, env={**os.environ, **(env or {})})
+
+
+def refused(done: subprocess.CompletedProcess, *words: str) -> None:
+    """Exit 1, a one-line ``error:`` message holding ``words``, no traceback."""
+    assert done.returncode == 1, (done.returncode, done.stderr[-2000:])
+    assert "Traceback" not in done.stderr and done.stderr.startswith("error: "), done.stderr[-2000:]
+    for word in words:
+        assert word in done.stderr, (word, done.stderr)
+
+
+def peak_memory(args, cwd, env=None, timeout=120) -> tuple[subprocess.CompletedProcess, float]:
+    """Run the CLI under a watcher process; return the result and the CLI's peak resident memory [bytes]."""
+    watcher = ("import resource, subprocess, sys\n"
+               "done = subprocess.run(sys.argv[1:])\n"
+               "print(resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss, file=sys.stderr)\n"
+               "sys.exit(done.returncode)\n")
+    done = subprocess.run([sys.executable, "-c", watcher, sys.executable, "-m", "masonryfw", *map(str, args)],
+                          cwd=cwd, capture_output=True, text=True, timeout=timeout, env={**os.environ, **(env or {})})
+    *message, peak = done.stderr.rstrip("\n").splitlines()
+    done.stderr = "\n".join(message) + "\n"
+    return done, float(peak) * 1024
+
+
+def hidden(folder: Path) -> list[str]:
+    """Temporary and lock files left in ``folder``."""
+    return sorted(p.name for p in folder.iterdir() if p.name.startswith("."))
+
+
+class Command:
+    """``python -m masonryfw ARGS`` started in ``cwd`` as a user's terminal would (SIGINT at its default: a
+    process started in the background inherits it ignored), its stderr read as it comes."""
+
+    def __init__(self, args, cwd, env=None, python=()):
+        self.process = subprocess.Popen(
+            [sys.executable, *python, "-m", "masonryfw", *map(str, args)], cwd=cwd, text=True,
+            stdout=subprocess.PIPE, stderr=subprocess.PIPE, env={**os.environ, **(env or {})},
+            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
+        self.seen = ""
+
+    def wait_for(self, pattern: str, timeout: float = 240.0) -> str:
+        """Read stderr until ``pattern`` (a regular expression) appears in it; what was read."""
+        deadline, fd = time.monotonic() + timeout, self.process.stderr.fileno()
+        while time.monotonic() < deadline:
+            if re.search(pattern, self.seen):
+                return self.seen
+            if select.select([fd], [], [], 1.0)[0]:
+                chunk = os.read(fd, 65536).decode(errors="replace")
+                if not chunk:
+                    break
+                self.seen += chunk
+        raise AssertionError(f"never saw {pattern!r} in: {self.seen[-800:]}")
+
+    def signal(self, signum: int, timeout: float = 120.0) -> tuple[int, str, float]:
+        """Send ``signum``; the exit status, the whole stderr and the seconds the process took to end."""
+        sent = time.monotonic()
+        self.process.send_signal(signum)
+        _, rest = self.process.communicate(timeout=timeout)
+        return self.process.returncode, self.seen + rest, time.monotonic() - sent
+
+    def stop(self) -> None:
+        """Kill it if still running."""
+        if self.process.poll() is None:
+            self.process.kill()
+            self.process.communicate()
