@@ -22,9 +22,10 @@ from support import Command, cli, hidden, peak_memory, refused
 
 import masonryfw as mf
 
-DATASETS = Path(mf.bundled_spec_path("panel-1")).parent
-CRACKS = (DATASETS / "surveys" / "facade-1-cracks.geojson").read_text()
-LEVELLING = (DATASETS / "surveys" / "facade-1-levelling.csv").read_text()
+DATASETS = Path(mf.bundled_spec_path("panel-1")).parent  # the installed package's bundled cases and drawings
+SURVEYS = Path(__file__).resolve().parents[2] / "datasets" / "surveys"  # the clone's: surveys are not installed
+CRACKS = (SURVEYS / "facade-1-cracks.geojson").read_text()
+LEVELLING = (SURVEYS / "facade-1-levelling.csv").read_text()
 MB = 2**20
 WALL = """title = "w"
 [wall]
