@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -15,13 +16,13 @@ from .checks import check
 from .damage import DERIVED_STEP_VARIABLES, damage_variables
 from .dofs import block_motion
 from .errors import MasonryError, ModelError, PluginError, SolveError
-from .hookspecs import Comparator, Estimate, Plotter, Solver
-from .hookspecs import resolved as resolved_function
 from .io import CONVENTIONS, add_history, content_sha256
-from .model import checked_digest, checked_model, contents_digest
+from .lazy import resolved as resolved_function
+from .model import checked_model, contents_digest, made_once
 from .options import resolve_options
 from .progress import ProgressCallback, no_progress
 from .provenance import core_version, input_hash, options_json, plugin_version, record_version
+from .records import Comparator, Estimate, Plotter, Solver
 from .registry import by_name, lookup
 from .resources import require_memory
 from .schema import FORMAT_VERSION, variable_attrs
@@ -36,7 +37,6 @@ from .semantics import (
 )
 
 _VALID = "masonryfw_valid"  # encoding key: (kind, contents digest) of an input found valid
-_ESTIMATES = "masonryfw_estimates"  # encoding key: the estimates made on a checked model
 
 
 def _problem_list(problems) -> str:
@@ -132,33 +132,97 @@ def _derive_comparable_fields(name: str, model: xr.Dataset, produced: xr.Dataset
     return produced.assign(derived)
 
 
+@dataclass(frozen=True)
+class SolvePlan:
+    """A solve ready to start (:func:`solve_plan`): the checked model, the solver (and the plugin it comes
+    from), its options resolved and checked, and its estimate (None when the solver gives none), each made
+    once; :meth:`run` solves."""
+
+    model: xr.Dataset
+    item: Any  # the registry's entry: the solver record and its plugin
+    options: Mapping[str, Any]
+    estimate: Estimate | None
+
+    @property
+    def solver(self) -> Solver:
+        return self.item.record
+
+    def run(self, progress: ProgressCallback | None = None) -> xr.Dataset:
+        """Run the solver and return the result dataset (:func:`solve` says what it holds)."""
+        model, solver, item, resolved = self.model, self.solver, self.item, self.options
+        function = _call_plugin("solver", solver.name, resolved_function, solver.solve)  # imported before the clock
+        start = time.perf_counter()
+        produced = _call_plugin("solver", solver.name, function, model, resolved, progress or no_progress)
+        wall_time = time.perf_counter() - start
+        if not isinstance(produced, xr.Dataset):
+            raise SolveError(f"solver {solver.name} returned {type(produced).__name__}, not an xarray.Dataset")
+        produced = _derive_comparable_fields(solver.name, model, produced)
+
+        result = _merge_result("solver", solver.name, model, model, produced)
+        compile_time = float(produced.attrs.get("compile_time_s", 0.0))
+        result.attrs = {**model.attrs, **produced.attrs}
+        result.attrs.update(
+            masonryfw_format="result",
+            masonryfw_format_version=FORMAT_VERSION,
+            plugin=item.plugin,
+            plugin_version=plugin_version(item),
+            solver=solver.name,
+            solver_version=record_version(item, solver.solve),
+            core_version=core_version(),
+            solver_options=options_json(resolved),
+            wall_time_s=float(wall_time - compile_time),
+            title=model.attrs.get("title", ""),
+            model_sha256=content_sha256(model),
+        )
+        if model.encoding.get("source"):
+            result.attrs["source_file"] = str(model.encoding["source"])
+        if model.encoding.get("sha256"):
+            result.attrs["input_sha256"] = str(model.encoding["sha256"])
+        result = add_history(
+            result, f"solve: solver {solver.name} (plugin {item.plugin}) options {result.attrs['solver_options']}"
+        )
+        _require_valid_output(result, f"the result of solver {solver.name}", _failure("solver"), model_checked=True)
+        return result
+
+
+def solve_plan(model: xr.Dataset, plugin: str, options: Mapping[str, Any] | None = None) -> SolvePlan:
+    """The solve of ``model`` by the solver called ``plugin``, ready to start: the model checked unless it already
+    is (:func:`masonryfw.checked_model`; every problem raises one :class:`ModelError`), the solver looked up, the
+    options resolved and checked against its declared rules, and its estimate made, once each; a run whose
+    estimated memory exceeds what is available is refused (:func:`masonryfw.resources.require_memory`).
+    The command line prints the estimate, then runs the plan."""
+    model = checked_model(model)
+    item = lookup("solver", plugin)
+    solver: Solver = item.record
+    resolved = resolve_options(f"solver {solver.name!r}", solver.options, dict(options or {}))
+    return SolvePlan(model, item, resolved, _checked_estimate(solver, model, resolved))
+
+
 def estimate(model: xr.Dataset, plugin: str, options: Mapping[str, Any] | None = None) -> Estimate | None:
     """The time and peak memory the solver called ``plugin`` expects on ``model`` (None if it gives none).
 
     Raises :class:`SolveError` when the memory would not fit (:func:`masonryfw.resources.require_memory`):
     the check :func:`solve` makes before it starts.
     """
-    model = checked_model(model)
-    solver: Solver = lookup("solver", plugin).record
-    resolved = resolve_options(f"solver {solver.name!r}", solver.options, dict(options or {}))
-    return _checked_estimate(solver, model, resolved)
+    return solve_plan(model, plugin, options).estimate
 
 
 def _checked_estimate(solver: Solver, model: xr.Dataset, resolved: Mapping[str, Any]) -> Estimate | None:
-    """The solver's estimate on a checked ``model``, made once per model contents and options (kept in the
-    model's encoding: the CLI's estimate and the solve's memory check are one call)."""
+    """The solver's estimate on a checked ``model``, made once per model contents and options
+    (:func:`masonryfw.made_once`), and the memory it needs refused when it does not fit."""
     if solver.estimate is None:
         return None
-    key = (solver.name, options_json(resolved), checked_digest(model))
-    made = model.encoding.setdefault(_ESTIMATES, {})
-    if key not in made:
+
+    def make(model: xr.Dataset) -> Estimate:
         function = _call_plugin("solver", solver.name, resolved_function, solver.estimate)
         expected = _call_plugin("solver", solver.name, function, model, resolved)
         if not isinstance(expected, Estimate):
             raise SolveError(f"solver {solver.name}'s estimate returned {type(expected).__name__}, not an Estimate")
-        made[key] = expected
-    require_memory(solver.name, made[key])
-    return made[key]
+        return expected
+
+    expected = made_once(model, f"estimate {solver.name} {options_json(resolved)}", make)
+    require_memory(solver.name, expected)
+    return expected
 
 
 def solve(
@@ -167,57 +231,15 @@ def solve(
     options: Mapping[str, Any] | None = None,
     progress: ProgressCallback | None = None,
 ) -> xr.Dataset:
-    """Run the solver called ``plugin`` on ``model`` and return the result dataset.
+    """Run the solver called ``plugin`` on ``model`` and return the result dataset: :func:`solve_plan`, run.
 
-    The model is checked unless it already is (:func:`masonryfw.checked_model`;
-    every problem raises one :class:`ModelError`); the options are resolved and
-    checked against the solver's declared rules; a run whose estimated memory
-    (:func:`estimate`) exceeds what is available is refused. The result holds the model's
-    variables, the solver's primary variables, the comparable fields the core
-    derives from ``block_displacement`` (:mod:`masonryfw.semantics`) and the
-    provenance attributes of docs/format.md. A result may be given: its model is
-    solved. ``wall_time_s`` leaves out the ``compile_time_s`` a solver reports.
-    A ``KeyboardInterrupt`` the solver lets through propagates (nothing computed).
+    The result holds the model's variables, the solver's primary variables, the comparable fields the core
+    derives from ``block_displacement`` (:mod:`masonryfw.semantics`) and the provenance attributes of
+    docs/format.md. A result may be given: its model is solved. ``wall_time_s`` leaves out the
+    ``compile_time_s`` a solver reports. A ``KeyboardInterrupt`` the solver lets through propagates (nothing
+    computed).
     """
-    model = checked_model(model)
-    item = lookup("solver", plugin)
-    solver: Solver = item.record
-    resolved = resolve_options(f"solver {solver.name!r}", solver.options, dict(options or {}))
-    _checked_estimate(solver, model, resolved)  # a run that cannot fit in memory is refused here
-    function = _call_plugin("solver", solver.name, resolved_function, solver.solve)  # imported before the clock
-
-    start = time.perf_counter()
-    produced = _call_plugin("solver", solver.name, function, model, resolved, progress or no_progress)
-    wall_time = time.perf_counter() - start
-    if not isinstance(produced, xr.Dataset):
-        raise SolveError(f"solver {solver.name} returned {type(produced).__name__}, not an xarray.Dataset")
-    produced = _derive_comparable_fields(solver.name, model, produced)
-
-    result = _merge_result("solver", solver.name, model, model, produced)
-    compile_time = float(produced.attrs.get("compile_time_s", 0.0))
-    result.attrs = {**model.attrs, **produced.attrs}
-    result.attrs.update(
-        masonryfw_format="result",
-        masonryfw_format_version=FORMAT_VERSION,
-        plugin=item.plugin,
-        plugin_version=plugin_version(item),
-        solver=solver.name,
-        solver_version=record_version(item, solver.solve),
-        core_version=core_version(),
-        solver_options=options_json(resolved),
-        wall_time_s=float(wall_time - compile_time),
-        title=model.attrs.get("title", ""),
-        model_sha256=content_sha256(model),
-    )
-    if model.encoding.get("source"):
-        result.attrs["source_file"] = str(model.encoding["source"])
-    if model.encoding.get("sha256"):
-        result.attrs["input_sha256"] = str(model.encoding["sha256"])
-    result = add_history(
-        result, f"solve: solver {solver.name} (plugin {item.plugin}) options {result.attrs['solver_options']}"
-    )
-    _require_valid_output(result, f"the result of solver {solver.name}", _failure("solver"), model_checked=True)
-    return result
+    return solve_plan(model, plugin, options).run(progress)
 
 
 def compare(

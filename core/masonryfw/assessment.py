@@ -37,7 +37,8 @@ import numpy as np
 
 from .geometry import block_bounds
 from .profiles import Profile, model_profile
-from .schema import flags, variable_attrs
+from .roles import masonry_blocks, support_blocks
+from .schema import variable_attrs
 
 if TYPE_CHECKING:  # annotations only
     import xarray as xr
@@ -141,13 +142,12 @@ def ltsm_parts(profile: Profile, x_a: float, x_b: float, height: float) -> list[
 def wall_extent(model: xr.Dataset) -> tuple[float, float, float]:
     """``(x_a, x_b, H)``: the horizontal extent of the masonry resting on the ground (its joints with the
     supports) and the masonry's height."""
-    codes = flags("block_role")
     role = np.asarray(model.block_role.values)
-    ground = np.isin(role, [codes["fixed_support"], codes["moving_support"]])
+    ground = support_blocks(role)
     sides = np.asarray(model.interface_blocks.values, dtype=np.int64)
     on_ground = ground[sides].any(axis=1) & ~ground[sides].all(axis=1)
     x = np.asarray(model.interface_x.values)[on_ground]
-    masonry = np.isin(role, [codes["unit"], codes["lintel"]])
+    masonry = masonry_blocks(role)
     _, _, ymin, ymax = block_bounds(model.node_x.values, model.node_y.values, model.block_node_count.values)
     return float(x.min()), float(x.max()), float(ymax[masonry].max() - ymin[masonry].min())
 

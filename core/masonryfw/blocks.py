@@ -36,6 +36,7 @@ from .errors import SpecError
 from .geometry import polygon_area_centroid
 from .interfaces import detect_interfaces
 from .material import Material
+from .roles import ROLE, support_blocks
 from .schema import FORMAT_VERSION, flags, variable_attrs
 
 DOF_NAMES = ("ux", "uy", "rz")
@@ -93,17 +94,16 @@ def ground_direction(edge: GroundEdge, centre) -> np.ndarray:
 
 def support_kinematics(supports, centres, loading: str):
     """``block_fixed``, ``settlement_direction`` and role of every support block (tilt: all held)."""
-    role = flags("block_role")
     count = len(supports)
     fixed = np.ones((count, 3), dtype=np.int8)
     direction = np.zeros((count, 3))
-    roles = np.full(count, role["fixed_support"], dtype=np.int8)
+    roles = np.full(count, ROLE["fixed_support"], dtype=np.int8)
     if loading == "tilt":
         return fixed, direction, roles
     for i, support in enumerate(supports):
         if support.kind != "moving":
             continue
-        roles[i] = role["moving_support"]
+        roles[i] = ROLE["moving_support"]
         if support.motion == "rotation":
             fixed[i] = 0
             direction[i] = support.rate * rotation_direction(centres[i], support.pivot)
@@ -173,19 +173,18 @@ def model_from_blocks(
     """
     if loading not in LOADINGS:
         raise SpecError(f"loading {loading!r}: must be one of {', '.join(LOADINGS)}")
-    flag = flags("block_role")
     role = np.asarray(role, dtype=np.int8)
     node_x, node_y = np.asarray(node_x, dtype=float), np.asarray(node_y, dtype=float)
     counts = np.asarray(block_node_count, dtype=np.int32)
-    is_support = np.isin(role, (flag["fixed_support"], flag["moving_support"]))
-    support_blocks = np.flatnonzero(is_support)
-    if len(supports) != support_blocks.size:
-        raise SpecError(f"{support_blocks.size} support blocks but {len(supports)} support descriptions")
+    is_support = support_blocks(role)
+    supported = np.flatnonzero(is_support)
+    if len(supports) != supported.size:
+        raise SpecError(f"{supported.size} support blocks but {len(supports)} support descriptions")
     n_block = role.size
     area, cx, cy = polygon_area_centroid(node_x, node_y, counts)
-    s_fixed, s_direction, s_role = support_kinematics(supports, np.c_[cx, cy][support_blocks], loading)
+    s_fixed, s_direction, s_role = support_kinematics(supports, np.c_[cx, cy][supported], loading)
     role = role.copy()
-    role[support_blocks] = s_role
+    role[supported] = s_role
 
     found = detect_interfaces(node_x, node_y, counts)
     blocks = np.asarray(found["blocks"], dtype=np.int64).reshape(-1, 2)
@@ -199,21 +198,21 @@ def model_from_blocks(
     unit_weight = np.where(is_support, 0.0, material.unit_weight)
     weight = unit_weight * np.abs(area) * thickness
     support_index = np.full(n_block, -1)
-    support_index[support_blocks] = np.arange(support_blocks.size)
-    contact = support_contact(blocks, length, support_index, support_blocks.size)
+    support_index[supported] = np.arange(supported.size)
+    contact = support_contact(blocks, length, support_index, supported.size)
     reaction = support_reactions(supports, contact, weight.sum(), loading)
 
     dead = np.zeros((n_block, 3))
     live = np.zeros((n_block, 3))
     dead[:, 1] = -weight
-    dead[support_blocks, 1] = reaction
-    live[support_blocks, 1] = -reaction
+    dead[supported, 1] = reaction
+    live[supported, 1] = -reaction
     if loading == "tilt":
         live[~is_support, 0] = tilt_direction * weight[~is_support]
     fixed = np.zeros((n_block, 3), dtype=np.int8)
-    fixed[support_blocks] = s_fixed
+    fixed[supported] = s_fixed
     direction = np.zeros((n_block, 3))
-    direction[support_blocks] = s_direction
+    direction[supported] = s_direction
 
     n_interface = blocks.shape[0]
     variables = {
@@ -254,28 +253,27 @@ def with_supports(model: xr.Dataset, supports) -> xr.Dataset:
     say: their roles, held components, settlement directions and the paper's dead and live loads made anew,
     every other variable kept (the geometry, the interfaces, the masonry's weight). Cheaper than building the
     model again: a settlement diagnosis tries hundreds of profiles on one wall."""
-    flag = flags("block_role")
     role = model.block_role.values.copy()
-    support_blocks = np.flatnonzero(np.isin(role, (flag["fixed_support"], flag["moving_support"])))
-    if len(supports) != support_blocks.size:
-        raise SpecError(f"{support_blocks.size} support blocks but {len(supports)} support descriptions")
-    centres = np.c_[model.block_centroid_x.values, model.block_centroid_y.values][support_blocks]
-    s_fixed, s_direction, role[support_blocks] = support_kinematics(supports, centres, "settlement")
+    supported = np.flatnonzero(support_blocks(role))
+    if len(supports) != supported.size:
+        raise SpecError(f"{supported.size} support blocks but {len(supports)} support descriptions")
+    centres = np.c_[model.block_centroid_x.values, model.block_centroid_y.values][supported]
+    s_fixed, s_direction, role[supported] = support_kinematics(supports, centres, "settlement")
     support_index = np.full(role.size, -1)
-    support_index[support_blocks] = np.arange(support_blocks.size)
+    support_index[supported] = np.arange(supported.size)
     contact = support_contact(model.interface_blocks.values.astype(np.int64), model.interface_length.values,
-                              support_index, support_blocks.size)
+                              support_index, supported.size)
     dead = block_loads(model, "dead").copy()
     masonry = np.ones(role.size, dtype=bool)
-    masonry[support_blocks] = False
+    masonry[supported] = False
     reaction = support_reactions(supports, contact, -dead[masonry, 1].sum(), "settlement")
     live = np.zeros_like(dead)
-    dead[support_blocks, 1] = reaction
-    live[support_blocks, 1] = -reaction
+    dead[supported, 1] = reaction
+    live[supported, 1] = -reaction
     fixed = model.block_fixed.values.copy()
-    fixed[support_blocks] = s_fixed
+    fixed[supported] = s_fixed
     direction = np.zeros((role.size, 3))
-    direction[support_blocks] = s_direction
+    direction[supported] = s_direction
     return model.assign({
         "block_role": model.block_role.copy(data=role),
         "block_fixed": model.block_fixed.copy(data=fixed),

@@ -30,7 +30,6 @@ from .geometry import (
     block_bounds,
     block_offsets,
     carrying_edges,
-    convex_pieces,
     model_scale,
     next_node,
     node_block,
@@ -38,6 +37,8 @@ from .geometry import (
     polygon_area_centroid,
     vertex_turns,
 )
+from .overlaps import overlapping_blocks, self_intersections
+from .roles import moving_blocks, support_blocks
 from .schema import FORMAT_VERSION, KINDS, READABLE_VERSIONS, load_schema
 
 if TYPE_CHECKING:  # annotations only
@@ -408,7 +409,8 @@ def _polygon_problems(model) -> list[Problem]:
                 "remove it", *_point(x[v], y[v]))
         for v in np.flatnonzero(collinear)
     ]
-    crossing_blocks, crossing_points = _self_intersections(model, polygon_ok)
+    crossing_blocks, crossing = self_intersections(model.x, model.y, model.counts, polygon_ok, model.tol)
+    crossing_points = [_point(px, py) for px, py in crossing]
     problems += [
         Problem(f"block {b}", "the polygon intersects itself (two of its edges meet); reorder the vertices", px, py)
         for b, (px, py) in zip(crossing_blocks, crossing_points)
@@ -434,182 +436,13 @@ def _polygon_problems(model) -> list[Problem]:
     return problems
 
 
-def _segment_distance(p0x, p0y, p1x, p1y, q0x, q0y, q1x, q1y):
-    """Shortest distance between segments p and q (0 when they cross), and a point near the contact."""
-    def side(ax, ay, bx, by, cx, cy):
-        return (bx - ax) * (cy - ay) - (by - ay) * (cx - ax)
-
-    d1 = side(q0x, q0y, q1x, q1y, p0x, p0y)
-    d2 = side(q0x, q0y, q1x, q1y, p1x, p1y)
-    d3 = side(p0x, p0y, p1x, p1y, q0x, q0y)
-    d4 = side(p0x, p0y, p1x, p1y, q1x, q1y)
-    crosses = (d1 * d2 < 0) & (d3 * d4 < 0)
-    candidates = [  # (distance of an end point from the other segment, that end point)
-        (point_segment_distance(p0x, p0y, q0x, q0y, q1x, q1y), p0x, p0y),
-        (point_segment_distance(p1x, p1y, q0x, q0y, q1x, q1y), p1x, p1y),
-        (point_segment_distance(q0x, q0y, p0x, p0y, p1x, p1y), q0x, q0y),
-        (point_segment_distance(q1x, q1y, p0x, p0y, p1x, p1y), q1x, q1y),
-    ]
-    dist = np.stack([c[0] for c in candidates])
-    which = np.argmin(dist, axis=0)
-    near_x = np.choose(which, [c[1] for c in candidates])
-    near_y = np.choose(which, [c[2] for c in candidates])
-    with np.errstate(invalid="ignore", divide="ignore"):
-        t = d1 / (d1 - d2)
-        cross_x = p0x + t * (p1x - p0x)
-        cross_y = p0y + t * (p1y - p0y)
-    distance = np.where(crosses, 0.0, dist.min(axis=0))
-    return distance, np.where(crosses, cross_x, near_x), np.where(crosses, cross_y, near_y)
-
-
-def _self_intersections(model, candidates):
-    """Blocks (among ``candidates``) two of whose non-adjacent edges come within tol, and where.
-
-    Blocks are grouped by vertex count; within a group all non-adjacent edge
-    pairs of all blocks are tested at once (k(k-3)/2 pairs for k vertices).
-    """
-    blocks_out, points_out = [], []
-    for k in np.unique(model.counts[candidates]):
-        if k < 4:
-            continue  # a triangle has no non-adjacent edges
-        blocks = np.flatnonzero(candidates & (model.counts == k))
-        idx = model.start[blocks][:, None] + np.arange(k)[None, :]
-        i, j = np.triu_indices(k, 2)
-        keep = ~((i == 0) & (j == k - 1))
-        i, j = i[keep], j[keep]
-        vx, vy = model.x[idx], model.y[idx]
-        wx, wy = np.roll(vx, -1, axis=1), np.roll(vy, -1, axis=1)
-        dist, px, py = _segment_distance(
-            vx[:, i], vy[:, i], wx[:, i], wy[:, i], vx[:, j], vy[:, j], wx[:, j], wy[:, j]
-        )
-        hit = dist <= model.tol
-        rows = np.flatnonzero(hit.any(axis=1))
-        first = np.argmax(hit[rows], axis=1)
-        blocks_out += blocks[rows].tolist()
-        points_out += [_point(px[r, c], py[r, c]) for r, c in zip(rows, first)]
-    order = np.argsort(blocks_out, kind="stable")
-    return np.asarray(blocks_out, dtype=np.int64)[order], [points_out[o] for o in order]
-
-
-def _ragged_expand(counts):
-    """For rows with ``counts`` items each: the row of every item and its position in the row."""
-    counts = np.asarray(counts, dtype=np.int64)
-    row = np.repeat(np.arange(counts.size), counts)
-    position = np.arange(counts.sum()) - np.repeat(np.cumsum(counts) - counts, counts)
-    return row, position
-
-
-def _candidate_block_pairs(xmin, xmax, ymin, ymax, blocks, tol):
-    """Pairs (a < b) of ``blocks`` whose bounding boxes, shrunk by tol, overlap; by a uniform grid.
-
-    Each block is entered in every grid cell its shrunk box covers; pairs are
-    formed only inside a cell, so the work grows with the number of blocks
-    rather than its square.
-    """
-    if blocks.size < 2:
-        return np.zeros(0, np.int64), np.zeros(0, np.int64)
-    x0, x1 = xmin[blocks] + tol, xmax[blocks] - tol
-    y0, y1 = ymin[blocks] + tol, ymax[blocks] - tol
-    cell = float(np.median(np.maximum(x1 - x0, y1 - y0)))
-    cell = cell if cell > 0 else 1.0
-    gx0, gy0 = x0.min(), y0.min()
-    ix0, ix1 = np.floor((x0 - gx0) / cell).astype(np.int64), np.floor((x1 - gx0) / cell).astype(np.int64)
-    iy0, iy1 = np.floor((y0 - gy0) / cell).astype(np.int64), np.floor((y1 - gy0) / cell).astype(np.int64)
-    ix1, iy1 = np.maximum(ix1, ix0), np.maximum(iy1, iy0)
-    nx_cells = int(ix1.max()) + 1
-    wide, high = ix1 - ix0 + 1, iy1 - iy0 + 1
-    row, pos = _ragged_expand(wide * high)
-    cell_id = (iy0[row] + pos // wide[row]) * nx_cells + ix0[row] + pos % wide[row]
-    order = np.lexsort((row, cell_id))
-    member, cell_id = row[order], cell_id[order]
-    group_start = np.flatnonzero(np.concatenate(([True], np.diff(cell_id) != 0)))
-    group_end = np.append(group_start[1:], cell_id.size)
-    size = group_end - group_start
-    end_of = np.repeat(group_end, size)
-    partners = end_of - np.arange(cell_id.size) - 1
-    left, offset = _ragged_expand(partners)
-    right = left + 1 + offset
-    a, b = member[left], member[right]
-    a, b = np.minimum(a, b), np.maximum(a, b)
-    key = np.sort(a * blocks.size + b)  # sort + diff: faster than np.unique's hashing here
-    key = key[np.concatenate(([True], np.diff(key) != 0))]
-    a, b = key // blocks.size, key % blocks.size
-    boxes_meet = (x0[a] < x1[b]) & (x0[b] < x1[a]) & (y0[a] < y1[b]) & (y0[b] < y1[a])
-    return blocks[a[boxes_meet]], blocks[b[boxes_meet]]
-
-
-@dataclass(frozen=True)
-class _Polygons:
-    """Convex polygons in the ragged layout, for the separating-axis test."""
-
-    x: np.ndarray
-    y: np.ndarray
-    counts: np.ndarray
-    owner: np.ndarray  # block of every polygon
-
-    @property
-    def start(self) -> np.ndarray:
-        return block_offsets(self.counts)[:-1]
-
-    @property
-    def next(self) -> np.ndarray:
-        return next_node(self.counts)
-
-
-def _penetration(pieces: _Polygons, a, b):
-    """Separating-axis depth of convex counter-clockwise polygon b into a, over a's edge normals.
-
-    For each edge of ``a`` (outward unit normal n, support value h = n . edge
-    start) the depth is ``h - min_j n . q_j`` over the vertices q of ``b``; the
-    polygons overlap by at most the smallest of these (<= 0: separated or touching).
-    """
-    x, y, nxt, start, counts = pieces.x, pieces.y, pieces.next, pieces.start, pieces.counts
-    pair, k = _ragged_expand(counts[a])
-    edge = start[a][pair] + k
-    ex, ey = x[nxt[edge]] - x[edge], y[nxt[edge]] - y[edge]
-    length = np.hypot(ex, ey)
-    nx, ny = ey / length, -ex / length
-    h = nx * x[edge] + ny * y[edge]
-    row, j = _ragged_expand(counts[b][pair])
-    vertex = start[b][pair][row] + j
-    projection = nx[row] * x[vertex] + ny[row] * y[vertex]
-    row_start = np.concatenate(([0], np.cumsum(counts[b][pair])[:-1]))
-    depth_per_edge = h - np.minimum.reduceat(projection, row_start)
-    pair_start = np.concatenate(([0], np.cumsum(counts[a])[:-1]))
-    return np.minimum.reduceat(depth_per_edge, pair_start)
-
-
 def _overlap_problems(model) -> list[Problem]:
-    """Blocks that interpenetrate by more than tol (bounding-box grid, then separating axes).
-
-    Non-convex blocks are tested through their convex pieces (:func:`convex_pieces`);
-    two blocks overlap by the deepest overlap of any two of their pieces.
-    """
+    """Blocks that interpenetrate by more than tol (:func:`masonryfw.overlaps.overlapping_blocks`)."""
     blocks = np.flatnonzero(model.good_polygon)
-    if blocks.size < 2:
-        return []
-    nodes = np.repeat(model.start[blocks], model.counts[blocks]) + _ragged_expand(model.counts[blocks])[1]
-    px, py, pc, owner = convex_pieces(model.x[nodes], model.y[nodes], model.counts[blocks], model.tol)
-    pieces = _Polygons(px, py, pc, blocks[owner])
-    everyone = np.arange(pc.size)
-    bounds = block_bounds(px, py, pc)
-    a, b = _candidate_block_pairs(*bounds, everyone, model.tol)
-    other = pieces.owner[a] != pieces.owner[b]
-    a, b = a[other], b[other]
-    if a.size == 0:
-        return []
-    depth = np.minimum(_penetration(pieces, a, b), _penetration(pieces, b, a))
-    overlapping = depth > model.tol
-    p_block = np.minimum(pieces.owner[a], pieces.owner[b])[overlapping]
-    q_block = np.maximum(pieces.owner[a], pieces.owner[b])[overlapping]
-    depth = depth[overlapping]
-    if depth.size == 0:
-        return []
-    order = np.lexsort((-depth, q_block, p_block))
-    first = np.concatenate(([True], (np.diff(p_block[order]) != 0) | (np.diff(q_block[order]) != 0)))
-    problems = []
+    p_block, q_block, depth = overlapping_blocks(model.x, model.y, model.counts, blocks, model.tol)
     xmin, xmax, ymin, ymax = block_bounds(model.x, model.y, model.counts)
-    for p, q, d in zip(p_block[order][first], q_block[order][first], depth[order][first]):
+    problems = []
+    for p, q, d in zip(p_block, q_block, depth):
         px_ = 0.5 * (max(xmin[p], xmin[q]) + min(xmax[p], xmax[q]))
         py_ = 0.5 * (max(ymin[p], ymin[q]) + min(ymax[p], ymax[q]))
         problems.append(Problem(
@@ -706,20 +539,18 @@ def _support_problems(ds, usable, model) -> list[Problem]:
     if not {"block_role", "settlement_direction"} <= usable:
         return []
     meaning = _flag_meanings("block_role")
-    moving_flag = next(v for v, m in meaning.items() if m == "moving_support")
     role = ds["block_role"].values
     direction = ds["settlement_direction"].values.astype(float)
     finite = np.isfinite(direction).all(axis=1)
     norm = np.linalg.norm(np.where(np.isfinite(direction), direction, 0.0), axis=1)
-    moving = role == moving_flag
+    moving = moving_blocks(role)
     known = np.isin(role, list(meaning))
 
     def where(b):
         return model.block_point(b) if model is not None else (None, None)
 
     problems = []
-    supports = [v for v, m in meaning.items() if m.endswith("support")]
-    if role.size and not np.isin(role, supports).any():
+    if role.size and not support_blocks(role).any():
         problems.append(Problem(
             "variable block_role",
             "no support block (fixed_support or moving_support): the wall stands on nothing",

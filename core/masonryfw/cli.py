@@ -135,98 +135,11 @@ def check_command(file: str, strict: bool) -> None:
         click.echo(f"OK: {ds.sizes.get('block', 0)} blocks, {ds.sizes.get('interface', 0)} interfaces")
 
 
-def _counts(values: np.ndarray, flag_variable: str) -> str:
-    meanings = mf.flags(flag_variable)
-    counts = np.bincount(np.asarray(values, dtype=np.int64), minlength=max(meanings.values()) + 1)
-    return ", ".join(f"{meaning.replace('_', ' ')} {counts[value]}" for meaning, value in meanings.items())
-
-
-def _span(values: np.ndarray) -> str:
-    low, high = float(np.min(values)), float(np.max(values))
-    return f"{low:.6g} m" if np.isclose(low, high) else f"{low:.6g}..{high:.6g} m"
-
-
-def _support_lines(model) -> list[str]:
-    """One line per support block: its x range and how it moves (supports are few)."""
-    roles = mf.flags("block_role")
-    xmin, xmax, _, _ = mf.block_bounds(model.node_x.values, model.node_y.values, model.block_node_count.values)
-    lines = []
-    for block in np.flatnonzero(np.isin(model.block_role.values, [roles["fixed_support"], roles["moving_support"]])):
-        held = model.block_fixed.values[block]
-        if model.block_role.values[block] == roles["fixed_support"]:
-            motion = f"fixed (held {' '.join(map(str, held))})"
-        else:
-            motion = "moving: " + _support_motion(model.settlement_direction.values[block], xmin[block], xmax[block],
-                                                  float(model.block_centroid_x.values[block]))
-        lines.append(f"  block {block}: x {xmin[block]:.6g}..{xmax[block]:.6g} m, {motion}")
-    return lines
-
-
-def _profile_text(profile) -> str:
-    """A settlement profile in a line: its kind and parameters, a tunnel's trough and S_max."""
-    if profile.kind == "tunnel":
-        return (f"tunnel, V_L {profile.volume_loss:g} %, D {profile.diameter:g} m, axis {profile.depth:g} m deep at "
-                f"x {profile.center:g} m, K {profile.trough_width_factor:g}: i {profile.width:.4g} m, S_max "
-                f"{1e3 * profile.target:.4g} mm (settlement_target); segments {profile.segment:.4g} m")
-    if profile.kind == "gaussian":
-        sideways = f", ground moving towards the axis (z0 {profile.depth:g} m)" if profile.depth else ""
-        return f"gaussian trough, axis x {profile.center:g} m, i {profile.width:.4g} m{sideways}; segments {profile.segment:.4g} m"
-    if profile.kind == "linear":
-        return f"tilt from x {profile.start:g} m (rate 0) to x {profile.end:g} m (rate 1); segments {profile.segment:.4g} m"
-    return f"table of {len(profile.points)} rates; segments {profile.segment:.4g} m"
-
-
-def _support_motion(direction, x0: float, x1: float, centre_x: float) -> str:
-    """What a moving support does per unit settlement parameter t, in words: its settlement (at its two ends
-    when it turns), sideways motion and rotation, then the settlement direction itself."""
-    ux, uy, rz = (float(d) for d in direction)
-    raw = f"settlement direction ({', '.join(f'{d:.4g}' for d in direction)})"
-    if rz == 0:
-        sideways = f", sideways {ux:.4g}" if ux else ""
-        return f"translates: settles {-uy:.4g}{sideways} per unit t; {raw}"
-    left, right = -(uy + rz * (x0 - centre_x)) + 0.0, -(uy + rz * (x1 - centre_x)) + 0.0  # no "-0"
-    return (f"translates and turns: settles {left:.4g} at its left end and {right:.4g} at its right, turns "
-            f"{rz:.4g} rad per unit t; {raw}")
-
-
-def _load_lines(model) -> list[str]:
-    roles = mf.flags("block_role")
-    on_support = np.isin(model.block_role.values, [roles["fixed_support"], roles["moving_support"]])
-    lines = []
-    for name in ("dead_load", "live_load"):
-        load = model[name].values
-        for label, rows in (("masonry", ~on_support), ("supports", on_support)):
-            fx, fy = load[rows, 0].sum(), load[rows, 1].sum()
-            lines.append(f"  {name.replace('_', ' ')} on {label}: Fx = {fx:.6g} N, Fy = {fy:.6g} N")
-    return lines
-
-
 @cli.command()
 @click.argument("model")
 def info(model: str) -> None:
     """Describe MODEL (a file or a bundled case name)."""
-    ds = mf.open_model(model)
-    roles = mf.flags("block_role")
-    masonry = np.isin(ds.block_role.values, [roles["unit"], roles["lintel"]])
-    owner = mf.node_block(ds.block_node_count.values)
-    x, y = ds.node_x.values[masonry[owner]], ds.node_y.values[masonry[owner]]
-    click.echo(f"title: {ds.attrs.get('title', '')}")
-    click.echo(f"blocks: {ds.sizes['block']} ({_counts(ds.block_role.values, 'block_role')})")
-    click.echo(f"interfaces: {ds.sizes.get('interface', 0)} ({_counts(ds.interface_kind.values, 'interface_kind')})")
-    if x.size:
-        click.echo(
-            f"wall: {np.ptp(x):.6g} m x {np.ptp(y):.6g} m "
-            f"(x {x.min():.6g}..{x.max():.6g}, y {y.min():.6g}..{y.max():.6g})"
-        )
-        click.echo(f"thickness: {_span(ds.block_thickness.values[masonry])}")
-    profile = mf.model_profile(ds)
-    if profile is not None:
-        click.echo(f"settlement profile: {_profile_text(profile)}")
-    click.echo("supports:")
-    for line in _support_lines(ds):
-        click.echo(line)
-    click.echo("loads:")
-    for line in _load_lines(ds):
+    for line in mf.describe_model(mf.open_model(model)):
         click.echo(line)
 
 
@@ -306,8 +219,8 @@ def solve(model: str, solver: str, output: str | None, options: dict[str, str], 
     inputs = mf.input_files(model)
     out = Path(output) if output else Path(f"{Path(model).stem if inputs else model}.{solver}.nc")
     mf.check_output_path(out, inputs)
-    dataset = mf.checked_model(mf.open_model(model))  # checked once, for the estimate and the solve
-    expected = mf.estimate(dataset, solver, options)
+    plan = mf.solve_plan(mf.open_model(model), solver, options)  # checked, looked up, resolved, estimated: once
+    expected = plan.estimate
     if expected is not None and expected.seconds > UNASKED_RUN and not force and "settlement" not in options:
         raise mf.MasonryError(f"{solver}: expect about {mf.duration_text(expected.seconds)} ({expected.basis}), over "
                               f"the {UNASKED_RUN / 3600:g} h a run starts without asking; is the model what was meant "
@@ -317,7 +230,7 @@ def solve(model: str, solver: str, output: str | None, options: dict[str, str], 
                    f"{mf.size_text(expected.memory)} ({expected.basis}); Ctrl-C keeps what is computed", err=True)
     bar = mf.progress_bar(progress)
     try:
-        result = mf.solve(dataset, solver, options, progress=bar)
+        result = plan.run(progress=bar)
     except KeyboardInterrupt:
         raise mf.Interrupted(f"solve {solver}: interrupted before the solver had a result to keep: nothing written") \
             from None
@@ -328,7 +241,7 @@ def solve(model: str, solver: str, output: str | None, options: dict[str, str], 
     if int(result.attrs.get("interrupted", 0)):
         raise mf.Interrupted(f"interrupted at settlement {_last_settlement(result)}: partial result written to {out}")
     numbers = ", ".join(map(str, mf.key_numbers(result))) or _scalar_summary(
-        result, [name for name in result.data_vars if name not in dataset.variables])
+        result, [name for name in result.data_vars if name not in plan.model.variables])
     stop = f"; {result.attrs['stop_reason']}" if result.attrs.get("stop_reason") else ""
     click.echo(f"result: {out}")
     click.echo(f"{solver}: {numbers + stop + '; ' if numbers else ''}wall time {result.attrs['wall_time_s']:.3g} s")

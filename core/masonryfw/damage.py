@@ -35,8 +35,9 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from .assessment import ltsm_variables
+from .roles import masonry_blocks, support_blocks
 from .schema import variable_attrs
-from .semantics import masonry_blocks, relative_motion, support_blocks
+from .semantics import relative_motion
 
 if TYPE_CHECKING:  # annotations only
     import xarray as xr

@@ -18,12 +18,11 @@ from .errors import SpecError
 from .geometry import block_bounds, derive_geometry
 from .material import Material
 from .profiles import Profile, node_motion, segment_count, with_profile
-from .schema import flags
+from .roles import ROLE, masonry_blocks, support_blocks
 
 if TYPE_CHECKING:  # annotations only
     import xarray as xr
 
-_ROLE = flags("block_role")
 
 
 def polygons(node_x: np.ndarray, node_y: np.ndarray, counts: np.ndarray):
@@ -63,7 +62,7 @@ def ground_pieces(areas, carried, edges: np.ndarray, tol: float) -> list[tuple]:
 
 def masonry_material(model: xr.Dataset) -> Material:
     """The material of a model's masonry, its median unit weight and joint strengths."""
-    masonry = np.isin(model.block_role.values, (_ROLE["unit"], _ROLE["lintel"]))
+    masonry = masonry_blocks(model.block_role.values)
     return Material(
         unit_weight=float(np.median(model.block_unit_weight.values[masonry])),
         friction=float(np.median(model.interface_friction.values)),
@@ -87,14 +86,14 @@ def ground_model(model: xr.Dataset, segment: float, key: str = "segment") -> xr.
     import shapely
 
     role = model.block_role.values
-    masonry = np.isin(role, (_ROLE["unit"], _ROLE["lintel"]))
+    masonry = masonry_blocks(role)
     if not masonry.any():
         raise SpecError("the model has no masonry (units or lintels) to put on a ground")
     counts_all = model.block_node_count.values.astype(np.int64)
     keep = np.repeat(masonry, counts_all)
     node_x, node_y = model.node_x.values[keep], model.node_y.values[keep]
     counts = counts_all[masonry].astype(np.int32)
-    supports = np.isin(role, (_ROLE["fixed_support"], _ROLE["moving_support"]))
+    supports = support_blocks(role)
     if supports.any():  # merged first: the segment grid alone cuts the ground
         merged = shapely.union_all(polygons(model.node_x.values, model.node_y.values, counts_all)[supports])
         areas = list(shapely.simplify(shapely.get_parts(merged), 0.0))  # no vertex left between collinear edges
@@ -114,7 +113,7 @@ def ground_model(model: xr.Dataset, segment: float, key: str = "segment") -> xr.
     node_x = np.concatenate([node_x, *(r[:, 0] for r in rings)])
     node_y = np.concatenate([node_y, *(r[:, 1] for r in rings)])
     counts = np.concatenate([counts, [r.shape[0] for r in rings]]).astype(np.int32)
-    roles = np.concatenate([role[masonry], np.full(len(rings), _ROLE["fixed_support"])]).astype(np.int8)
+    roles = np.concatenate([role[masonry], np.full(len(rings), ROLE["fixed_support"])]).astype(np.int8)
     thickness = np.concatenate([model.block_thickness.values[masonry],
                                 np.full(len(rings), float(np.median(model.block_thickness.values[masonry])))])
     held = [blocks.Support(f"ground segment {k} [{edges[k]:.6g}, {edges[k + 1]:.6g}] m") for _, k in pieces]
@@ -128,7 +127,7 @@ def over_profile(model: xr.Dataset, profile: Profile) -> xr.Dataset:
     says (a continuous ground follows the profile at both ends of each segment, a step translates the
     segments under it), recording the profile; the geometry and the interfaces kept."""
     role = model.block_role.values
-    ground = np.flatnonzero(np.isin(role, (_ROLE["fixed_support"], _ROLE["moving_support"])))
+    ground = np.flatnonzero(support_blocks(role))
     xmin, xmax, _, ymax = block_bounds(model.node_x.values, model.node_y.values, model.block_node_count.values)
     supports = []
     for block in ground:

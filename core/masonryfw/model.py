@@ -22,6 +22,7 @@ SPEC_SUFFIXES = (".toml",)
 #: CF attributes describing a dataset that a model keeps when taken out of a result.
 _DESCRIPTIVE_ATTRIBUTES = ("comment", "institution", "references", "source")
 _CHECKED = "masonryfw_checked"
+_MADE = "masonryfw_made_once"
 
 
 def model_part(ds: xr.Dataset) -> xr.Dataset:
@@ -72,6 +73,18 @@ def is_checked(ds: xr.Dataset) -> bool:
     digest is the one recorded then)."""
     mark = ds.encoding.get(_CHECKED)
     return mark is not None and mark == _fingerprint(ds)
+
+
+def made_once(model: xr.Dataset, name: str, make):
+    """``make(model)`` once per checked ``model``'s contents: kept in its encoding under ``name`` with the digest
+    :func:`checked_model` recorded, made again for a model changed (and checked) since. What a solver derives
+    from a model for its estimate and again for its solve (fdem's scene), or the core's estimates."""
+    digest = checked_digest(model)
+    made = model.encoding.setdefault(_MADE, {})
+    key = (name, digest)
+    if digest is None or key not in made:
+        made[key] = make(model)
+    return made[key]
 
 
 def checked_model(ds: xr.Dataset, where: str = "") -> xr.Dataset:

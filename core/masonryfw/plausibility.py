@@ -33,7 +33,7 @@ import numpy as np
 
 from .geometry import block_bounds
 from .profiles import model_profile
-from .schema import flags
+from .roles import masonry_blocks
 
 if TYPE_CHECKING:  # annotations only
     import xarray as xr
@@ -80,8 +80,7 @@ def _spec_info(model: xr.Dataset) -> tuple[bool, str]:
 def plausibility(model: xr.Dataset) -> list[str]:
     """One message per implausible value of ``model`` (a model or result dataset; module docstring)."""
     role = np.asarray(model.block_role.values)
-    codes = flags("block_role")
-    masonry = np.isin(role, [codes["unit"], codes["lintel"]])
+    masonry = masonry_blocks(role)
     if not masonry.any():
         return []
     drawn, length_unit = _spec_info(model)

@@ -17,8 +17,9 @@ import click
 import pluggy
 
 from .errors import PluginError
-from .hookspecs import PROJECT, Comparator, MasonryfwSpec, Plotter, Solver
+from .hookspecs import PROJECT, MasonryfwSpec
 from .options import unknown_name_message
+from .records import Comparator, Plotter, Solver
 
 #: record kind -> (hook name, record type)
 _HOOKS = {

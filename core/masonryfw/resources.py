@@ -13,7 +13,7 @@ import re
 from pathlib import Path
 
 from .errors import SolveError
-from .hookspecs import Estimate
+from .records import Estimate
 
 MEMORY_LIMIT_VARIABLE = "MASONRYFW_MEMORY_LIMIT"
 _UNITS = {"": 1, "b": 1, "kb": 1e3, "mb": 1e6, "gb": 1e9, "kib": 2**10, "mib": 2**20, "gib": 2**30}

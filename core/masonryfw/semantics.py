@@ -39,10 +39,10 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .assessment import assess
 from .dofs import block_loads
 from .errors import ModelError
 from .geometry import block_offsets, model_scale, node_block
+from .roles import ROLE, masonry_blocks, masonry_joints, support_blocks
 from .schema import flags, variable_attrs
 
 if TYPE_CHECKING:  # annotations only
@@ -51,34 +51,15 @@ if TYPE_CHECKING:  # annotations only
 #: A joint is cracked where it moves more than this share of the largest masonry-joint motion
 #: (``crack_indicator > CRACK_THRESHOLD``), intact otherwise.
 CRACK_THRESHOLD = 0.1
-#: The reaction history is at its plateau from the first settlement after which it stays within
-#: this share of the dead reaction of its final value.
-PLATEAU_SHARE = 0.01
 ROTATIONS = ("small", "finite")
 FLOW_RULES = ("associative", "nonassociative")
 DERIVED_RESULT_VARIABLES = ("interface_opening", "interface_slip", "interface_state", "crack_indicator",
                             "macro_block")
 
-_ROLE = flags("block_role")
 _STATE = flags("interface_state")
 
 
 # ---------------------------------------------------------------- masks and scales
-
-def support_blocks(role: np.ndarray) -> np.ndarray:
-    """Blocks that are supports (ground): fixed or moving."""
-    return np.isin(role, (_ROLE["fixed_support"], _ROLE["moving_support"]))
-
-
-def masonry_blocks(role: np.ndarray) -> np.ndarray:
-    """Units and lintels."""
-    return np.isin(role, (_ROLE["unit"], _ROLE["lintel"]))
-
-
-def masonry_joints(role: np.ndarray, interface_blocks: np.ndarray) -> np.ndarray:
-    """Interfaces with at least one masonry side (not ground against ground)."""
-    return ~support_blocks(np.asarray(role)[np.asarray(interface_blocks, dtype=np.int64)]).all(axis=1)
-
 
 def polar_moment(node_x, node_y, block_node_count) -> np.ndarray:
     """Polar second moment of area of every polygon about its own centroid [m4].
@@ -389,26 +370,12 @@ def cracked_joints(result: xr.Dataset, threshold: float = CRACK_THRESHOLD) -> np
     return indicator_at(result, threshold) > 0
 
 
-# ---------------------------------------------------------------- the numbers a user came for
-
-@dataclass(frozen=True)
-class KeyNumber:
-    """One headline number of a result, with its unit and what it is."""
-
-    name: str
-    value: float
-    units: str
-    long_name: str
-
-    def __str__(self) -> str:
-        unit = f" {self.units}" if self.units not in ("", "1") else ""
-        return f"{self.name} = {self.value:.6g}{unit}"
-
+# ---------------------------------------------------------------- the reaction of a settlement
 
 def settlement_weights(model: xr.Dataset) -> np.ndarray:
     """``(block, 3)``: every moving support's ``settlement_direction``, 0 for other blocks: the weights of
     :func:`settlement_reaction`."""
-    moving = np.asarray(model.block_role.values) == _ROLE["moving_support"]
+    moving = np.asarray(model.block_role.values) == ROLE["moving_support"]
     return np.where(moving[:, None], np.asarray(model.settlement_direction.values, dtype=float), 0.0)
 
 
@@ -432,7 +399,7 @@ def refuse_rigid_settlement(model: xr.Dataset, solver: str) -> None:
     then follows the ground as one rigid body, nothing in it deforms and the settlement reaction stays R0."""
     role = np.asarray(model.block_role.values)
     ground = support_blocks(role)
-    moving = role == _ROLE["moving_support"]
+    moving = role == ROLE["moving_support"]
     direction = np.asarray(model.settlement_direction.values, dtype=float)[ground]
     if moving.any() and moving.sum() == ground.sum() and np.all(direction[:, 2] == 0) \
             and np.allclose(direction, direction[0], rtol=0.0, atol=1e-12 * np.abs(direction).max()):
@@ -447,136 +414,3 @@ def dead_reaction(model: xr.Dataset) -> float:
     convention: each moving support carries ``W L_s / L_total`` up): :func:`settlement_reaction` of the
     force the wall would exert on them (their dead load, down), a sum weighted by the supports' rates."""
     return float(settlement_reaction(model, -block_loads(model, "dead")))
-
-
-def plateau_start(settlement: np.ndarray, reaction: np.ndarray, band: float) -> int:
-    """Index of the first record after which the reaction stays within ``band`` of its final value."""
-    outside = np.flatnonzero(np.abs(reaction - reaction[-1]) > band)
-    return int(outside[-1] + 1) if outside.size else 0
-
-
-def _history_numbers(result: xr.Dataset) -> list[KeyNumber]:
-    settlement = np.asarray(result.step_settlement.values, dtype=float)
-    reaction = np.asarray(result.step_reaction.values, dtype=float)
-    if settlement.size == 0:
-        return []
-    loaded = np.flatnonzero(settlement <= 0)
-    first = int(loaded[-1]) if loaded.size else 0
-    r0 = float(reaction[first])
-    numbers = [KeyNumber("dead_reaction", r0, "N", "settlement reaction before the supports settle (R0)")]
-    s, r = settlement[first:], reaction[first:]
-    if s.size < 2:
-        return numbers
-    low = int(np.argmin(r))
-    start = plateau_start(s, r, PLATEAU_SHARE * abs(r0))
-    return numbers + [
-        KeyNumber("minimum_reaction", float(r[low]), "N", "smallest settlement reaction"),
-        KeyNumber("minimum_reaction_settlement", float(s[low]), "m", "settlement at the smallest reaction"),
-        KeyNumber("plateau_reaction", float(r[start:].mean()), "N",
-                  f"mean settlement reaction from the plateau on (within {PLATEAU_SHARE:.0%} of R0 of the final value)"),
-        KeyNumber("plateau_settlement", float(s[start]), "m", "settlement where the plateau starts"),
-        KeyNumber("final_settlement", float(s[-1]), "m", "settlement of the last record"),
-    ]
-
-
-def _crack_numbers(result: xr.Dataset) -> list[KeyNumber]:
-    """The widest crack over the run, where and when it is, the damage category it gives; the last
-    record's crack and category; the widest base gap."""
-    width = np.asarray(result.step_crack_width_max.values, dtype=float)
-    if width.size == 0:
-        return []
-    widest = int(np.argmax(width))
-    numbers = [KeyNumber("crack_width", float(width[widest]), "m", "widest crack in the masonry over the run")]
-    if "step_settlement" in result:
-        numbers.append(KeyNumber("crack_settlement", float(result.step_settlement.values[widest]), "m",
-                                 "settlement at the record of the widest crack"))
-    interface = int(result.step_crack_interface.values[widest]) if "step_crack_interface" in result else -1
-    if interface >= 0:
-        numbers += [
-            KeyNumber("crack_interface", float(interface), "1", "the joint of the widest crack"),
-            KeyNumber("crack_x", float(result.interface_x.values[interface].mean()), "m", "x of that joint's midpoint"),
-            KeyNumber("crack_y", float(result.interface_y.values[interface].mean()), "m", "y of that joint's midpoint"),
-        ]
-    if "step_damage_category" in result:
-        category = np.asarray(result.step_damage_category.values)
-        numbers += [
-            KeyNumber("damage_category", float(category.max()), "1",
-                      "largest damage category over the run (0 negligible .. 5 very severe)"),
-            KeyNumber("damage_category_final", float(category[-1]), "1", "damage category at the last record"),
-        ]
-    numbers.append(KeyNumber("crack_width_final", float(width[-1]), "m", "widest crack at the last record"))
-    if "step_base_gap_max" in result and result.step_base_gap_max.size:
-        numbers.append(KeyNumber("base_gap", float(np.max(result.step_base_gap_max.values)), "m",
-                                 "widest gap between the wall and the ground over the run (not a crack in the masonry)"))
-    return numbers
-
-
-def _assessment_numbers(result: xr.Dataset) -> list[KeyNumber]:
-    """The engineers' stages 1 and 2 (:mod:`masonryfw.assessment`) at the last record's settlement, or at the
-    model's ``settlement_target`` for a result without a history (limit analysis)."""
-    if "step_settlement" in result and result.step_settlement.size:
-        settlement = float(result.step_settlement.values[-1])
-    elif "settlement_target" in result:
-        settlement = float(result.settlement_target.values)
-    else:
-        return []
-    stages = assess(result, settlement)
-    if stages is None:
-        return []
-    return [
-        KeyNumber("assessed_settlement", settlement, "m", "settlement parameter of the stage 1 and 2 assessment"),
-        KeyNumber("greenfield_slope", stages.slope, "1", "stage 1: largest greenfield slope under the wall"),
-        KeyNumber("greenfield_settlement", stages.greenfield_settlement, "m",
-                  "stage 1: largest greenfield settlement under the wall"),
-        KeyNumber("screened_out", float(stages.screened_out), "1",
-                  "stage 1: 1 if the slope stays under 1/500 and the settlement under 10 mm (negligible risk)"),
-        KeyNumber("ltsm_strain", stages.strain, "1", "stage 2: the limiting tensile strain method's governing strain"),
-        KeyNumber("ltsm_category", float(stages.category), "1",
-                  "stage 2: LTSM damage category (0 negligible .. 4 severe to very severe)"),
-    ]
-
-
-def key_numbers(result: xr.Dataset) -> list[KeyNumber]:
-    """The numbers a user came for, whatever the solver.
-
-    Limit analysis: alpha, the dead reaction R0 and the settlement reaction at collapse (the solver's
-    ``moving_support_reaction``, else ``(1 - alpha) R0``). Incremental solvers: the dead reaction, the
-    smallest and the plateau settlement reaction with their settlements; the widest crack over the run
-    with its joint, place and settlement, the largest damage category, and the last record's
-    (:mod:`masonryfw.damage`). Both: the number of masonry macro-blocks when the result has them. R0 and
-    the reactions are settlement reactions (:func:`settlement_reaction`), one definition for every solver.
-    """
-    numbers: list[KeyNumber] = []
-    if "collapse_multiplier" in result:
-        alpha = float(result.collapse_multiplier.values)
-        numbers.append(KeyNumber("alpha", alpha, "1", "collapse multiplier"))
-        r0 = dead_reaction(result)
-        if r0 > 0:
-            numbers.append(KeyNumber("dead_reaction", r0, "N",
-                                     "settlement reaction of the dead loads W L_s / L_total on the moving supports (R0)"))
-        if "moving_support_reaction" in result:
-            numbers.append(KeyNumber("collapse_reaction", float(result.moving_support_reaction.values), "N",
-                                     "settlement reaction at collapse"))
-        elif r0 > 0:
-            numbers.append(KeyNumber("collapse_reaction", (1.0 - alpha) * r0, "N",
-                                     "settlement reaction at collapse, (1 - alpha) R0"))
-    if "step_reaction" in result and "step_settlement" in result:
-        numbers += _history_numbers(result)
-    if "step_crack_width_max" in result:
-        numbers += _crack_numbers(result)
-    for name, what in (("deflection_ratio", "deflection ratio of the imposed profile at the last record "
-                                              "(sagging positive, Burland & Wroth 1974)"),
-                       ("angular_distortion", "angular distortion of the imposed profile at the last record [rad]")):
-        if f"step_{name}" in result and result[f"step_{name}"].size:
-            numbers.append(KeyNumber(name, float(result[f"step_{name}"].values[-1]), "1" if "ratio" in name else "rad",
-                                     what))
-    numbers += _assessment_numbers(result)
-    derived = at_threshold(result)
-    if "crack_indicator" in derived:
-        numbers.append(KeyNumber("cracked_joints", float(np.count_nonzero(derived.crack_indicator.values)), "1",
-                                 f"joints moving more than {CRACK_THRESHOLD:g} of the largest joint motion"))
-    if "macro_block" in derived:
-        masonry = masonry_blocks(derived.block_role.values)
-        count = np.unique(derived.macro_block.values[masonry]).size
-        numbers.append(KeyNumber("macro_blocks", float(count), "1", "macro-blocks of the masonry"))
-    return numbers

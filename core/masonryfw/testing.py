@@ -43,13 +43,13 @@ from .errors import PluginError
 from .material import Material
 from .model import checked_model
 from .registry import get_solver
-from .schema import flags, load_schema
-from .semantics import key_numbers
+from .roles import ROLE, support_blocks
+from .schema import load_schema
+from .summary import key_numbers
 
 if TYPE_CHECKING:  # annotations only
     import xarray as xr
 
-ROLES = flags("block_role")
 
 
 def rectangles_model(
@@ -79,13 +79,13 @@ def rectangles_model(
     Young's modulus rescaled so that the loads in N and the strains are the same).
     """
     rects = np.asarray(rects, dtype=float).reshape(-1, 4) * length_unit
-    role = np.array([ROLES[r] if isinstance(r, str) else int(r) for r in roles], dtype=np.int8)
+    role = np.array([ROLE[r] if isinstance(r, str) else int(r) for r in roles], dtype=np.int8)
     if role.size != rects.shape[0]:
         raise ValueError(f"{rects.shape[0]} rectangles but {role.size} roles")
     motions = dict(motions or {})
     supports = []
-    for b in np.flatnonzero(np.isin(role, (ROLES["fixed_support"], ROLES["moving_support"]))):
-        if role[b] == ROLES["fixed_support"]:
+    for b in np.flatnonzero(support_blocks(role)):
+        if role[b] == ROLE["fixed_support"]:
             supports.append(blocks.Support(f"support block {b}"))
         else:
             motion, pivot = motions.get(int(b), ("translation", None))

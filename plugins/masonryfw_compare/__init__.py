@@ -8,23 +8,19 @@ functions), the plot kinds drawn through ``masonryfw.render`` (:mod:`.block_plot
 """
 from __future__ import annotations
 
-import importlib
+import lazy_loader
 
 import masonryfw as mf
 
 from .commands import COMMANDS
 from .records import COMPARATOR, PLOTTERS
 
-#: The Python API beyond ``masonryfw.compare`` / ``masonryfw.render``, imported on first access (PEP 562)
+#: The Python API beyond ``masonryfw.compare`` / ``masonryfw.render``, imported on first access (lazy_loader, Scientific Python's SPEC 1)
 #: so registering stays cheap.
-_PUBLIC = {"export_vtk": "export"}
-__all__ = sorted(_PUBLIC)
-
-
-def __getattr__(name: str):
-    if name in _PUBLIC:
-        return getattr(importlib.import_module(f".{_PUBLIC[name]}", __name__), name)
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+# no __dir__: pluggy finds the hook implementations by dir(module)
+__getattr__, _, __all__ = lazy_loader.attach(__name__, submod_attrs={
+    "export": ["export_vtk"],
+})
 
 
 @mf.hookimpl

@@ -14,15 +14,18 @@ From Python::
 """
 from __future__ import annotations
 
-import importlib
+import lazy_loader
 
 import masonryfw as mf
 
 from .commands import COMMANDS
 
-_PUBLIC = {"diagnose": "diagnosis", "verify": "diagnosis", "wall_model": "diagnosis", "read_cracks": "survey",
-           "read_levelling": "survey", "to_dataset": "dataset", "to_json": "dataset"}
-__all__ = sorted(_PUBLIC)
+# no __dir__: pluggy finds the hook implementations by dir(module)
+__getattr__, _, __all__ = lazy_loader.attach(__name__, submod_attrs={
+    "dataset": ["to_dataset", "to_json"],
+    "diagnosis": ["diagnose", "prepare", "search", "verify", "wall_model"],
+    "survey": ["read_cracks", "read_levelling"],
+})
 
 PLOTTER = mf.Plotter(
     "diagnosis",
@@ -33,11 +36,6 @@ PLOTTER = mf.Plotter(
                        "as 8 % of the wall's size", above=0.0),),
 )
 
-
-def __getattr__(name: str):
-    if name in _PUBLIC:
-        return getattr(importlib.import_module(f".{_PUBLIC[name]}", __name__), name)
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 @mf.hookimpl

@@ -279,21 +279,22 @@ def verify(diagnosis: Diagnosis, solver: str = "fdem", count: int = KEPT, progre
     model's ``settlement_target``): their widest crack, damage category and smallest reaction go into
     ``candidate.verified``."""
     diagnosis.verified_with = solver
-    for k, candidate in enumerate(diagnosis.candidates[:count]):
-        magnitude = candidate.score.magnitude
-        if magnitude is None or not magnitude > 0 or not math.isfinite(magnitude):
-            continue
-        progress(k / count, f"verify: {scenarios.describe(candidate.table)} with {solver} to {1e3 * magnitude:.3g} mm")
-        profile = dataclasses.replace(profile_of(diagnosis, candidate.table), target=magnitude)
-        try:
+    try:
+        for k, candidate in enumerate(diagnosis.candidates[:count]):
+            magnitude = candidate.score.magnitude
+            if magnitude is None or not magnitude > 0 or not math.isfinite(magnitude):
+                continue
+            progress(k / count, f"verify: {scenarios.describe(candidate.table)} with {solver} to "
+                                f"{1e3 * magnitude:.3g} mm")
+            profile = dataclasses.replace(profile_of(diagnosis, candidate.table), target=magnitude)
             result = mf.solve(mf.over_profile(diagnosis.model, profile), solver, {})
-        except KeyboardInterrupt:
-            diagnosis.verify_interrupted = True
-            return
-        if int(result.attrs.get("interrupted", 0)):  # a run cut short verifies nothing: not kept
-            diagnosis.verify_interrupted = True
-            return
-        numbers = {n.name: n.value for n in mf.key_numbers(result)}
-        candidate.verified = {key: numbers.get(key) for key in ("crack_width", "damage_category", "minimum_reaction",
-                                                                "dead_reaction", "final_settlement")}
+            if int(result.attrs.get("interrupted", 0)):  # a run cut short verifies nothing: not kept
+                raise KeyboardInterrupt
+            numbers = {n.name: n.value for n in mf.key_numbers(result)}
+            candidate.verified = {key: numbers.get(key) for key in ("crack_width", "damage_category",
+                                                                    "minimum_reaction", "dead_reaction",
+                                                                    "final_settlement")}
+    except KeyboardInterrupt:
+        diagnosis.verify_interrupted = True
+        return
     progress(1.0, "verify: done")

@@ -38,6 +38,8 @@ from .kernels import (
     TIME,
     WORK_GRAVITY,
     WORK_SUPPORT,
+    EndLaw,
+    contact_end,
     face_geometry,
     next_node,
     settlement_rate,
@@ -318,7 +320,7 @@ def node_contact_forces(offs, mesh, pairs, law, motion, force, dt, update_histor
         ktp = kt * half
         m_inv = 0.5 * (inv_mass[ea] + inv_mass[ka] + inv_mass[eb] + inv_mass[kb])
         dashpot = 2.0 * contact_damping * np.sqrt(knp / m_inv) if m_inv > 0.0 else 0.0
-        mu, coh, ten = props[f, 0], props[f, 1] * half, props[f, 2] * half
+        end_law = EndLaw(knp, ktp, dashpot, props[f, 0], props[f, 1] * half, props[f, 2] * half)
         for e in range(2):
             s = s_lo if e == 0 else s_hi
             gap = g[6] if e == 0 else g[7]
@@ -329,41 +331,18 @@ def node_contact_forces(offs, mesh, pairs, law, motion, force, dt, update_histor
             wb = edge_weight(x, y, eb, kb, px, py)
             dvx = ((1.0 - wb) * vel[eb, 0] + wb * vel[kb, 0]) - ((1.0 - wa) * vel[ea, 0] + wa * vel[ka, 0])
             dvy = ((1.0 - wb) * vel[eb, 1] + wb * vel[kb, 1]) - ((1.0 - wa) * vel[ea, 1] + wa * vel[ka, 1])
-            opening_rate = dvx * nx + dvy * ny
-            fn_elastic = -knp * gap
-            ft = shear[f, e]
-            if bonded[f, e] and fn_elastic < -ten and update_history:
-                bonded[f, e] = 0
-                acc[DISSIPATED_FRICTION] += 0.5 * fn_elastic * fn_elastic / knp
-            if not bonded[f, e] and fn_elastic <= 0.0:
-                if update_history:
-                    acc[DISSIPATED_FRICTION] += 0.5 * ft * ft / ktp
-                    shear[f, e] = 0.0
+            is_open, fn, ft, bond, spring, friction_1, friction_2, damping = contact_end(
+                -knp * gap, dvx * nx + dvy * ny, dvx * tx + dvy * ty, shear[f, e], bonded[f, e], end_law, dt,
+                update_history)
+            acc[DISSIPATED_FRICTION] += friction_1
+            acc[DISSIPATED_FRICTION] += friction_2
+            acc[DISSIPATED_DAMPING] -= damping
+            shear[f, e] = ft
+            bonded[f, e] = bond
+            if is_open:
                 normal[f, e] = 0.0
                 energy[f, e] = 0.0
                 continue
-            fn = fn_elastic - dashpot * opening_rate
-            if not bonded[f, e] and fn < 0.0:
-                fn = 0.0
-            if update_history:
-                acc[DISSIPATED_DAMPING] -= (fn - fn_elastic) * opening_rate * dt
-                slip = (dvx * tx + dvy * ty) * dt
-                trial = ft - ktp * slip
-                cap = mu * max(fn, 0.0) + (coh if bonded[f, e] else 0.0)
-                if abs(trial) > cap:
-                    if bonded[f, e]:
-                        bonded[f, e] = 0
-                        if fn < 0.0:
-                            acc[DISSIPATED_FRICTION] += 0.5 * fn_elastic * fn_elastic / knp
-                            fn = 0.0
-                            fn_elastic = 0.0
-                        cap = mu * fn
-                    acc[DISSIPATED_FRICTION] += cap * (abs(trial) - cap) / ktp
-                    ft = cap if trial > 0.0 else -cap
-                else:
-                    ft = trial
-                shear[f, e] = ft
-            spring = 0.5 * fn_elastic * fn_elastic / knp + 0.5 * ft * ft / ktp
             stored += spring
             if update_history:
                 energy[f, e] = spring

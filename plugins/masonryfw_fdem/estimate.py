@@ -47,7 +47,7 @@ def threads(options: Mapping[str, Any], blocks: int) -> int:
 
 
 def estimate(model: xr.Dataset, options: Mapping[str, Any]) -> mf.Estimate:
-    scene = build_scene(model)
+    scene = mf.made_once(model, "fdem scene", build_scene)
     controls = make_controls(scene, options)
     blocks = model.sizes["block"]
     gravity = GRAVITY_TIME * np.sqrt(masonry_height(scene)) / controls.dt  # scaled time: sqrt(length / g)

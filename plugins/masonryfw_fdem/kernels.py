@@ -78,6 +78,19 @@ class ContactLaw(NamedTuple):
     damping: float
 
 
+class EndLaw(NamedTuple):
+    """The contact law of one face pair's ends (:func:`contact_end`), per unit of an end's share of the overlap:
+    the normal and shear spring stiffnesses, the normal dashpot, the friction coefficient, the cohesion and
+    tensile strength (bonded ends)."""
+
+    knp: float
+    ktp: float
+    dashpot: float
+    mu: float
+    coh: float
+    ten: float
+
+
 class Motion(NamedTuple):
     """What the steps change: positions and velocities (block, 3), positions at the last detection,
     the active (integrated) and calm (slow steps in a row) counters, the accumulators ``acc``."""
@@ -336,6 +349,58 @@ def wake_sleepers(bodies, pairs, law, motion, vx, vy, wake_speed):
                 break
 
 
+@jit
+def contact_end(fn_elastic, opening_rate, slip_rate, ft, bonded, law, dt, update_history):
+    """The contact law at one end of a face pair, for rigid blocks and for nodes alike.
+
+    In: the elastic normal force ``-kn gap`` (compression positive), the opening and sliding rates of the two
+    faces there, the shear spring force ``ft`` and ``bonded`` (1 while the end keeps its cohesion and tensile
+    strength), the face pair's :class:`EndLaw`. A bond breaks in tension beyond ``ten`` or at the first
+    slip; a dry end that opens carries nothing; the dashpot keeps a dry end's normal force compressive; the
+    shear trial is capped by Coulomb's ``mu fn (+ coh while bonded)``.
+
+    Returns ``(open, fn, ft, bonded, spring, friction_1, friction_2, damping)``: whether the end carries no
+    force, its normal and shear forces and bond, the energy its springs store, and the energy dissipated by
+    friction (two terms, each added on its own: the sums are the same bit for bit as written inline) and by
+    the dashpot (``damping``, subtracted). With ``update_history`` False nothing of the history changes.
+    """
+    knp, ktp, dashpot, mu, coh, ten = law
+    friction_1 = 0.0
+    friction_2 = 0.0
+    damping = 0.0
+    if bonded and fn_elastic < -ten and update_history:
+        bonded = 0
+        friction_1 = 0.5 * fn_elastic * fn_elastic / knp
+    if not bonded and fn_elastic <= 0.0:  # open dry end: no force at all
+        if update_history:
+            friction_2 = 0.5 * ft * ft / ktp
+            ft = 0.0
+        return True, 0.0, ft, bonded, 0.0, friction_1, friction_2, damping
+    fn = fn_elastic - dashpot * opening_rate
+    if not bonded and fn < 0.0:
+        fn = 0.0
+    if update_history:
+        damping = (fn - fn_elastic) * opening_rate * dt
+        slip = slip_rate * dt
+        trial = ft - ktp * slip
+        cap = mu * max(fn, 0.0) + (coh if bonded else 0.0)
+        if abs(trial) > cap:
+            if bonded:  # brittle: the bond is lost at the first violation
+                bonded = 0
+                if fn < 0.0:
+                    friction_1 = 0.5 * fn_elastic * fn_elastic / knp
+                    fn = 0.0
+                    fn_elastic = 0.0
+                cap = mu * fn
+            # friction work on the plastic part of the slip increment
+            friction_2 = cap * (abs(trial) - cap) / ktp
+            ft = cap if trial > 0.0 else -cap
+        else:
+            ft = trial
+    spring = 0.5 * fn_elastic * fn_elastic / knp + 0.5 * ft * ft / ktp
+    return False, fn, ft, bonded, spring, friction_1, friction_2, damping
+
+
 @pjit
 def contact_forces(bodies, pairs, law, motion, vx, vy, force, dt, update_history, wake_speed):
     """Add the contact forces of every face pair to ``force`` (block, 3), the vertices at ``vx``, ``vy``.
@@ -400,54 +465,32 @@ def contact_forces(bodies, pairs, law, motion, vx, vy, force, dt, update_history
         ktp = kt * half
         m_inv = inv_mass[a] + inv_mass[b]
         dashpot = 2.0 * contact_damping * np.sqrt(knp / m_inv) if m_inv > 0.0 else 0.0
-        mu, coh, ten = props[f, 0], props[f, 1] * half, props[f, 2] * half
+        end_law = EndLaw(knp, ktp, dashpot, props[f, 0], props[f, 1] * half, props[f, 2] * half)
         for e in range(2):
             s = s_lo if e == 0 else s_hi
             gap = g[6] if e == 0 else g[7]
             h = g[8] if e == 0 else g[9]
             px = ox + s * tx + h * nx
             py = oy + s * ty + h * ny
-            fn_elastic = -knp * gap
             dvx = (vel[b, 0] - vel[b, 2] * (py - pos[b, 1])) - (vel[a, 0] - vel[a, 2] * (py - pos[a, 1]))
             dvy = (vel[b, 1] + vel[b, 2] * (px - pos[b, 0])) - (vel[a, 1] + vel[a, 2] * (px - pos[a, 0]))
-            opening_rate = dvx * nx + dvy * ny
-            ft = shear[f, e]
-            if bonded[f, e] and fn_elastic < -ten and update_history:
-                bonded[f, e] = 0
-                d_friction += 0.5 * fn_elastic * fn_elastic / knp
-            if not bonded[f, e] and fn_elastic <= 0.0:  # open dry end: no force at all
-                if update_history:
-                    d_friction += 0.5 * ft * ft / ktp
-                    shear[f, e] = 0.0
+            is_open, fn, ft, bond, spring, friction_1, friction_2, damping = contact_end(
+                -knp * gap, dvx * nx + dvy * ny, dvx * tx + dvy * ty, shear[f, e], bonded[f, e], end_law, dt,
+                update_history)
+            if friction_1 != 0.0:  # each term on its own, as the law adds them (numba: one reduction a branch)
+                d_friction += friction_1
+            if friction_2 != 0.0:
+                d_friction += friction_2
+            if damping != 0.0:
+                d_damping -= damping
+            shear[f, e] = ft
+            bonded[f, e] = bond
+            if is_open:
                 normal[f, e] = 0.0
                 energy[f, e] = 0.0
                 continue
             if wake_speed > 0.0 and dvx * dvx + dvy * dvy > wake_speed * wake_speed:
                 calm[a] = calm[b] = 0  # touched by something moving: neither may fall asleep
-            fn = fn_elastic - dashpot * opening_rate
-            if not bonded[f, e] and fn < 0.0:
-                fn = 0.0
-            if update_history:
-                d_damping -= (fn - fn_elastic) * opening_rate * dt
-                slip = (dvx * tx + dvy * ty) * dt
-                trial = ft - ktp * slip
-                cap = mu * max(fn, 0.0) + (coh if bonded[f, e] else 0.0)
-                if abs(trial) > cap:
-                    if bonded[f, e]:  # brittle: the bond is lost at the first violation
-                        bonded[f, e] = 0
-                        if fn < 0.0:
-                            d_friction += 0.5 * fn_elastic * fn_elastic / knp
-                            fn = 0.0
-                            fn_elastic = 0.0
-                        cap = mu * fn
-                    limited = cap if trial > 0.0 else -cap
-                    # friction work on the plastic part of the slip increment
-                    d_friction += cap * (abs(trial) - cap) / ktp
-                    ft = limited
-                else:
-                    ft = trial
-                shear[f, e] = ft
-            spring = 0.5 * fn_elastic * fn_elastic / knp + 0.5 * ft * ft / ktp
             stored += spring
             if update_history:
                 energy[f, e] = spring

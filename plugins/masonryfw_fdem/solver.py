@@ -47,7 +47,7 @@ def solve(model: xr.Dataset, options: Mapping[str, Any], progress=mf.no_progress
 
 
 def _solve(model: xr.Dataset, options: Mapping[str, Any], progress) -> xr.Dataset:
-    scene = build_scene(model)
+    scene = mf.made_once(model, "fdem scene", build_scene)  # the one the estimate made
     mf.refuse_rigid_settlement(model, "fdem")
     controls = make_controls(scene, options)
     load = scene.dead + (options["load_factor"] or 0.0) * scene.live

@@ -24,7 +24,6 @@ import xarray as xr
 
 import masonryfw as mf
 
-ROLE = mf.flags("block_role")
 KIND = mf.flags("interface_kind")
 
 
@@ -42,7 +41,7 @@ class WallMesh:
 
 def masonry(model: xr.Dataset) -> np.ndarray:
     """Indices of the units and lintels (the blocks the mesh covers)."""
-    found = np.nonzero(np.isin(model.block_role.values, [ROLE["unit"], ROLE["lintel"]]))[0]
+    found = np.flatnonzero(mf.masonry_blocks(model.block_role.values))
     if found.size == 0:
         raise mf.ModelError("jmm: the model has no unit or lintel blocks to mesh")
     return found

@@ -8,7 +8,9 @@ than ``plateau_slope`` times the first step's rate per unit of the largest displ
 over ``plateau_steps`` steps): the last converged factor is the collapse multiplier."""
 from __future__ import annotations
 
+import math
 from collections import deque
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -158,8 +160,109 @@ def _gravity(newton: NewtonSolver, state: State, history: History, info: dict, p
     return state, bool(failure)
 
 
+@dataclass(frozen=True)
+class Path:
+    """What a run steps along, for :func:`_continue`: the settlement (settlement control) or the live load's factor
+    (load control). ``step(newton, state, target, guess)`` is one Newton step to ``target``; the increment
+    starts at ``first``, grows to at most ``largest`` and a failing step halves it down to ``smallest``; the
+    target never passes ``limit``; ``failure(target, reached)`` says why the run ended when no step converges,
+    ``record(newton, history, state, value, iterations)`` keeps a converged step (and says it),
+    ``stop(history, value)`` why the run ends after one ("" to go on)."""
+
+    step: Callable
+    first: float
+    largest: float
+    smallest: float
+    limit: float
+    failure: Callable[[float, float], str]
+    record: Callable
+    stop: Callable[[History, float], str]
+
+
+def _continue(newton: NewtonSolver, state: State, history: History, info: dict, path: Path, options) -> State:
+    """Converged steps along ``path`` until it stops, the step limit, no step converges or Ctrl-C (``info``'s
+    ``stop_reason``); returns the last converged state. A step that needs few Newton iterations grows the next
+    increment by half, one that needs many halves it. The last converged increment, extrapolated, is the next
+    step's predictor."""
+    value, increment, last = 0.0, path.first, None
+    try:
+        while True:
+            if history.steps >= options["max_steps"]:
+                info["stop_reason"] = f"max_steps ({options['max_steps']}) reached"
+                return state
+            target = min(value + increment, path.limit)
+            guess = None if last is None else state.u + (target - value) / last[1] * last[0]
+            trial, report = path.step(newton, state, target, guess)
+            if not report.converged:
+                increment /= 2
+                if increment < path.smallest:
+                    info["stop_reason"] = path.failure(target, value)
+                    return state
+                continue
+            last = (trial.u - state.u, target - value)
+            state, value = trial, target
+            path.record(newton, history, state, value, report.iterations)
+            stop = path.stop(history, value)
+            if stop:
+                info["stop_reason"] = stop
+                return state
+            if report.iterations <= options["target_iterations"]:
+                increment = min(1.5 * increment, path.largest)
+            elif report.iterations > 2 * options["target_iterations"]:
+                increment *= 0.5
+    except KeyboardInterrupt:
+        _interrupted(info)
+        return state
+
+
+def _interrupted(info: dict) -> None:
+    info["interrupted"] = 1
+    info["stop_reason"] = "interrupted"
+
+
+def _settlement_path(problem: Problem, options, unloading: float, slope: float, progress) -> Path:
+    """Settlement control: from ``first_increment`` elastic unloading settlements (``unloading``) to the target
+    (or 30 of them), until the reaction plateau."""
+    limit = options["settlement"] / problem.displacement if options["settlement"] is not None else 30 * unloading
+    largest = options["max_increment"] * unloading
+    if options["settlement"] is not None:  # a target far away: reachable in TARGET_STEPS full increments
+        largest = max(largest, limit / TARGET_STEPS)
+
+    def record(newton, history, state, settlement, iterations):
+        history.add(newton, state, settlement, 0.0, iterations)
+        progress(min(0.99, settlement / limit), f"step {history.steps}: settlement "
+                 f"{settlement * problem.displacement:.3g} m, reaction {history.reaction[-1] * problem.force:.4g} N, "
+                 f"{iterations} Newton iterations")
+
+    def stop(history, settlement):
+        if _plateau(history, slope, options):
+            return "reaction plateau"
+        return "target settlement reached" if settlement >= limit else ""
+
+    return Path(step=lambda newton, state, target, guess: newton.step(state, 1.0, target, guess=guess),
+                first=options["first_increment"] * unloading, largest=largest, smallest=MIN_INCREMENT * unloading,
+                limit=limit, failure=lambda target, reached: f"no convergence at settlement "
+                f"{target * problem.displacement:.4g} m", record=record, stop=stop)
+
+
+def _load_path(options, progress) -> Path:
+    """Load control: the live load's factor from ``load_increment`` until no step converges (the limit load) or the
+    load plateau."""
+    def record(newton, history, state, factor, iterations):
+        history.add(newton, state, 0.0, factor, iterations)
+        progress(min(0.99, history.steps / options["max_steps"]),
+                 f"step {history.steps}: load factor {factor:.4g}, {iterations} Newton iterations")
+
+    return Path(step=lambda newton, state, target, guess: newton.step(state, 1.0, 0.0, guess=guess,
+                                                                      load_factor=target),
+                first=options["load_increment"], largest=math.inf, smallest=options["load_tolerance"],
+                limit=math.inf, failure=lambda target, reached: f"no convergence above load factor {reached:.6g}: "
+                "the limit load", record=record,
+                stop=lambda history, factor: "load plateau" if _load_plateau(history, options) else "")
+
+
 def run(problem: Problem, options, progress) -> tuple[State, History, dict]:
-    """Gravity, then settlement steps until the plateau; every converged step kept."""
+    """Gravity, then settlement steps until the plateau (or the target); every converged step kept."""
     newton, history, info, state = _start(problem, options)
     try:
         state, failed = _gravity(newton, state, history, info, progress)
@@ -167,48 +270,10 @@ def run(problem: Problem, options, progress) -> tuple[State, History, dict]:
             return state, history, info
         unloading, slope = elastic_unloading_settlement(newton, state)
         info["jmm_elastic_unloading_settlement_m"] = unloading * problem.displacement
-        limit = (options["settlement"] / problem.displacement if options["settlement"] is not None
-                 else 30 * unloading)
-        increment, settlement = options["first_increment"] * unloading, 0.0
-        largest = options["max_increment"] * unloading
-        if options["settlement"] is not None:  # a target far away: reachable in TARGET_STEPS full increments
-            largest = max(largest, limit / TARGET_STEPS)
-        last_increment = None  # (du, ds) of the last converged step, extrapolated as a second predictor
-        while True:
-            if history.steps >= options["max_steps"]:
-                info["stop_reason"] = f"max_steps ({options['max_steps']}) reached"
-                break
-            target = min(settlement + increment, limit)
-            guess = None
-            if last_increment is not None:
-                du, ds = last_increment
-                guess = state.u + (target - settlement) / ds * du
-            trial, report = newton.step(state, 1.0, target, guess=guess)
-            if not report.converged:
-                increment /= 2
-                if increment < MIN_INCREMENT * unloading:
-                    info["stop_reason"] = f"no convergence at settlement {target * problem.displacement:.4g} m"
-                    break
-                continue
-            last_increment = (trial.u - state.u, target - settlement)
-            state, settlement = trial, target
-            history.add(newton, state, settlement, 0.0, report.iterations)
-            progress(min(0.99, settlement / limit), f"step {history.steps}: settlement "
-                     f"{settlement * problem.displacement:.3g} m, reaction {history.reaction[-1] * problem.force:.4g} N, "
-                     f"{report.iterations} Newton iterations")
-            if _plateau(history, slope, options):
-                info["stop_reason"] = "reaction plateau"
-                break
-            if settlement >= limit:
-                info["stop_reason"] = "target settlement reached"
-                break
-            if report.iterations <= options["target_iterations"]:
-                increment = min(1.5 * increment, largest)
-            elif report.iterations > 2 * options["target_iterations"]:
-                increment *= 0.5
+        state = _continue(newton, state, history, info, _settlement_path(problem, options, unloading, slope, progress),
+                          options)
     except KeyboardInterrupt:
-        info["interrupted"] = 1
-        info["stop_reason"] = "interrupted"
+        _interrupted(info)
     return state, history, info
 
 
@@ -231,35 +296,9 @@ def run_load_factor(problem: Problem, options, progress) -> tuple[State, History
         state, failed = _gravity(newton, state, history, info, progress)
         if failed:
             return state, history, info
-        factor, increment, last = 0.0, options["load_increment"], None
-        while True:
-            if history.steps >= options["max_steps"]:
-                info["stop_reason"] = f"max_steps ({options['max_steps']}) reached"
-                break
-            target = factor + increment
-            guess = None if last is None else state.u + (target - factor) / last[1] * last[0]
-            trial, report = newton.step(state, 1.0, 0.0, guess=guess, load_factor=target)
-            if not report.converged:
-                increment /= 2
-                if increment < options["load_tolerance"]:
-                    info["stop_reason"] = f"no convergence above load factor {factor:.6g}: the limit load"
-                    break
-                continue
-            last = (trial.u - state.u, target - factor)
-            state, factor = trial, target
-            history.add(newton, state, 0.0, factor, report.iterations)
-            progress(min(0.99, history.steps / options["max_steps"]),
-                     f"step {history.steps}: load factor {factor:.4g}, {report.iterations} Newton iterations")
-            if _load_plateau(history, options):
-                info["stop_reason"] = "load plateau"
-                break
-            if report.iterations <= options["target_iterations"]:
-                increment *= 1.5
-            elif report.iterations > 2 * options["target_iterations"]:
-                increment *= 0.5
+        state = _continue(newton, state, history, info, _load_path(options, progress), options)
     except KeyboardInterrupt:
-        info["interrupted"] = 1
-        info["stop_reason"] = "interrupted"
+        _interrupted(info)
     return state, history, info
 
 

@@ -14,25 +14,20 @@ From Python::
 """
 from __future__ import annotations
 
-import importlib
+import lazy_loader
 
 import masonryfw as mf
 
 from .commands import available_commands
 
-#: The Python API, imported on first access (PEP 562): registering the plugin stays cheap.
-_PUBLIC = {
-    "Param": "params", "parse_param": "params", "Store": "store", "content_key": "store",
-    "SweepPlan": "sweep", "combine": "sweep", "dask_client": "sweep", "failed_points": "sweep",
-    "plan_sweep": "sweep", "run_sweep": "sweep", "verify_archive": "archive", "write_archive": "archive",
-}
-__all__ = sorted(_PUBLIC)
-
-
-def __getattr__(name: str):
-    if name in _PUBLIC:
-        return getattr(importlib.import_module(f".{_PUBLIC[name]}", __name__), name)
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+#: The Python API, imported on first access (lazy_loader, Scientific Python's SPEC 1): registering the plugin stays cheap.
+# no __dir__: pluggy finds the hook implementations by dir(module)
+__getattr__, _, __all__ = lazy_loader.attach(__name__, submod_attrs={
+    "archive": ["verify_archive", "write_archive"],
+    "params": ["Param", "parse_param"],
+    "store": ["Store", "content_key"],
+    "sweep": ["SweepPlan", "combine", "dask_client", "failed_points", "plan_sweep", "run_sweep"],
+})
 
 
 @mf.hookimpl

@@ -61,3 +61,31 @@ def test_a_comparison_of_n_results_checks_each_once(monkeypatch):
     results[0].block_unit_weight.values[3] = -1.0  # edited in place: checked again, and refused
     with pytest.raises(mf.ModelError, match="block_unit_weight"):
         mf.compare(results[0], results[1])
+
+
+def test_a_solve_from_the_command_line_checks_looks_up_resolves_and_builds_once(monkeypatch, tmp_path):
+    """The CLI checked a model twice (``open_model``, then ``checked_model``), looked the solver up and resolved its
+    options twice (for the estimate, then the solve), and fdem built its scene twice: once each now."""
+    from masonryfw import cli, model
+    from masonryfw_fdem import estimate, solver
+
+    calls: dict[str, int] = {}
+
+    def counted(module, name):
+        real = getattr(module, name)
+
+        def call(*args, **kwargs):
+            calls[name] = calls.get(name, 0) + 1
+            return real(*args, **kwargs)
+        monkeypatch.setattr(module, name, call)
+
+    counted(model, "check")
+    counted(api, "lookup")
+    counted(api, "resolve_options")
+    counted(estimate, "build_scene")
+    monkeypatch.setattr(solver, "build_scene", estimate.build_scene)  # one counter for both
+    with pytest.raises(SystemExit) as end:
+        cli.main(["solve", "test-12c", "--plugin", "fdem", "--option", "settlement=0.0002", "--no-progress",
+                  "-o", str(tmp_path / "r.nc")])
+    assert end.value.code == 0
+    assert calls == {"check": 1, "lookup": 1, "resolve_options": 1, "build_scene": 1}

@@ -1,0 +1,96 @@
+"""A model in words, as ``masonryfw info`` prints it: its counts, size, settlement profile, supports and loads."""
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from .geometry import block_bounds, node_block
+from .profiles import Profile, model_profile
+from .roles import ROLE, masonry_blocks, support_blocks
+from .schema import flags
+
+if TYPE_CHECKING:  # annotations only
+    import xarray as xr
+
+
+def describe_model(model: xr.Dataset) -> list[str]:
+    """The lines that describe ``model`` (a checked model: its derived geometry is read)."""
+    masonry = masonry_blocks(model.block_role.values)
+    owner = node_block(model.block_node_count.values)
+    x, y = model.node_x.values[masonry[owner]], model.node_y.values[masonry[owner]]
+    lines = [f"title: {model.attrs.get('title', '')}",
+             f"blocks: {model.sizes['block']} ({_counts(model.block_role.values, 'block_role')})",
+             f"interfaces: {model.sizes.get('interface', 0)} ({_counts(model.interface_kind.values, 'interface_kind')})"]
+    if x.size:
+        lines += [f"wall: {np.ptp(x):.6g} m x {np.ptp(y):.6g} m (x {x.min():.6g}..{x.max():.6g}, "
+                  f"y {y.min():.6g}..{y.max():.6g})",
+                  f"thickness: {_span(model.block_thickness.values[masonry])}"]
+    profile = model_profile(model)
+    if profile is not None:
+        lines.append(f"settlement profile: {profile_text(profile)}")
+    return lines + ["supports:", *_support_lines(model), "loads:", *_load_lines(model)]
+
+
+def _counts(values: np.ndarray, flag_variable: str) -> str:
+    meanings = flags(flag_variable)
+    counts = np.bincount(np.asarray(values, dtype=np.int64), minlength=max(meanings.values()) + 1)
+    return ", ".join(f"{meaning.replace('_', ' ')} {counts[value]}" for meaning, value in meanings.items())
+
+
+def _span(values: np.ndarray) -> str:
+    low, high = float(np.min(values)), float(np.max(values))
+    return f"{low:.6g} m" if np.isclose(low, high) else f"{low:.6g}..{high:.6g} m"
+
+
+def _support_lines(model: xr.Dataset) -> list[str]:
+    """One line per support block: its x range and how it moves (supports are few)."""
+    xmin, xmax, _, _ = block_bounds(model.node_x.values, model.node_y.values, model.block_node_count.values)
+    lines = []
+    for block in np.flatnonzero(support_blocks(model.block_role.values)):
+        held = model.block_fixed.values[block]
+        if model.block_role.values[block] == ROLE["fixed_support"]:
+            motion = f"fixed (held {' '.join(map(str, held))})"
+        else:
+            motion = "moving: " + _support_motion(model.settlement_direction.values[block], xmin[block], xmax[block],
+                                                  float(model.block_centroid_x.values[block]))
+        lines.append(f"  block {block}: x {xmin[block]:.6g}..{xmax[block]:.6g} m, {motion}")
+    return lines
+
+
+def profile_text(profile: Profile) -> str:
+    """A settlement profile in a line: its kind and parameters, a tunnel's trough and S_max."""
+    if profile.kind == "tunnel":
+        return (f"tunnel, V_L {profile.volume_loss:g} %, D {profile.diameter:g} m, axis {profile.depth:g} m deep at "
+                f"x {profile.center:g} m, K {profile.trough_width_factor:g}: i {profile.width:.4g} m, S_max "
+                f"{1e3 * profile.target:.4g} mm (settlement_target); segments {profile.segment:.4g} m")
+    if profile.kind == "gaussian":
+        sideways = f", ground moving towards the axis (z0 {profile.depth:g} m)" if profile.depth else ""
+        return f"gaussian trough, axis x {profile.center:g} m, i {profile.width:.4g} m{sideways}; segments {profile.segment:.4g} m"
+    if profile.kind == "linear":
+        return f"tilt from x {profile.start:g} m (rate 0) to x {profile.end:g} m (rate 1); segments {profile.segment:.4g} m"
+    return f"table of {len(profile.points)} rates; segments {profile.segment:.4g} m"
+
+
+def _support_motion(direction, x0: float, x1: float, centre_x: float) -> str:
+    """What a moving support does per unit settlement parameter t, in words: its settlement (at its two ends
+    when it turns), sideways motion and rotation, then the settlement direction itself."""
+    ux, uy, rz = (float(d) for d in direction)
+    raw = f"settlement direction ({', '.join(f'{d:.4g}' for d in direction)})"
+    if rz == 0:
+        sideways = f", sideways {ux:.4g}" if ux else ""
+        return f"translates: settles {-uy:.4g}{sideways} per unit t; {raw}"
+    left, right = -(uy + rz * (x0 - centre_x)) + 0.0, -(uy + rz * (x1 - centre_x)) + 0.0  # no "-0"
+    return (f"translates and turns: settles {left:.4g} at its left end and {right:.4g} at its right, turns "
+            f"{rz:.4g} rad per unit t; {raw}")
+
+
+def _load_lines(model: xr.Dataset) -> list[str]:
+    on_support = support_blocks(model.block_role.values)
+    lines = []
+    for name in ("dead_load", "live_load"):
+        load = model[name].values
+        for label, rows in (("masonry", ~on_support), ("supports", on_support)):
+            fx, fy = load[rows, 0].sum(), load[rows, 1].sum()
+            lines.append(f"  {name.replace('_', ' ')} on {label}: Fx = {fx:.6g} N, Fy = {fy:.6g} N")
+    return lines
