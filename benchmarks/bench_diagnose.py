@@ -19,9 +19,7 @@ import numpy as np
 from _report import command_line, write_section
 
 import masonryfw as mf
-from masonryfw_diagnose import diagnose, read_cracks, read_levelling
-from masonryfw_diagnose.survey import Survey
-from masonryfw_diagnose.synthetic import visible_cracks
+from masonryfw_diagnose import Survey, diagnose, read_cracks, read_levelling, visible_cracks
 
 SURVEYS = Path(__file__).resolve().parents[1] / "datasets" / "surveys"
 SEGMENTS = (0.15, 0.1, 0.075, 0.05)

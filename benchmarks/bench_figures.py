@@ -17,7 +17,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from _report import command_line, write_section  # noqa: E402
-from bench_scale import wall_spec  # noqa: E402
+from _walls import scale_spec  # noqa: E402
 
 import masonryfw as mf  # noqa: E402
 
@@ -42,7 +42,7 @@ def main() -> None:
     with tempfile.TemporaryDirectory() as folder:
         cwd = Path(folder)
         for units in SIZES:
-            model = mf.build(wall_spec(units))
+            model = mf.build(scale_spec(units))
             blocks = model.sizes["block"]
             mf.save(mf.solve(model, "la"), cwd / f"w{units}.nc")
             times = [_median(["plot", f"w{units}.nc", "--kind", kind, "-o", f"{kind}{units}.png"], cwd)

@@ -18,8 +18,8 @@ from pathlib import Path
 from _report import command_line, write_section
 
 import masonryfw as mf
+import masonryfw.plugin_api as mfp
 from masonryfw.datasets.drawings import generate
-from masonryfw.drawing import read_drawing
 
 SIZES = ((20, 25), (40, 50), (80, 80))  # (courses, units per course): ~500, ~2,000, ~5,000 blocks merged
 
@@ -63,9 +63,9 @@ def row(folder: Path, courses: int, units: int, merged: bool, kind: str = "dxf")
             handle.write("block,x,y,layer\n")
             for i, (polygon, layer) in enumerate(zip(polygons, layers)):
                 handle.writelines(f"{i},{x},{y},{layer}\n" for x, y in polygon)
-    read, drawing = timed(lambda: read_drawing(path, "mm"))
+    read, drawing = timed(lambda: mfp.read_drawing(path, "mm"))
     total, model = timed(lambda: mf.build(spec(path)))
-    non_convex = int((~mf.convex_blocks(model.node_x.values, model.node_y.values,
+    non_convex = int((~mfp.convex_blocks(model.node_x.values, model.node_y.values,
                                         model.block_node_count.values)).sum())
     return f"| {kind} | {model.sizes['block']} | {non_convex} | {model.sizes['interface']} | {read:.2f} | {total:.2f} |"
 

@@ -13,6 +13,7 @@ import numpy as np
 from _report import command_line, write_section
 
 import masonryfw as mf
+import masonryfw.plugin_api as mfp
 from masonryfw_jmm.material import JointStrength, ReturnMap, elastic_matrix
 from masonryfw_jmm.newton import NewtonSolver, State
 from masonryfw_jmm.options import INCREMENTAL_OPTIONS
@@ -32,7 +33,7 @@ def median_time(function, repeat: int = 5) -> float:
 
 def kernels(case: str) -> list[str]:
     options = dict(DEFAULT)
-    model = mf.derive_geometry(mf.open_model(case))
+    model = mfp.derive_geometry(mf.open_model(case))
     problem = build_problem(model, options)
     newton = NewtonSolver(problem)
     non_associated = NewtonSolver(problem)

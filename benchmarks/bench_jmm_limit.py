@@ -14,8 +14,9 @@ import numpy as np
 from _report import command_line, write_section
 
 import masonryfw as mf
+import masonryfw.plugin_api as mfp
 
-FLAG = mf.flags("qp_failure")
+FLAG = mfp.flags("qp_failure")
 
 
 def limit_row(case: str, repeat: int, incremental: bool) -> str:

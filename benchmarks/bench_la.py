@@ -35,12 +35,14 @@ import numpy as np
 import scipy.sparse as sp
 
 import masonryfw as mf
+import masonryfw.plugin_api as mfp
 from masonryfw_la import assembly, backends
-from masonryfw_la.options import DEFAULT_BACKEND
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from _report import write_section  # noqa: E402
+from _walls import running_bond_spec  # noqa: E402
 
+DEFAULT_BACKEND = next(option.default for option in mf.get_solver("la").options if option.name == "solver")
 BACKENDS = ("ipm", "clarabel", "highs", "osqp")
 REPEATS = 3
 THRESHOLDS = (1e-6, 1e-4, 1e-3, 0.01, 0.05, 0.1, 0.2)
@@ -66,7 +68,7 @@ def timed_solve(model, **given):
 
 def masonry_macro_blocks(result) -> int:
     """The masonry's macro-blocks as ``result`` labels them (at the threshold it was derived at)."""
-    return int(np.unique(result.macro_block.values[mf.masonry_blocks(result.block_role.values)]).size)
+    return int(np.unique(result.macro_block.values[mfp.masonry_blocks(result.block_role.values)]).size)
 
 
 def same_cracks(result, reference) -> float:
@@ -114,7 +116,7 @@ def other_forms() -> str:
 
     rows = []
     for case in ("test-12c", "facade-3"):
-        model = mf.derive_geometry(mf.open_model(case))
+        model = mfp.derive_geometry(mf.open_model(case))
         wall = assembly.Wall.from_model(model)
         scales = assembly.model_scales(model, wall)
         lp = assembly.assemble(wall, scales, assembly.interface_kinematics(wall, scales))
@@ -181,27 +183,9 @@ def other_forms() -> str:
     )
 
 
-def running_bond_spec(courses: int, units: int) -> dict:
-    width = units * 0.2
-    split = round(0.6 * width, 9)
-    return {
-        "title": f"running bond {courses} x {units}",
-        "length_unit": "m",
-        "wall": {"width": width, "height": courses * 0.05, "thickness": 0.1},
-        "unit": {"length": 0.2, "height": 0.05},
-        "bond": {"pattern": "running", "first_course": "full"},
-        "material": {"unit_weight": 12000.0, "friction_angle": 21.8, "cohesion": 0.0, "tensile_strength": 0.0},
-        "supports": {
-            "fixed": {"kind": "fixed", "start": 0.0, "end": split},
-            "settling": {"kind": "moving", "start": split, "end": width, "motion": "translation"},
-        },
-        "loading": {"type": "settlement"},
-    }
-
-
 def one_size(size: int, backend: str) -> dict:
     """Solve one running-bond wall once (run in a child process: its peak RSS is this solve's)."""
-    model = mf.derive_geometry(mf.build(running_bond_spec(*SIZES[size])))
+    model = mfp.derive_geometry(mf.build(running_bond_spec(*SIZES[size])))
     rss_before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
     if size <= WARM_UP_BELOW:  # imports (cvxopt: 30 ms) and first calls would otherwise be most of the LP time
         mf.solve(model, "la", {"solver": backend})

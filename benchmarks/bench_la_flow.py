@@ -22,10 +22,12 @@ import time
 from _report import write_section
 
 import masonryfw as mf
+import masonryfw.plugin_api as mfp
 from masonryfw_la import nonassociative
 
 sys.path.insert(0, os.path.dirname(__file__))
-from bench_la import SIZES, running_bond_spec  # noqa: E402
+from _walls import running_bond_spec  # noqa: E402
+from bench_la import SIZES  # noqa: E402
 
 PAIRS = 3
 NON = {"flow": "nonassociative"}
@@ -106,7 +108,7 @@ def main(argv=None) -> None:
     walls = [(case, mf.open_model(case)) for case in mf.CASE_NAMES]
     ten = pair_rows(walls, PAIRS)
     sizes = (1_000, 10_000) if args.big else (1_000,)
-    running = {size: mf.derive_geometry(mf.build(running_bond_spec(*SIZES[size]))) for size in sizes}
+    running = {size: mfp.derive_geometry(mf.build(running_bond_spec(*SIZES[size]))) for size in sizes}
     big = pair_rows([(f"running bond, {size:,} units", running[size]) for size in sizes], 1)
     selection = selection_rows([(case, mf.open_model(case)) for case in ("test-12c", "panel-5", "facade-3")], PAIRS)
     selection += selection_rows([("running bond, 1,000 units", running[1_000])], 1)

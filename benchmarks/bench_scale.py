@@ -24,33 +24,12 @@ import time
 from pathlib import Path
 
 from _report import write_section
+from _walls import scale_spec
 
 import masonryfw as mf
 
 SIZES = (300, 1_000, 2_400, 10_000)
 SOLVERS = ("la", "fdem", "jmm", "jmm-limit")
-
-
-def wall_spec(units: int) -> dict:
-    """Running bond of 200 x 50 mm units, 8:3, the right 40 % of the base settling."""
-    courses = round(math.sqrt(1.5 * units))
-    per_course = round(units / courses)
-    width = round(per_course * 0.2, 9)
-    split = round(0.6 * width, 9)
-    return {
-        "title": f"running bond {courses} x {per_course}",
-        "length_unit": "m",
-        "wall": {"width": width, "height": round(courses * 0.05, 9), "thickness": 0.1},
-        "unit": {"length": 0.2, "height": 0.05},
-        "bond": {"pattern": "running", "first_course": "full"},
-        "material": {"unit_weight": 18000.0, "friction_angle": 30.0, "cohesion": 0.0, "tensile_strength": 0.0,
-                     "young_modulus": 3e9, "poisson_ratio": 0.2},
-        "supports": {
-            "fixed": {"kind": "fixed", "start": 0.0, "end": split},
-            "settling": {"kind": "moving", "start": split, "end": width, "motion": "translation"},
-        },
-        "loading": {"type": "settlement"},
-    }
 
 
 def run(command: list[str], limit: float) -> tuple[float, float, int]:
@@ -122,7 +101,7 @@ def main(argv=None) -> None:
             if size not in sizes and "la" not in solvers:
                 continue
             spec = Path(tmp, f"wall-{size}.toml")
-            spec.write_text(mf.dump_toml(wall_spec(size)))
+            spec.write_text(mf.dump_toml(scale_spec(size)))
             model = Path(tmp, f"wall-{size}.nc")
             seconds, peak, code = run([sys.executable, "-m", "masonryfw", "build", str(spec), "-o", str(model)],
                                       args.limit)

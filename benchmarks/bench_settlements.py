@@ -18,6 +18,7 @@ import time
 from _report import command_line, write_section
 
 import masonryfw as mf
+import masonryfw.plugin_api as mfp
 
 PAIRS = 3
 OPTIONS = {"settlement": 0.02, "plateau_tolerance": 0.0}
@@ -47,7 +48,7 @@ def main() -> None:
         ratios.append(a / b)
     slow, reference = timed(trough, {**OPTIONS, "loading_rate": 1e-3})
     default, fine = numbers(result_a), numbers(reference)
-    moving = int((trough.block_role.values == mf.flags("block_role")["moving_support"]).sum())
+    moving = int((trough.block_role.values == mfp.flags("block_role")["moving_support"]).sum())
     body = f"""
 fdem (rigid blocks) to S_max = 20 mm, `plateau_tolerance=0`, {PAIRS} A/B pairs in one process
 (load average before: {load[0]:.2f}, {load[1]:.2f}, {load[2]:.2f}). A: `facade-1-trough`

@@ -29,9 +29,7 @@ import time
 from pathlib import Path
 
 import masonryfw as mf
-from masonryfw_sweep import dask_client, plan_sweep, run_sweep
-from masonryfw_sweep.params import point_assignments, with_values
-from masonryfw_sweep.tasks import run_point
+from masonryfw_sweep import dask_client, plan_sweep, point_assignments, run_point, run_sweep, with_values
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from _report import command_line, write_section  # noqa: E402

@@ -81,3 +81,13 @@ class Command:
         if self.process.poll() is None:
             self.process.kill()
             self.process.communicate()
+
+
+def tilted_drawing_spec(drawing, key: str = "dxf", unit: str | None = None, thickness: float = 0.1,
+                        unit_weight: float = 18000.0, friction: float = 30.0, title: str = "drawn") -> str:
+    """The TOML of a wall drawn in ``drawing`` (``geometry.<key>``, in ``unit``: the drawing's own when None)
+    standing on its lowest block, on a tilting table."""
+    drawing_unit = f'drawing_unit = "{unit}"\n' if unit else ""
+    return (f'title = "{title}"\n[geometry]\n{key} = "{drawing}"\n{drawing_unit}[wall]\nthickness = {thickness!r}\n'
+            f'[material]\nunit_weight = {unit_weight!r}\nfriction_angle = {friction!r}\n'
+            '[supports.base]\nkind = "fixed"\nselect = "lowest"\n[loading]\ntype = "tilt"\ndirection = 1\n')

@@ -46,6 +46,7 @@ if TYPE_CHECKING:  # annotations only
 #: Limiting tensile strains of LTSM categories 1 to 4 (Boscardin & Cording 1989; Burland 1995).
 LTSM_LIMITS = (5.0e-4, 7.5e-4, 1.5e-3, 3.0e-3)
 E_OVER_G = 2.6
+#: Poisson's ratio of the deep beam of the LTSM (Burland & Wroth 1974: E/G = 2.6 for masonry).
 POISSON = 0.3
 #: Stage 1: a building is screened out when its greenfield slope and settlement stay under these.
 SCREEN_SLOPE = 1.0 / 500.0

@@ -48,7 +48,7 @@ from .material import Material
 from .model import checked_model
 from .plausibility import warn_implausible
 from .profiles import SETTLEMENT_KEYS, Profile, profile_segments, read_profile, with_profile
-from .schema import flags
+from .roles import ROLE
 from .spec import (
     LENGTH_UNITS,
     SpecTable,
@@ -422,7 +422,6 @@ def unit_rectangles(wall: Wall):
 
 def masonry_blocks(wall: Wall):
     """``(x0, x1, y0, y1, role)`` of units and lintels, course by course, left to right."""
-    role = flags("block_role")
     course, x0, x1 = unit_rectangles(wall)
     lintels = [o for o in wall.openings if o.lintel_bearing > 0]
     l_course = np.array([o.course1 for o in lintels], dtype=np.int64)
@@ -431,7 +430,7 @@ def masonry_blocks(wall: Wall):
     course = np.concatenate((course, l_course))
     x0 = np.clip(np.concatenate((x0, l_x0)), 0.0, wall.width)
     x1 = np.clip(np.concatenate((x1, l_x1)), 0.0, wall.width)
-    kinds = np.concatenate((np.full(x0.size - l_x0.size, role["unit"]), np.full(l_x0.size, role["lintel"])))
+    kinds = np.concatenate((np.full(x0.size - l_x0.size, ROLE["unit"]), np.full(l_x0.size, ROLE["lintel"])))
     order = np.lexsort((x0, course))
     y0 = course[order] * wall.unit_height
     return x0[order], x1[order], y0, y0 + wall.unit_height, kinds[order].astype(np.int8)
@@ -473,7 +472,7 @@ def _build_parametric(spec_dict: dict, text: str, validate: bool) -> xr.Dataset:
     x0, x1 = np.concatenate((mx0, s_x0)), np.concatenate((mx1, s_x1))
     y0 = np.concatenate((my0, np.full(s_x0.size, -wall.unit_height)))
     y1 = np.concatenate((my1, np.zeros(s_x0.size)))
-    role = np.concatenate((m_role, np.full(s_x0.size, flags("block_role")["fixed_support"], dtype=np.int8)))
+    role = np.concatenate((m_role, np.full(s_x0.size, ROLE["fixed_support"], dtype=np.int8)))
     supports = [blocks.Support(_support_label(s.name), s.kind, s.motion, s.pivot, s.rate, s.ground)
                 for s in wall.supports]
     material = wall.material

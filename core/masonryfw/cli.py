@@ -19,6 +19,7 @@ import click
 import numpy as np
 
 import masonryfw as mf
+import masonryfw.plugin_api as mfp
 from masonryfw import inputs, signals
 from masonryfw.command_kit import OPTIONS, PROGRESS, command_line
 from masonryfw.locks import release_all
@@ -101,10 +102,10 @@ def cli(debug: bool) -> None:
 @click.option("-o", "--output", type=click.Path(dir_okay=False), help="Model file to write [default: <spec stem>.nc].")
 def build(spec: str, output: str | None) -> None:
     """Build a model from SPEC (a TOML file or a bundled case name)."""
-    spec_path = mf.source_path(spec)
-    inputs = mf.input_files(spec)
+    spec_path = mfp.source_path(spec)
+    inputs = mfp.input_files(spec)
     out = Path(output) if output else Path(f"{Path(spec).stem}.nc")
-    mf.check_output_path(out, inputs)
+    mfp.check_output_path(out, inputs)
     model = mf.build(spec_path)
     mf.save(model, out, command=command_line(), protect=inputs)
     click.echo(f"wrote {out}: {model.sizes['block']} blocks, {model.sizes.get('interface', 0)} interfaces")
@@ -195,7 +196,7 @@ def _open_input(path_or_name: str, validate: bool = True):
     """A dataset file as it is (model, result); a spec file or a bundled case name as its model
     (not checked with ``validate`` False: to draw a model that is wrong)."""
     path = Path(path_or_name)
-    if path.is_file() and not mf.is_spec(path):
+    if path.is_file() and not mfp.is_spec(path):
         return mf.open_checked(path) if validate else mf.open_dataset(path)
     return mf.open_model(path_or_name, validate=validate)
 
@@ -216,19 +217,19 @@ def solve(model: str, solver: str, output: str | None, options: dict[str, str], 
     (incremental solvers); else the solver's scalar outputs. Ctrl-C keeps what an incremental solver has computed
     so far (exit status 130).
     """
-    inputs = mf.input_files(model)
+    inputs = mfp.input_files(model)
     out = Path(output) if output else Path(f"{Path(model).stem if inputs else model}.{solver}.nc")
-    mf.check_output_path(out, inputs)
+    mfp.check_output_path(out, inputs)
     plan = mf.solve_plan(mf.open_model(model), solver, options)  # checked, looked up, resolved, estimated: once
     expected = plan.estimate
     if expected is not None and expected.seconds > UNASKED_RUN and not force and "settlement" not in options:
-        raise mf.MasonryError(f"{solver}: expect about {mf.duration_text(expected.seconds)} ({expected.basis}), over "
+        raise mf.MasonryError(f"{solver}: expect about {mfp.duration_text(expected.seconds)} ({expected.basis}), over "
                               f"the {UNASKED_RUN / 3600:g} h a run starts without asking; is the model what was meant "
                               f"(see its warnings)? Run it with --force, or end it sooner with --option settlement=...")
     if expected is not None and expected.seconds > LONG_RUN:
-        click.echo(f"{solver}: expect about {mf.duration_text(expected.seconds)} and "
-                   f"{mf.size_text(expected.memory)} ({expected.basis}); Ctrl-C keeps what is computed", err=True)
-    bar = mf.progress_bar(progress)
+        click.echo(f"{solver}: expect about {mfp.duration_text(expected.seconds)} and "
+                   f"{mfp.size_text(expected.memory)} ({expected.basis}); Ctrl-C keeps what is computed", err=True)
+    bar = mfp.progress_bar(progress)
     try:
         result = plan.run(progress=bar)
     except KeyboardInterrupt:
@@ -276,7 +277,7 @@ def compare(
     if output and len(results) != 2:
         raise mf.MasonryError(f"-o writes the comparison of two results, got {len(results)}: compare them in pairs")
     if output:
-        mf.check_output_path(output, list(results))
+        mfp.check_output_path(output, list(results))
     datasets = [mf.open_dataset(r) for r in results]
     pairs = list(itertools.combinations(range(len(results)), 2))
     comparisons = [mf.compare(datasets[i], datasets[j], comparator, options) for i, j in pairs]
@@ -289,11 +290,11 @@ def compare(
     for letter, path, ds in zip(letters, results, datasets):
         click.echo(f"{letter}: {path} ({mf.result_label(ds)})")
     click.echo("")
-    click.echo(mf.text_table(["", *letters], mf.headline_rows(datasets)))
+    click.echo(mfp.text_table(["", *letters], mfp.headline_rows(datasets)))
     click.echo("")
-    rows = mf.score_rows(comparisons)
+    rows = mfp.score_rows(comparisons)
     header = [f"{comparisons[0].attrs['comparator']} score", *(f"{letters[i]}-{letters[j]}" for i, j in pairs)]
-    click.echo(mf.text_table(header, rows) if rows else "(no scalar scores)")
+    click.echo(mfp.text_table(header, rows) if rows else "(no scalar scores)")
     if output:
         click.echo(f"comparison: {output}")
 
@@ -323,17 +324,17 @@ def plot(results: tuple[str, ...], kind: str | None, output: str, file_format: s
 
     Kinds that overlay (history) or set side by side (compare) take several results.
     """
-    inputs = mf.input_files(*results)
+    inputs = mfp.input_files(*results)
     wanted = f".{file_format}" if file_format else Path(output).suffix.lower()
     if wanted != Path(output).suffix.lower():
         raise mf.MasonryError(f"{output}: --format {file_format} needs a file ending in {wanted}")
     if wanted == ".csv":
-        mf.check_output_path(output, inputs, (".csv",))
+        mfp.check_output_path(output, inputs, (".csv",))
         header, rows = mf.plot_table([_open_input(r) for r in results], kind, options)
-        mf.save_text(mf.csv_text(header, rows), output, protect=inputs, suffixes=(".csv",))
+        mfp.save_text(mfp.csv_text(header, rows), output, protect=inputs, suffixes=(".csv",))
         click.echo(f"table: {output} ({len(rows)} rows)")
         return
-    mf.check_output_path(output, inputs, mf.io.FIGURE_FORMATS)
+    mfp.check_output_path(output, inputs, mfp.FIGURE_FORMATS)
     figure = mf.render([_open_input(r, validate=kind != "model") for r in results], kind, options)
     mf.save_figure(figure, output, protect=inputs)
     click.echo(f"plot: {output}")

@@ -42,7 +42,7 @@ class Length(click.ParamType):
 #: ``type=LENGTH``: a positive, finite length in metres.
 LENGTH = Length()
 
-#: ``@PROGRESS``: ``--progress/--no-progress`` (``mf.progress_bar`` draws what it asks for).
+#: ``@PROGRESS``: ``--progress/--no-progress`` (``progress_bar`` draws what it asks for).
 PROGRESS = click.option("--progress/--no-progress", default=None,
                         help="Progress on stderr [default: a bar on a terminal, a line a stage or 10 % elsewhere].")
 

@@ -27,6 +27,7 @@ from .records import Comparator, Plotter, Solver
 
 PROJECT = "masonryfw"
 hookspec = pluggy.HookspecMarker(PROJECT)
+#: The pluggy marker of a plugin's hook implementations (``@mfp.hookimpl``).
 hookimpl = pluggy.HookimplMarker(PROJECT)
 
 

@@ -45,7 +45,7 @@ from .ground import ground_pieces, made_ground, polygons
 from .material import Material
 from .model import checked_model
 from .profiles import SETTLEMENT_KEYS, profile_segments, read_profile, with_profile
-from .schema import flags
+from .roles import ROLE
 from .spec import LENGTH_UNITS, SpecTable, check_pivot, read_loading, read_material, read_motion
 
 if TYPE_CHECKING:  # annotations only
@@ -232,8 +232,7 @@ def build_drawn(spec_dict: dict, text: str, base_dir: Path | None, validate: boo
 
 
 def _masonry_roles(spec: DrawnSpec, drawing: Drawing, masonry: np.ndarray) -> list[int]:
-    role_flag = flags("block_role")
-    return [role_flag["lintel"] if spec.layers.get(drawing.layers[b]) == "lintel" else role_flag["unit"]
+    return [ROLE["lintel"] if spec.layers.get(drawing.layers[b]) == "lintel" else ROLE["unit"]
             for b in masonry]
 
 
@@ -249,7 +248,7 @@ def _drawn_supports_model(spec: DrawnSpec, drawing: Drawing, kept: np.ndarray, p
         raise SpecError(f"drawing {path.name!r}: every block is a support or ignored; nothing to analyse")
     support_order = np.concatenate([members for members in chosen])
     order = np.concatenate((masonry, support_order))
-    roles = np.array(_masonry_roles(spec, drawing, masonry) + [flags("block_role")["fixed_support"]] * support_order.size,
+    roles = np.array(_masonry_roles(spec, drawing, masonry) + [ROLE["fixed_support"]] * support_order.size,
                      dtype=np.int8)
     described = [blocks.Support(f"spec key 'supports.{s.name}'", s.kind, s.motion, s.pivot, s.rate)
                  for s, members in zip(spec.supports, chosen) for _ in members]
@@ -302,7 +301,7 @@ def _ground_model(spec: DrawnSpec, drawing: Drawing, kept: np.ndarray, path: Pat
     node_x = np.concatenate([node_x, *(r[:, 0] for r in rings)])
     node_y = np.concatenate([node_y, *(r[:, 1] for r in rings)])
     counts = np.concatenate([counts, [r.shape[0] for r in rings]]).astype(np.int32)
-    roles = np.array(_masonry_roles(spec, drawing, masonry) + [flags("block_role")["fixed_support"]] * len(rings),
+    roles = np.array(_masonry_roles(spec, drawing, masonry) + [ROLE["fixed_support"]] * len(rings),
                      dtype=np.int8)
     ds = blocks.model_from_blocks(node_x, node_y, counts, roles, spec.thickness, spec.material, described,
                                   spec.loading, spec.tilt_direction, attrs)

@@ -422,6 +422,7 @@ def save(
     return write_atomically({target: lambda temporary: _write_netcdf(prepared, temporary)}, path)[0]
 
 
+#: The figure files ``save_figure`` writes.
 FIGURE_FORMATS = (".png", ".svg", ".pdf")
 
 

@@ -13,6 +13,7 @@ import time
 from collections.abc import Callable
 from typing import TypeVar
 
+#: The type of a progress callback: ``(share done in [0, 1], message) -> None``.
 ProgressCallback = Callable[[float, str], None]
 T = TypeVar("T")
 

@@ -11,6 +11,7 @@ from importlib import resources
 
 from .errors import ModelError
 
+#: The data contract's version (docs/format.md).
 FORMAT_VERSION = 2
 #: Versions this code reads: older ones are upgraded in memory on reading (:func:`masonryfw.dofs.upgrade`).
 READABLE_VERSIONS = (1, 2)
@@ -38,7 +39,7 @@ def load_schema(kind: str, version: int = FORMAT_VERSION) -> dict:
 
 
 def flags(variable: str) -> dict[str, int]:
-    """``{meaning: value}`` of a flag variable, e.g. ``flags("block_role")["moving_support"] == 3``."""
+    """``{meaning: value}`` of a flag variable, e.g. ``flags("interface_kind")["bed"] == 0``."""
     spec = load_schema("result")["variables"].get(variable)
     if spec is None or "flag_values" not in spec:
         raise KeyError(f"{variable!r} is not a flag variable of the format")

@@ -373,6 +373,7 @@ def score_rows(comparisons: Sequence[xr.Dataset]) -> list[Row]:
     return rows
 
 
+#: The columns of a diagnosis's candidate table (``diagnosis_rows``).
 DIAGNOSIS_COLUMNS = ("scenario", "score", "cracks", "levelling", "settlement", "plausible", "unexplained",
                      "unobserved", "verified")
 

@@ -28,11 +28,9 @@ from pathlib import Path
 import numpy as np
 
 import masonryfw as mf
+import masonryfw.plugin_api as mfp
+from masonryfw_diagnose import Survey, describe, diagnose, to_dataset
 from masonryfw_diagnose import synthetic as sy
-from masonryfw_diagnose.dataset import to_dataset
-from masonryfw_diagnose.diagnosis import diagnose
-from masonryfw_diagnose.scenarios import describe
-from masonryfw_diagnose.survey import Survey
 
 ROOT = Path(__file__).resolve().parents[2]
 IMAGES = ROOT / "docs" / "img" / "diagnose"
@@ -146,8 +144,8 @@ def walls(cache: Path) -> dict:
     for name in TEN_WALLS:
         model = mf.open_model(name)
         role = model.block_role.values
-        moving = np.flatnonzero(role == mf.flags("block_role")["moving_support"])
-        xmin, xmax, _, _ = mf.block_bounds(model.node_x.values, model.node_y.values, model.block_node_count.values)
+        moving = np.flatnonzero(role == mfp.flags("block_role")["moving_support"])
+        xmin, xmax, _, _ = mfp.block_bounds(model.node_x.values, model.node_y.values, model.block_node_count.values)
         settling = (float(xmin[moving].min()), float(xmax[moving].max()))
         for solver in ("la", "fdem"):
             result = forward(cache, name, model, solver)

@@ -17,7 +17,7 @@ import numpy as np  # noqa: E402
 from matplotlib.collections import PolyCollection  # noqa: E402
 
 import masonryfw  # noqa: E402
-from masonryfw.geometry import block_offsets  # noqa: E402
+import masonryfw.plugin_api as mfp  # noqa: E402
 
 FILL = {"unit": "#f3e3c8", "lintel": "#8c6d46", "fixed_support": "#9e9e9e", "moving_support": "#e0a020"}
 WIDTH_PX = 600
@@ -28,11 +28,11 @@ DPI = 100
 def block_polygons(ds) -> list[np.ndarray]:
     """Vertex arrays of every block (ragged layout split at the block offsets)."""
     points = np.stack((ds.node_x.values, ds.node_y.values), axis=1)
-    return np.split(points, block_offsets(ds.block_node_count.values)[1:-1])
+    return np.split(points, mfp.block_offsets(ds.block_node_count.values)[1:-1])
 
 
 def draw(ds, path: Path) -> None:
-    roles = {value: name for name, value in masonryfw.flags("block_role").items()}
+    roles = {value: name for name, value in mfp.ROLE.items()}
     role_names = [roles[int(r)] for r in ds.block_role.values]
     x, y = ds.node_x.values, ds.node_y.values
     span_x, span_y = np.ptp(x), np.ptp(y)
@@ -43,7 +43,7 @@ def draw(ds, path: Path) -> None:
     polygons = block_polygons(ds)
     ax.add_collection(PolyCollection(polygons, facecolors=[FILL[r] for r in role_names],
                                      edgecolors="#303030", linewidths=0.6))
-    moving = np.flatnonzero(ds.block_role.values == masonryfw.flags("block_role")["moving_support"])
+    moving = np.flatnonzero(ds.block_role.values == mfp.ROLE["moving_support"])
     for block in moving:
         direction = ds.settlement_direction.values[block, :2]
         start = np.array([ds.block_centroid_x.values[block], polygons[block][:, 1].min()])
@@ -62,7 +62,7 @@ def draw(ds, path: Path) -> None:
 
 def table_row(name: str, ds, paper_count: str) -> str:
     """One markdown row: case, size, blocks (paper / ours), openings, supports."""
-    role = masonryfw.flags("block_role")
+    role = mfp.ROLE
     roles = ds.block_role.values
     masonry = int(np.sum(roles <= role["lintel"]))
     lintels = int(np.sum(roles == role["lintel"]))

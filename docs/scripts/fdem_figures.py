@@ -20,6 +20,7 @@ import numpy as np  # noqa: E402
 from matplotlib.figure import Figure  # noqa: E402
 
 import masonryfw as mf  # noqa: E402
+import masonryfw.plugin_api as mfp
 
 OUT = Path(__file__).resolve().parents[1] / "img" / "fdem"
 PAPER_MACRO_BLOCKS = {"test-8c": "3", "test-12c": "2", "panel-1": "many", "panel-2": "3", "panel-3": "2",
@@ -32,7 +33,7 @@ def masonry_macro_blocks(result) -> int:
 
 
 def largest_share(result, count: int) -> float:
-    masonry = mf.masonry_blocks(result.block_role.values)
+    masonry = mfp.masonry_blocks(result.block_role.values)
     sizes = np.sort(np.bincount(result.macro_block.values[masonry]))[::-1]
     return float(sizes[:count].sum() / masonry.sum())
 
@@ -67,7 +68,7 @@ def run_case(case: str, options: dict) -> dict:
     phase = fdem.step_phase.values == 1
     return {
         "case": case,
-        "blocks": int(mf.masonry_blocks(model.block_role.values).sum()),
+        "blocks": int(mfp.masonry_blocks(model.block_role.values).sum()),
         "time_s": seconds,
         "steps": int(fdem.attrs["fdem_steps"]),
         "stop": fdem.attrs["stop_reason"],

@@ -18,6 +18,7 @@ import matplotlib
 matplotlib.use("Agg")
 
 import masonryfw as mf  # noqa: E402
+import masonryfw.plugin_api as mfp
 
 DOCS = Path(__file__).resolve().parents[1]
 OUT = DOCS / "import"
@@ -51,7 +52,7 @@ def run(name: str) -> str:
         results.append(result)
     mf.render(results, "compare").savefig(OUT / f"{name}-compare.png", dpi=80)
     published = f"tan({PUBLISHED[name]} deg) = {math.tan(math.radians(PUBLISHED[name])):.4f}" if name in PUBLISHED else "-"
-    blocks = int(mf.masonry_blocks(model.block_role.values).sum())
+    blocks = int(mfp.masonry_blocks(model.block_role.values).sum())
     return f"| {name} | {blocks} | {published} | " + " | ".join(cells) + " |"
 
 

@@ -17,9 +17,10 @@ import time
 import numpy as np
 
 import masonryfw as mf
+import masonryfw.plugin_api as mfp
 import masonryfw.testing as mt
 
-ROLE = mf.flags("block_role")
+ROLE = mfp.flags("block_role")
 
 
 def ferris_tin_loi_wall():

@@ -17,8 +17,8 @@ import matplotlib
 matplotlib.use("Agg")
 
 import masonryfw as mf  # noqa: E402
-from masonryfw_compare.block_plots import drawable_kinds  # noqa: E402
-from masonryfw_compare.report import report_html  # noqa: E402
+import masonryfw.plugin_api as mfp
+from masonryfw_compare import drawable_kinds, report_html  # noqa: E402
 
 DOCS = Path(__file__).resolve().parents[1]
 IMAGES = DOCS / "img" / "report"
@@ -49,11 +49,11 @@ def case_figures(case: str, folder: Path) -> None:
     mf.save_figure(mf.render(incremental, "history", {"quantity": "damage"}), IMAGES / f"{case}-damage.png", dpi=DPI)
     mf.save_figure(mf.render(results, "compare"), IMAGES / f"{case}-compare.png", dpi=DPI)
     header, rows = mf.plot_table(results, "history")
-    mf.save_text(mf.csv_text(header, rows), IMAGES / f"{case}-history.csv")
+    mfp.save_text(mfp.csv_text(header, rows), IMAGES / f"{case}-history.csv")
     start = time.perf_counter()
     command = f"masonryfw report {' '.join(f'{case}.{s}.nc' for s in SOLVERS)} -o {case}.html"
     text = report_html(paths, command)
-    mf.save_text(text.replace(str(folder) + "/", ""), REPORTS / f"{case}.html")
+    mfp.save_text(text.replace(str(folder) + "/", ""), REPORTS / f"{case}.html")
     print(f"{case} report: {time.perf_counter() - start:.1f} s, {len(text) / 1e6:.2f} MB", flush=True)
 
 

@@ -29,6 +29,7 @@ from _studies import arguments, run_plan, values
 from matplotlib.figure import Figure
 
 import masonryfw as mf
+import masonryfw.plugin_api as mfp
 from masonryfw_sweep import dask_client, plan_sweep
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -65,7 +66,7 @@ def draw_damage(fdem, path: Path) -> None:
     """Damage category and widest crack against S_max, one line per trough axis."""
     figure = Figure(figsize=(7.5, 5.0), layout="constrained")
     top, bottom = figure.subplots(2, 1, sharex=True, height_ratios=(1.2, 1))
-    names = mf.flags("step_damage_category")
+    names = mfp.flags("step_damage_category")
     for k, x0 in enumerate(AXES):
         row = fdem.sel(settlement_center=x0)
         s = 1e3 * row.option_settlement.values

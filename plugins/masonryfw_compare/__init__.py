@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import lazy_loader
 
-import masonryfw as mf
+import masonryfw.plugin_api as mfp
 
 from .commands import COMMANDS
 from .records import COMPARATOR, PLOTTERS
@@ -19,20 +19,22 @@ from .records import COMPARATOR, PLOTTERS
 #: so registering stays cheap.
 # no __dir__: pluggy finds the hook implementations by dir(module)
 __getattr__, _, __all__ = lazy_loader.attach(__name__, submod_attrs={
+    "block_plots": ["drawable_kinds"],
     "export": ["export_vtk"],
+    "report": ["report_html"],
 })
 
 
-@mf.hookimpl
+@mfp.hookimpl
 def masonryfw_comparators():
     return [COMPARATOR]
 
 
-@mf.hookimpl
+@mfp.hookimpl
 def masonryfw_plotters():
     return list(PLOTTERS.values())
 
 
-@mf.hookimpl
+@mfp.hookimpl
 def masonryfw_commands():
     return list(COMMANDS)

@@ -19,6 +19,7 @@ from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
 
 import masonryfw as mf
+import masonryfw.plugin_api as mfp
 
 from .figure_parts import (
     SUPPORT_COLOUR,
@@ -59,7 +60,7 @@ class Pieces:
 def dominant_pieces(ds: xr.Dataset, geo: xr.Dataset) -> Pieces:
     """Number the macro-blocks holding at least :data:`DOMINANT_SHARE` of the masonry area (at most
     :data:`MOST_NUMBERED`), largest first; the others are small pieces."""
-    masonry = mf.masonry_blocks(geo.block_role.values)
+    masonry = mfp.masonry_blocks(geo.block_role.values)
     number = np.zeros(geo.sizes["block"], dtype=np.int64)
     if "macro_block" not in ds or not masonry.any():
         return Pieces(number, 0, 0)
@@ -85,7 +86,7 @@ def piece_colours(geo: xr.Dataset, pieces: Pieces) -> np.ndarray:
 def _number_pieces(ax, geo: xr.Dataset, pieces: Pieces, x: np.ndarray, y: np.ndarray) -> None:
     """Write (1), (2), ... on each dominant piece, at its block nearest to the piece's area centroid (so the
     label lies on the piece even when the piece is not convex), in the deformed configuration."""
-    owner = mf.node_block(geo.block_node_count.values)
+    owner = mfp.node_block(geo.block_node_count.values)
     count = np.bincount(owner, minlength=geo.sizes["block"])
     bx = np.bincount(owner, weights=x, minlength=geo.sizes["block"]) / np.maximum(count, 1)
     by = np.bincount(owner, weights=y, minlength=geo.sizes["block"]) / np.maximum(count, 1)
@@ -110,7 +111,7 @@ def _deformed_crack_faces(geo: xr.Dataset, u, amplification: float, cracked: np.
 def default_amplification(geo: xr.Dataset, displacement) -> float:
     """Factor that draws the largest vertex displacement as 10 % of the model size (1 if nothing moves)."""
     largest = largest_vertex_motion(geo, displacement)
-    size = mf.model_scale(geo.node_x.values, geo.node_y.values)
+    size = mfp.model_scale(geo.node_x.values, geo.node_y.values)
     return DRAWN_MOTION_SHARE * size / largest if largest > 0 else 1.0
 
 
@@ -123,8 +124,8 @@ def draw_model(datasets: Sequence[xr.Dataset], ax, options: Mapping[str, Any]) -
     """A model as imported: blocks by role (supports hatched, a moving one with an arrow along its
     settlement direction), interfaces coloured by kind, block numbers on request."""
     ds = single_result(datasets, "model")
-    geo = ds if "block_centroid_x" in ds else mf.derive_geometry(ds)
-    names = {value: name for name, value in mf.flags("block_role").items()}
+    geo = ds if "block_centroid_x" in ds else mfp.derive_geometry(ds)
+    names = {value: name for name, value in mfp.ROLE.items()}
     roles = np.array([names[int(r)] for r in geo.block_role.values])
     verts = block_vertices(geo, geo.node_x.values, geo.node_y.values)
     support = supports_of(geo)
@@ -134,7 +135,7 @@ def draw_model(datasets: Sequence[xr.Dataset], ax, options: Mapping[str, Any]) -
     if support.any():
         ax.add_collection(PolyCollection(list(verts[support]), facecolors=list(fill[support]), edgecolors="0.2",
                                          linewidths=0.4, hatch="////", zorder=1))
-    kinds = {value: name for name, value in mf.flags("interface_kind").items()}
+    kinds = {value: name for name, value in mfp.flags("interface_kind").items()}
     kind = np.array([kinds[int(k)] for k in geo.interface_kind.values]) if "interface_kind" in geo else np.array([])
     handles = []
     for name, colour in KIND_COLOURS.items():
@@ -143,7 +144,7 @@ def draw_model(datasets: Sequence[xr.Dataset], ax, options: Mapping[str, Any]) -
             segments = segment_array(geo.interface_x.values[chosen], geo.interface_y.values[chosen])
             ax.add_collection(LineCollection(segments, colors=colour, linewidths=1.2, zorder=2))
             handles.append(Line2D([], [], color=colour, lw=1.5, label=f"{name} ({int(chosen.sum())})"))
-    size = mf.model_scale(geo.node_x.values, geo.node_y.values)
+    size = mfp.model_scale(geo.node_x.values, geo.node_y.values)
     moving = np.flatnonzero(roles == "moving_support")
     starts, motions = _ground_arrows(geo, moving)
     fastest = float(np.linalg.norm(motions, axis=1).max(initial=0.0))
@@ -165,7 +166,7 @@ def draw_model(datasets: Sequence[xr.Dataset], ax, options: Mapping[str, Any]) -
 def _ground_arrows(geo: xr.Dataset, moving: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Per moving support: the middle of its top edge and that point's motion per unit settlement (a
     support that turns moves its centroid sideways, its top edge less)."""
-    xmin, xmax, _, ymax = mf.block_bounds(geo.node_x.values, geo.node_y.values, geo.block_node_count.values)
+    xmin, xmax, _, ymax = mfp.block_bounds(geo.node_x.values, geo.node_y.values, geo.block_node_count.values)
     points = np.c_[0.5 * (xmin + xmax), ymax][moving]
     d = geo.settlement_direction.values[moving]
     arm = points - np.c_[geo.block_centroid_x.values[moving], geo.block_centroid_y.values[moving]]
@@ -175,7 +176,7 @@ def _ground_arrows(geo: xr.Dataset, moving: np.ndarray) -> tuple[np.ndarray, np.
 def mechanism_amplification(ds: xr.Dataset, options: Mapping[str, Any]) -> float:
     """The factor the mechanism plot draws ``ds``'s displacements by: the option ``amplification``, or
     :func:`default_amplification`."""
-    return options["amplification"] or default_amplification(mf.derive_geometry(ds), mf.block_motion(ds))
+    return options["amplification"] or default_amplification(mfp.derive_geometry(ds), mfp.block_motion(ds))
 
 
 def draw_mechanism(datasets: Sequence[xr.Dataset], ax, options: Mapping[str, Any]) -> None:
@@ -185,8 +186,8 @@ def draw_mechanism(datasets: Sequence[xr.Dataset], ax, options: Mapping[str, Any
     ds = single_result(datasets, "mechanism")
     require_variables(ds, ["block_displacement"], "mechanism", "block displacements (la, fdem, jmm or jmm-limit)")
     ds = mf.at_threshold(ds, options["threshold"])
-    geo = mf.derive_geometry(ds)
-    u = mf.block_motion(ds)
+    geo = mfp.derive_geometry(ds)
+    u = mfp.block_motion(ds)
     amplification = mechanism_amplification(ds, options)
     scale = line_scale(geo)
     draw_outline(ax, geo)
@@ -218,11 +219,11 @@ def draw_cracks(datasets: Sequence[xr.Dataset], ax, options: Mapping[str, Any]) 
     ds = single_result(datasets, "cracks")
     require_variables(ds, ["interface_opening", "interface_slip"], "cracks",
              "the relative motion at the joints (a result with block displacements: la, fdem)")
-    geo = mf.derive_geometry(ds)
+    geo = mfp.derive_geometry(ds)
     state = mf.at_threshold(ds, options["threshold"]).interface_state.values
     draw_blocks(ax, geo, geo.node_x.values, geo.node_y.values, np.array(["0.93"] * geo.sizes["block"], dtype=object))
     segments = segment_array(geo.interface_x.values, geo.interface_y.values)
-    flag = mf.flags("interface_state")
+    flag = mfp.flags("interface_state")
     handles = []
     for meaning, colour in STATE_COLOURS.items():
         chosen = state == flag[meaning]
@@ -285,7 +286,7 @@ def draw_forces(datasets: Sequence[xr.Dataset], ax, options: Mapping[str, Any]) 
         ds, ["interface_normal_force", "interface_shear_force"], "forces",
         "contact forces (a limit analysis la result)",
     )
-    geo = mf.derive_geometry(ds)
+    geo = mfp.derive_geometry(ds)
     draw_blocks(ax, geo, geo.node_x.values, geo.node_y.values, np.array(["0.93"] * geo.sizes["block"], dtype=object))
     normal, shear = ds.interface_normal_force.values, ds.interface_shear_force.values
     px, py, magnitude, segments = thrust_segments(geo, normal, shear, options["scale"])
@@ -322,11 +323,11 @@ def draw_plastic(datasets: Sequence[xr.Dataset], ax, options: Mapping[str, Any])
     """Plastic quadrature points over the mesh: blue tensile, grey shear, navy both."""
     ds = single_result(datasets, "plastic")
     require_variables(ds, ["qp_failure", "qp_x", "qp_y"], "plastic", "a continuum (jmm) result")
-    draw_outline(ax, mf.derive_geometry(ds))
+    draw_outline(ax, mfp.derive_geometry(ds))
     if "mesh_face_nodes" in ds:
         ax.add_collection(PolyCollection(list(_mesh_faces(ds)), facecolors="none", edgecolors="0.9", linewidths=0.3))
     failure = ds.qp_failure.values
-    flag = mf.flags("qp_failure")
+    flag = mfp.flags("qp_failure")
     for meaning, colour in FAILURE_COLOURS.items():
         chosen = failure == flag[meaning]
         ax.scatter(ds.qp_x.values[chosen], ds.qp_y.values[chosen], s=options["marker_size"], c=colour,

@@ -6,7 +6,7 @@ from pathlib import Path
 import click
 
 import masonryfw as mf
-from masonryfw.command_kit import PROGRESS
+import masonryfw.plugin_api as mfp
 
 
 @click.command("gallery")
@@ -55,22 +55,22 @@ def export_command(result: str, file_format: str, output: str | None) -> None:
 @click.command("report")
 @click.argument("results", nargs=-1, required=True, type=click.Path(dir_okay=False, exists=True))
 @click.option("-o", "--output", type=click.Path(dir_okay=False), required=True, help="The HTML file to write.")
-@PROGRESS
+@mfp.PROGRESS
 def report_command(results: tuple[str, ...], output: str, progress: bool | None) -> None:
     """Write one self-contained HTML report of RESULTS (one model): the wall, its spec, the key numbers,
     every figure, the agreement of the results and their provenance; a diagnosis file (`masonryfw diagnose`)
     among them adds its verdict, ranked candidates and figure."""
     from .report import report_html  # imported here: the CLI starts without matplotlib
 
-    mf.check_output_path(output, list(results), (".html", ".htm"))
+    mfp.check_output_path(output, list(results), (".html", ".htm"))
     context = click.get_current_context()
-    bar = mf.progress_bar(progress)
+    bar = mfp.progress_bar(progress)
     try:
         text = report_html(list(results), context.find_root().obj["command_line"], bar)
     finally:
         if bar is not None:
             bar.close()
-    mf.save_text(text, output, protect=list(results), suffixes=(".html", ".htm"))
+    mfp.save_text(text, output, protect=list(results), suffixes=(".html", ".htm"))
     click.echo(f"report: {output} ({len(text) / 1e6:.2g} MB, {text.count('<img ')} figures)")
 
 

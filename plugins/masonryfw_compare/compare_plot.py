@@ -10,6 +10,7 @@ import xarray as xr
 from matplotlib.collections import LineCollection
 
 import masonryfw as mf
+import masonryfw.plugin_api as mfp
 
 from .block_plots import draw_mechanism, draw_plastic, mechanism_amplification
 from .figure_parts import draw_blocks, finish_axes, segment_array
@@ -31,7 +32,7 @@ def panel_kind(ds: xr.Dataset) -> str:
 def draw_indicator(ds: xr.Dataset, ax, threshold: float) -> None:
     """The joints cracked at ``threshold`` (:func:`masonryfw.cracked_joints`) drawn heavy over the undeformed
     wall."""
-    geo = mf.derive_geometry(ds)
+    geo = mfp.derive_geometry(ds)
     draw_blocks(ax, geo, geo.node_x.values, geo.node_y.values, np.array(["0.93"] * geo.sizes["block"], dtype=object))
     cracked = mf.cracked_joints(ds, threshold)
     ax.add_collection(LineCollection(

@@ -24,6 +24,7 @@ import numpy as np
 import xarray as xr
 
 import masonryfw as mf
+import masonryfw.plugin_api as mfp
 
 from . import scores
 from .shapes import distance_to_points, distance_to_segments, segment_samples
@@ -72,7 +73,7 @@ def ensure_same_model(a: xr.Dataset, b: xr.Dataset) -> None:
                 a, b, f"{a.sizes.get(dim, 0)} vs {b.sizes.get(dim, 0)} {dim}s "
                 f"({a.attrs.get('title', '?')!r} vs {b.attrs.get('title', '?')!r})",
             )
-    for name in mf.load_schema("model")["variables"]:
+    for name in mfp.load_schema("model")["variables"]:
         if name not in a or name not in b:
             continue
         va, vb = np.asarray(a[name].values), np.asarray(b[name].values)
@@ -110,10 +111,10 @@ def mechanism_scores(a: xr.Dataset, b: xr.Dataset, geo: xr.Dataset, masonry: np.
     if "block_displacement" not in a or "block_displacement" not in b:
         return {}
     area = geo.block_area.values
-    polar = mf.polar_moment(geo.node_x.values, geo.node_y.values, geo.block_node_count.values)
+    polar = mfp.polar_moment(geo.node_x.values, geo.node_y.values, geo.block_node_count.values)
     return {
         "mechanism_cosine": scores.rigid_field_cosine(
-            mf.block_motion(a)[masonry], mf.block_motion(b)[masonry], area[masonry], polar[masonry],
+            mfp.block_motion(a)[masonry], mfp.block_motion(b)[masonry], area[masonry], polar[masonry],
         )
     }
 
@@ -142,7 +143,7 @@ def failure_locus(ds: xr.Dataset) -> Locus | None:
     so a long crack counts more than a short one.
     """
     if "qp_failure" in ds:
-        plastic = ds.qp_failure.values != mf.flags("qp_failure")["elastic"]
+        plastic = ds.qp_failure.values != mfp.flags("qp_failure")["elastic"]
         if not plastic.any():
             return None
         x, y = ds.qp_x.values[plastic], ds.qp_y.values[plastic]
@@ -187,7 +188,7 @@ def comparison_variables(values: Mapping[str, float | int | None]) -> xr.Dataset
     The core (:func:`masonryfw.compare`) adds the global attributes: comparator,
     options, the inputs' hashes and the history line.
     """
-    spec = mf.load_schema("comparison")["variables"]
+    spec = mfp.load_schema("comparison")["variables"]
     data = {}
     for name, value in values.items():
         if value is None:
@@ -203,9 +204,9 @@ def compare(a: xr.Dataset, b: xr.Dataset, options: Mapping[str, Any]) -> xr.Data
     (:func:`masonryfw.at_threshold`); returns the score variables."""
     ensure_same_model(a, b)
     a, b = mf.at_threshold(a, options["threshold"]), mf.at_threshold(b, options["threshold"])
-    geo = mf.derive_geometry(a[list(GEOMETRY_VARIABLES)])
-    masonry = mf.masonry_blocks(geo.block_role.values)
-    size = mf.model_scale(geo.node_x.values, geo.node_y.values)
+    geo = mfp.derive_geometry(a[list(GEOMETRY_VARIABLES)])
+    masonry = mfp.masonry_blocks(geo.block_role.values)
+    size = mfp.model_scale(geo.node_x.values, geo.node_y.values)
     values: dict[str, float | int | None] = {"length_scale": size}
     values.update(multiplier_values(a, b))
     values.update(interface_scores(a, b, geo.interface_length.values))

@@ -25,6 +25,7 @@ import numpy as np
 import xarray as xr
 
 import masonryfw as mf
+import masonryfw.plugin_api as mfp
 
 from .shapes import padded_block_nodes, vertex_motion
 
@@ -71,7 +72,7 @@ def _as_vtk(values: np.ndarray) -> np.ndarray:
 def blocks_mesh(ds: xr.Dataset):
     """Blocks as polygons with their role, macro-block and motion."""
     meshio = _meshio()
-    geo = mf.derive_geometry(ds)
+    geo = mfp.derive_geometry(ds)
     counts = geo.block_node_count.values.astype(np.int64)
     cells, order = _grouped_cells(padded_block_nodes(counts), counts)
     cell_data = {
@@ -82,7 +83,7 @@ def blocks_mesh(ds: xr.Dataset):
     if "macro_block" in ds:
         cell_data["macro_block"] = _split(_as_vtk(ds.macro_block.values), order)
     if "block_displacement" in ds:
-        u = mf.block_motion(ds)
+        u = mfp.block_motion(ds)
         cell_data["centroid_displacement"] = _split(np.column_stack([u[:, 0], u[:, 1], np.zeros(len(u))]), order)
         cell_data["rotation"] = _split(u[:, 2], order)
         ux, uy = vertex_motion(geo, u, str(ds.attrs.get("rotations", "small")))
@@ -164,12 +165,12 @@ def export_vtk(ds: xr.Dataset, path: str | os.PathLike) -> list[Path]:
     """
     paths = export_paths(ds, path)
     for target in paths:
-        mf.check_output_path(target, [ds.encoding.get("source")])
+        mfp.check_output_path(target, [ds.encoding.get("source")])
     present = [(name, build) for name, _, has, build in PIECES if has(ds)]
     pieces = [(name, target) for (name, _), target in zip(present, paths)]
     writes = {target: _vtu_writer(build(ds)) for (_, build), target in zip(present, paths)}
     writes[paths[-1]] = lambda temporary: temporary.write_text(_multiblock(pieces))
-    return mf.write_atomically(writes, path)  # the set or nothing: ParaView opens the index, which names the rest
+    return mfp.write_atomically(writes, path)  # the set or nothing: ParaView opens the index, which names the rest
 
 
 def _vtu_writer(mesh):

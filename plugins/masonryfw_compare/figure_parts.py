@@ -14,6 +14,7 @@ import xarray as xr
 from matplotlib.collections import PolyCollection
 
 import masonryfw as mf
+import masonryfw.plugin_api as mfp
 
 from .shapes import padded_block_nodes
 
@@ -62,7 +63,7 @@ def block_vertices(geo: xr.Dataset, x: np.ndarray, y: np.ndarray) -> np.ndarray:
 
 
 def supports_of(geo: xr.Dataset) -> np.ndarray:
-    return mf.support_blocks(geo.block_role.values)
+    return mfp.support_blocks(geo.block_role.values)
 
 
 def draw_blocks(ax, geo, x, y, facecolors, *, edge="0.3", width=None, zorder=1) -> None:

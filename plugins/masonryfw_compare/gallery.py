@@ -22,6 +22,7 @@ from typing import Any
 import xarray as xr
 
 import masonryfw as mf
+import masonryfw.plugin_api as mfp
 
 GALLERY_DPI = 110
 IDENTICAL_COSINE_GAP = 1e-3
@@ -62,7 +63,7 @@ class CaseOutcome:
     seconds: dict[str, float]
 
 
-def installed_methods() -> dict[str, mf.Solver]:
+def installed_methods() -> dict[str, mfp.Solver]:
     """Every installed solver by name, in name order."""
     return {record.name: record for record in mf.installed_solvers()}
 
@@ -75,7 +76,7 @@ def gallery_methods() -> list[str]:
 def _known_method(method: str, what: str) -> None:
     installed = installed_methods()
     if method not in installed:
-        raise mf.PluginError(f"{what}: {mf.unknown_name_message('method', method, list(installed))}")
+        raise mf.PluginError(f"{what}: {mfp.unknown_name_message('method', method, list(installed))}")
 
 
 def parse_method_options(pairs: list[str] | tuple[str, ...]) -> dict[str, dict[str, str]]:
@@ -124,7 +125,7 @@ def planned_runs(methods: list[str] | tuple[str, ...] | None = None,
     runs = []
     for name in chosen:
         solver, given = installed[name], options.get(name, {})
-        mf.resolve_options(f"solver {name!r}", solver.options, given)
+        mfp.resolve_options(f"solver {name!r}", solver.options, given)
         varied = {key for variant in solver.variants for key in variant.options}
         if solver.variants and not varied & set(given):
             runs += [Run(f"{name} ({v.label})", name, {**given, **v.options}) for v in solver.variants]
@@ -434,9 +435,9 @@ def run_gallery(
     if not runs:
         raise mf.PluginError("no gallery solver is installed")
     notes_text = notes.read_text() if notes is not None else ""
-    mf.check_output_path(agreement)
+    mfp.check_output_path(agreement)
     if not output.is_dir():
-        mf.check_output_path(output)  # its folder exists and is writable: the gallery folder is made in it
+        mfp.check_output_path(output)  # its folder exists and is writable: the gallery folder is made in it
     output.mkdir(exist_ok=True)
     written, outcomes = [], []
     for case in cases or list(bundled):

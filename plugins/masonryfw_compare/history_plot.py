@@ -12,6 +12,7 @@ import xarray as xr
 from matplotlib.patches import Patch
 
 import masonryfw as mf
+import masonryfw.plugin_api as mfp
 
 from .figure_parts import DAMAGE_COLOURS, require_variables, title_of
 
@@ -24,7 +25,7 @@ def distinct_labels(datasets: Sequence[xr.Dataset]) -> list[str]:
     their place in the list: no two results share a label."""
     labels = [mf.result_label(ds) for ds in datasets]
     details = [
-        lambda ds: mf.result_options(ds),
+        lambda ds: mfp.result_options(ds),
         lambda ds: {"": ds.attrs.get("title", "")},
         lambda ds: {"": Path(str(ds.encoding.get("source", ""))).name},
     ]
@@ -123,7 +124,7 @@ def gravity_records(settlement: np.ndarray) -> int:
 def _damage_strips(ax, incremental: Sequence[xr.Dataset]) -> tuple[list, int]:
     """A thin strip per result along the top of ``ax``, coloured by the damage category along the settlement;
     returns the legend's handles and the number of strips."""
-    names = {v: k.replace("_", " ") for k, v in mf.flags("step_damage_category").items()}
+    names = {v: k.replace("_", " ") for k, v in mfp.flags("step_damage_category").items()}
     seen: set[int] = set()
     row = 0
     for ds in incremental:
@@ -150,7 +151,7 @@ def _room_for_strips(ax, rows: int) -> None:
 def _profiled(results: Sequence[xr.Dataset]) -> bool:
     """Whether any result settles several supports (a profile): its reaction is then the settlement reaction
     (``mf.settlement_reaction``: each support weighted by its motion), not one support's."""
-    moving = mf.flags("block_role")["moving_support"]
+    moving = mfp.ROLE["moving_support"]
     return any(int((ds.block_role.values == moving).sum()) > 1 for ds in results if "block_role" in ds)
 
 
@@ -224,7 +225,7 @@ def _draw_damage(ax, incremental, labels, colours) -> None:
     for ds in incremental:
         require_variables(ds, ["step_damage_category", "step_crack_width_max"], "history --option quantity=damage",
                  "a result with crack widths (fdem or jmm)")
-    names = {v: k.replace("_", " ") for k, v in mf.flags("step_damage_category").items()}
+    names = {v: k.replace("_", " ") for k, v in mfp.flags("step_damage_category").items()}
     limits_mm = [0.0, *(1e3 * v for v in mf.DAMAGE_LIMITS)]
     widest = max(float(np.max(ds.step_crack_width_max.values, initial=0.0)) for ds in incremental) * 1e3
     top = max(2.0 * limits_mm[-1], 1.5 * widest)

@@ -15,7 +15,7 @@ import xarray as xr
 from matplotlib.patches import Rectangle
 
 import masonryfw as mf
-from masonryfw.assessment import LTSM_LIMITS, POISSON, Part, assess, deep_beam_strains, wall_extent
+import masonryfw.plugin_api as mfp
 
 from .figure_parts import DAMAGE_COLOURS, single_result, title_of
 
@@ -32,14 +32,14 @@ def assessed_settlement(ds: xr.Dataset) -> float:
                           "a settlement_target (a tunnel's S_max)")
 
 
-def zone_boundary(limit: float, strain: np.ndarray, part: Part, height: float) -> np.ndarray:
+def zone_boundary(limit: float, strain: np.ndarray, part: mfp.Part, height: float) -> np.ndarray:
     """The deflection ratio at which a part like ``part`` (its length, height and neutral axis) reaches the
     LTSM strain ``limit`` at the horizontal strains ``strain``: the smaller of the bending and the diagonal
     route; nan where the horizontal strain alone reaches it."""
     length = part.end - part.start
-    per_bending, per_diagonal = deep_beam_strains(1.0, length, height, part.sagging)
+    per_bending, per_diagonal = mfp.deep_beam_strains(1.0, length, height, part.sagging)
     bending = (limit - strain) / per_bending
-    nu = POISSON
+    nu = mfp.POISSON
     square = (limit - strain * (1 - nu) / 2) ** 2 - (strain * (1 + nu) / 2) ** 2
     diagonal = np.sqrt(np.where(square > 0, square, np.nan)) / per_diagonal
     ratio = np.fmin(bending, diagonal)
@@ -50,11 +50,11 @@ def draw_ltsm(datasets: Sequence[xr.Dataset], ax, options: Mapping[str, Any]) ->
     """The trough under the wall and the interaction chart with the wall's parts (module docstring)."""
     ds = single_result(datasets, "ltsm")
     settlement = assessed_settlement(ds)
-    stages = assess(ds, settlement)
+    stages = mfp.assess(ds, settlement)
     if stages is None:
         raise mf.MasonryError("the ltsm plot needs a model built over a settlement profile ([settlement] in its spec)")
     profile = mf.model_profile(ds)
-    x_a, x_b, height = wall_extent(ds)
+    x_a, x_b, height = mfp.wall_extent(ds)
     figure, spec = ax.figure, ax.get_subplotspec()
     ax.set_axis_off()
     trough, chart = (figure.add_subplot(g) for g in spec.subgridspec(2, 1, height_ratios=(1, 2), hspace=0.08))
@@ -91,11 +91,11 @@ def _draw_chart(ax, stages, settlement: float, height: float) -> None:
     the worst part's (so the parts are not lost in the corner of a chart of every zone), the parts as points."""
     governing = max(stages.parts, key=lambda p: p.strain)
     points = [(100 * settlement * p.horizontal_strain, 100 * settlement * p.deflection_ratio) for p in stages.parts]
-    shown = min(stages.category, len(LTSM_LIMITS) - 1)  # the limit above the worst category (the last: itself)
-    top_strain = max(1.15 * 100 * LTSM_LIMITS[shown], 1.3 * max(s for s, _ in points))
+    shown = min(stages.category, len(mfp.LTSM_LIMITS) - 1)  # the limit above the worst category (the last: itself)
+    top_strain = max(1.15 * 100 * mfp.LTSM_LIMITS[shown], 1.3 * max(s for s, _ in points))
     low_strain = min(0.0, 1.3 * min(s for s, _ in points))
     strain = np.linspace(low_strain, top_strain, 600)
-    boundaries = [100 * zone_boundary(limit, strain / 100, governing, height) for limit in LTSM_LIMITS]
+    boundaries = [100 * zone_boundary(limit, strain / 100, governing, height) for limit in mfp.LTSM_LIMITS]
     ceiling = max(1.15 * float(np.nanmax(boundaries[shown])), 1.3 * max(r for _, r in points))
     lower = np.zeros_like(strain)
     for category, upper in enumerate([*boundaries, np.full_like(strain, ceiling)]):

@@ -6,8 +6,9 @@ imported on first use through :func:`masonryfw.lazy`.
 from __future__ import annotations
 
 import masonryfw as mf
+import masonryfw.plugin_api as mfp
 
-THRESHOLD_OPTION = mf.Option(
+THRESHOLD_OPTION = mfp.Option(
     "threshold",
     float,
     mf.CRACK_THRESHOLD,
@@ -16,25 +17,25 @@ THRESHOLD_OPTION = mf.Option(
     at_least=0.0,
     below=1.0,
 )
-AMPLIFICATION_OPTION = mf.Option(
+AMPLIFICATION_OPTION = mfp.Option(
     "amplification", float, None, "displacement amplification; auto: the largest motion drawn as 10 % of the model size",
     above=0.0,
 )
 COMPARE_OPTIONS = (THRESHOLD_OPTION,)
 
-COMPARATOR = mf.Comparator(
+COMPARATOR = mfp.Comparator(
     name="crack",
     summary="crack-pattern agreement: F1/Jaccard, overlap, Spearman, macro-block ARI, "
     "mechanism cosine, failure-locus distance",
-    compare=mf.lazy("masonryfw_compare.comparison:compare"),
+    compare=mfp.lazy("masonryfw_compare.comparison:compare"),
     options=COMPARE_OPTIONS,
 )
 
 
 def _plotter(name: str, summary: str, options: tuple = (), table: bool = False,
-             side_by_side: bool = False, module: str = "block_plots") -> mf.Plotter:
-    return mf.Plotter(name, summary, mf.lazy(f"masonryfw_compare.{module}:draw_{name}"), options=options,
-                      table=mf.lazy(f"masonryfw_compare.{module}:{name}_table") if table else None,
+             side_by_side: bool = False, module: str = "block_plots") -> mfp.Plotter:
+    return mfp.Plotter(name, summary, mfp.lazy(f"masonryfw_compare.{module}:draw_{name}"), options=options,
+                      table=mfp.lazy(f"masonryfw_compare.{module}:{name}_table") if table else None,
                       side_by_side=side_by_side)
 
 
@@ -42,24 +43,24 @@ PLOTTERS = {
     plotter.name: plotter
     for plotter in (
         _plotter("model", "the model as built or imported: blocks by role, interfaces by kind, block numbers",
-                 (mf.Option("numbers", bool, False, "write every block's number at its centroid"),
-                  mf.Option("font_size", float, 5.0, "size of the block numbers [pt]", above=0.0))),
+                 (mfp.Option("numbers", bool, False, "write every block's number at its centroid"),
+                  mfp.Option("font_size", float, 5.0, "size of the block numbers [pt]", above=0.0))),
         _plotter("mechanism", "amplified deformed wall, alpha and the reaction in the title, the dominant "
                  "macro-blocks numbered, cracks on the blocks' faces",
                  (AMPLIFICATION_OPTION, THRESHOLD_OPTION)),
         _plotter("cracks", "joints that open, slide or both, in colours", (THRESHOLD_OPTION,)),
         _plotter("forces", "contact forces (at collapse, or at the last record) as thrust segments",
-                 (mf.Option("scale", float, 1.0, "largest segment, in median interface lengths", above=0.0),)),
+                 (mfp.Option("scale", float, 1.0, "largest segment, in median interface lengths", above=0.0),)),
         _plotter("plastic", "plastic quadrature points over the mesh (continuum results)",
-                 (mf.Option("marker_size", float, 4.0, "marker area [pt^2]", above=0.0),)),
+                 (mfp.Option("marker_size", float, 4.0, "marker area [pt^2]", above=0.0),)),
         _plotter("history", "reaction on the moving supports (or the damage) against settlement; several "
                  "incremental results overlaid, la results as their collapse reaction (1 - alpha) R0",
-                 (mf.Option("quantity", str, "reaction",
+                 (mfp.Option("quantity", str, "reaction",
                             "reaction: on the moving supports; damage: the damage category and the widest crack",
                             ("reaction", "damage")),
-                  mf.Option("xscale", str, "linear", "settlement axis; log shows the first fraction of a millimetre "
+                  mfp.Option("xscale", str, "linear", "settlement axis; log shows the first fraction of a millimetre "
                             "(where jmm's history lives) next to fdem's centimetres", ("linear", "log")),
-                  mf.Option("settlement_max", float, None, "zoom: the settlement axis ends here [mm]", above=0.0)),
+                  mfp.Option("settlement_max", float, None, "zoom: the settlement axis ends here [mm]", above=0.0)),
                  table=True, module="history_plot"),
         _plotter("compare", "two or more results side by side with their scores",
                  (AMPLIFICATION_OPTION, THRESHOLD_OPTION), side_by_side=True, module="compare_plot"),

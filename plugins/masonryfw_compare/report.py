@@ -21,6 +21,7 @@ from importlib import metadata
 import xarray as xr
 
 import masonryfw as mf
+import masonryfw.plugin_api as mfp
 
 from .block_plots import drawable_kinds
 from .comparison import ensure_same_model
@@ -67,7 +68,7 @@ def _value_attribute(value: float | None) -> str:
     return "" if value is None else f' data-value="{value!r}"'
 
 
-def _table(header: Sequence[str], rows: Sequence[mf.Row], table_id: str, columns: Sequence[str]) -> str:
+def _table(header: Sequence[str], rows: Sequence[mfp.Row], table_id: str, columns: Sequence[str]) -> str:
     """An HTML table of :class:`masonryfw.Row`; each cell says its row key, column and full value."""
     head = "".join(f"<th>{html.escape(h)}</th>" for h in header) + "<th>what it means</th>"
     body = []
@@ -83,17 +84,17 @@ def _table(header: Sequence[str], rows: Sequence[mf.Row], table_id: str, columns
 
 def _model_of(result: xr.Dataset) -> xr.Dataset:
     """The model variables of a result, titled as the model (drawn as a model, not as a result)."""
-    names = [n for n in result.data_vars if n in mf.load_schema("model")["variables"]]
+    names = [n for n in result.data_vars if n in mfp.load_schema("model")["variables"]]
     return xr.Dataset({n: result[n] for n in names}, attrs={"title": result.attrs.get("title", "")})
 
 
 def _model_section(first: xr.Dataset) -> str:
-    geo = mf.derive_geometry(first)
+    geo = mfp.derive_geometry(first)
     roles = first.block_role.values
-    masonry = mf.masonry_blocks(roles)
-    xmin, xmax, ymin, ymax = mf.block_bounds(geo.node_x, geo.node_y, geo.block_node_count)
+    masonry = mfp.masonry_blocks(roles)
+    xmin, xmax, ymin, ymax = mfp.block_bounds(geo.node_x, geo.node_y, geo.block_node_count)
     size = f"{xmax[masonry].max() - xmin[masonry].min():.4g} m x {ymax[masonry].max() - ymin[masonry].min():.4g} m"
-    facts = (f"{int(masonry.sum())} masonry blocks, {int(mf.support_blocks(roles).sum())} supports, "
+    facts = (f"{int(masonry.sum())} masonry blocks, {int(mfp.support_blocks(roles).sum())} supports, "
              f"{first.sizes.get('interface', 0)} interfaces; the masonry spans {size}.")
     parts = ["<h2>The wall</h2>", f"<p>{html.escape(facts)}</p>",
              _figure([_model_of(first)], "model",
@@ -165,7 +166,7 @@ def _agreement_section(datasets: Sequence[xr.Dataset], letters: Sequence[str]) -
     return ["<h2>Agreement</h2>",
             "<p>Every pair scored by the <code>crack</code> comparator (the first of a pair is its reference): "
             "do the two results crack the same joints, break into the same pieces, move the same way?</p>",
-            _table(["score", *columns], mf.score_rows(comparisons), "agreement", columns),
+            _table(["score", *columns], mfp.score_rows(comparisons), "agreement", columns),
             _figure(datasets, "compare", "The results side by side, each later one with its scores against the "
                     "first.")]
 
@@ -184,7 +185,7 @@ def _provenance_section(paths: Sequence[str], datasets: Sequence[xr.Dataset], le
                         command: str) -> list[str]:
     rows = []
     for letter, path, ds in zip(letters, paths, datasets):
-        digest = mf.sha256_file(path)
+        digest = mfp.sha256_file(path)
         facts = {
             "file": path, "file sha256": digest, "solver": ds.attrs.get("solver", "?"),
             "solver version": ds.attrs.get("solver_version", "?"), "core version": ds.attrs.get("core_version", "?"),
@@ -204,7 +205,7 @@ def _provenance_section(paths: Sequence[str], datasets: Sequence[xr.Dataset], le
 
 def _diagnosis_section(path: str, ds: xr.Dataset) -> list[str]:
     """A settlement diagnosis (a ``diagnosis`` dataset): its verdict, the ranked candidates and its figure."""
-    columns = list(mf.DIAGNOSIS_COLUMNS)
+    columns = list(mfp.DIAGNOSIS_COLUMNS)
     source = ", ".join(f"{k} <code>{html.escape(str(ds.attrs[a]))}</code>" for k, a in
                        (("cracks", "source_cracks"), ("levelling", "source_levelling")) if ds.attrs.get(a))
     made_by = (str(ds.attrs.get("history", "")).splitlines() or [""])[-1]
@@ -213,10 +214,10 @@ def _diagnosis_section(path: str, ds: xr.Dataset) -> list[str]:
              f"({int(ds.attrs.get('failed_candidates', 0))} could not be solved), scored against the survey "
              f"({source}); a surveyed line follows a joint within {_number(ds.attrs.get('tolerance'), '.3g')} m. "
              f"The plausible set: every candidate within {_number(ds.attrs.get('plausible_margin'), 'g')} of the "
-             f"best score. File sha256 {mf.sha256_file(path)}; made by: <code>{html.escape(made_by)}</code>")
+             f"best score. File sha256 {mfp.sha256_file(path)}; made by: <code>{html.escape(made_by)}</code>")
     return [f"<h2>Diagnosis: {html.escape(path)}</h2>",
             f"<p><strong>{html.escape(str(ds.attrs.get('verdict', '')))}</strong></p>", f"<p>{facts}</p>",
-            _table(["rank", *columns], mf.diagnosis_rows(ds, 10), "diagnosis", columns),
+            _table(["rank", *columns], mfp.diagnosis_rows(ds, 10), "diagnosis", columns),
             _figure([ds], "diagnosis", "The surveyed cracks (red) over the wall, the best candidates' mechanisms "
                     "with the joints they crack (blue), every candidate's score by rank, and the Gaussian troughs' "
                     "scores over their centre and width.")]
@@ -247,7 +248,7 @@ def report_html(paths: Sequence[str], command: str, progress: Callable[[float, s
                  [*zip(labels, paths), *(("diagnosis", p) for p, _ in diagnoses)]) + "</p>",
              _model_section(first)]
     if datasets:
-        parts += ["<h2>Key numbers</h2>", _table(["", *letters], mf.headline_rows(datasets), "key-numbers", letters)]
+        parts += ["<h2>Key numbers</h2>", _table(["", *letters], mfp.headline_rows(datasets), "key-numbers", letters)]
     step(0.2, "figures")
     parts += _history_section(datasets)
     for i, (label, ds) in enumerate(zip(labels, datasets)):

@@ -9,7 +9,7 @@ import numpy as np
 import xarray as xr
 from scipy.spatial import cKDTree
 
-import masonryfw as mf
+import masonryfw.plugin_api as mfp
 
 # Sample points per joint when a crack segment is integrated along its length
 # (midpoint rule, equal weights): exact for a distance that is constant along
@@ -24,7 +24,7 @@ def padded_block_nodes(block_node_count: np.ndarray) -> np.ndarray:
     drawing, so all polygons fit one rectangular array.
     """
     counts = np.asarray(block_node_count, dtype=np.int64)
-    start = mf.block_offsets(counts)[:-1]
+    start = mfp.block_offsets(counts)[:-1]
     columns = np.arange(counts.max(initial=1))
     return start[:, None] + np.minimum(columns[None, :], counts[:, None] - 1)
 
@@ -72,8 +72,8 @@ def distance_to_points(px, py, tx, ty) -> np.ndarray:
 
 def vertex_motion(geo: xr.Dataset, displacement, rotations: str = "small"):
     """Motion ``(ux, uy)`` of every block vertex under block motions ``displacement`` (block, 3)."""
-    owner = mf.node_block(geo.block_node_count.values)
-    return mf.point_motion(displacement, geo.block_centroid_x.values, geo.block_centroid_y.values,
+    owner = mfp.node_block(geo.block_node_count.values)
+    return mfp.point_motion(displacement, geo.block_centroid_x.values, geo.block_centroid_y.values,
                            geo.node_x.values, geo.node_y.values, owner, rotations)
 
 
@@ -82,14 +82,14 @@ def deformed_points(geo: xr.Dataset, displacement, amplification: float, px, py,
 
     The rotation is applied exactly (not linearised), so amplified blocks keep their shape.
     """
-    ux, uy = mf.point_motion(amplification * np.asarray(displacement, dtype=float), geo.block_centroid_x.values,
+    ux, uy = mfp.point_motion(amplification * np.asarray(displacement, dtype=float), geo.block_centroid_x.values,
                              geo.block_centroid_y.values, px, py, owner, "finite")
     return np.asarray(px) + ux, np.asarray(py) + uy
 
 
 def deformed_nodes(geo: xr.Dataset, displacement, amplification: float):
     """Block vertices after the rigid motion ``amplification * displacement``."""
-    owner = mf.node_block(geo.block_node_count.values)
+    owner = mfp.node_block(geo.block_node_count.values)
     return deformed_points(geo, displacement, amplification, geo.node_x.values, geo.node_y.values, owner)
 
 

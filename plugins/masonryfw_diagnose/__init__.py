@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import lazy_loader
 
-import masonryfw as mf
+import masonryfw.plugin_api as mfp
 
 from .commands import COMMANDS
 
@@ -24,25 +24,27 @@ from .commands import COMMANDS
 __getattr__, _, __all__ = lazy_loader.attach(__name__, submod_attrs={
     "dataset": ["to_dataset", "to_json"],
     "diagnosis": ["diagnose", "prepare", "search", "verify", "wall_model"],
-    "survey": ["read_cracks", "read_levelling"],
-})
+    "scenarios": ["describe"],
+    "survey": ["Survey", "read_cracks", "read_levelling"],
+    "synthetic": ["visible_cracks"],
+}, submodules=["synthetic"])
 
-PLOTTER = mf.Plotter(
+PLOTTER = mfp.Plotter(
     "diagnosis",
     "a settlement diagnosis: the surveyed cracks over the wall beside the best candidates' mechanisms and cracks, "
     "the scores of every candidate (and of the Gaussian troughs over their centre and width)",
-    mf.lazy("masonryfw_diagnose.plotting:draw_diagnosis"),
-    options=(mf.Option("amplification", float, None, "displacement amplification; auto: the largest motion drawn "
+    mfp.lazy("masonryfw_diagnose.plotting:draw_diagnosis"),
+    options=(mfp.Option("amplification", float, None, "displacement amplification; auto: the largest motion drawn "
                        "as 8 % of the wall's size", above=0.0),),
 )
 
 
 
-@mf.hookimpl
+@mfp.hookimpl
 def masonryfw_commands():
     return list(COMMANDS)
 
 
-@mf.hookimpl
+@mfp.hookimpl
 def masonryfw_plotters():
     return [PLOTTER]

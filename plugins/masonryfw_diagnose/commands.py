@@ -8,7 +8,7 @@ from pathlib import Path
 import click
 
 import masonryfw as mf
-from masonryfw.command_kit import LENGTH, PROGRESS, command_line
+import masonryfw.plugin_api as mfp
 
 
 def _families(ctx, param, value: str) -> tuple[str, ...]:
@@ -72,9 +72,9 @@ def _table_lines(table: dict) -> list[str]:
                    "are always mm.")
 @click.option("--profiles", "families", default="step,gaussian,linear", show_default=True, callback=_families,
               help="The scenario families to try, comma separated.")
-@click.option("--segment", type=LENGTH,
+@click.option("--segment", type=mfp.LENGTH,
               help="Length of the ground segments [m] [default: the median unit length].")
-@click.option("--tolerance", type=LENGTH,
+@click.option("--tolerance", type=mfp.LENGTH,
               help="How far a surveyed line may lie from the joint it follows [m] [default: half the median unit "
                    "height].")
 @click.option("--plugin", "solver", default="la", show_default=True,
@@ -87,7 +87,7 @@ def _table_lines(table: dict) -> list[str]:
               help="Candidates listed (the JSON also lists every plausible one).")
 @click.option("--json", "as_json", is_flag=True, help="Print the diagnosis as one JSON object on stdout.")
 @click.option("-o", "--output", type=click.Path(dir_okay=False), help="[default: <wall>.diagnosis.nc]")
-@PROGRESS
+@mfp.PROGRESS
 def diagnose_command(wall: str, cracks: str, cracks_layer: str | None, levelling: str | None, unit: str | None,
                      families: tuple[str, ...], segment: float | None, tolerance: float | None, solver: str,
                      options: tuple[str, ...], verify_with: str | None, top: int, as_json: bool,
@@ -105,33 +105,33 @@ def diagnose_command(wall: str, cracks: str, cracks_layer: str | None, levelling
     from .diagnosis import KEPT, prepare, search, verify, wall_model
     from .survey import read_cracks, read_levelling
 
-    inputs = mf.input_files(wall, cracks, levelling)
+    inputs = mfp.input_files(wall, cracks, levelling)
     out = Path(output) if output else _default_output(wall)
-    mf.check_output_path(out, inputs)
+    mfp.check_output_path(out, inputs)
     survey = read_cracks(cracks, unit, cracks_layer)
     if levelling:
         survey = survey.with_levelling(read_levelling(levelling, survey.sources["unit"]), Path(levelling).name)
-    solver_options = mf.parse_option_pairs(options)
+    solver_options = mfp.parse_option_pairs(options)
     mf.get_solver(solver)  # an unknown solver named before the wall is built
     if verify_with:
         mf.get_solver(verify_with)
     model = wall_model(wall)
     diagnosis = prepare(model, survey, families, segment, solver, solver_options, tolerance)
-    expected = f"; expect about {mf.duration_text(diagnosis.expected.seconds)}" if diagnosis.expected else ""
+    expected = f"; expect about {mfp.duration_text(diagnosis.expected.seconds)}" if diagnosis.expected else ""
     click.echo(f"diagnose: {len(diagnosis.tables):,} scenarios ({', '.join(families)}) with {solver} on "
-               f"{len(diagnosis.model.block) - int(mf.masonry_blocks(diagnosis.model.block_role.values).sum())} "
+               f"{len(diagnosis.model.block) - int(mfp.masonry_blocks(diagnosis.model.block_role.values).sum())} "
                f"ground pieces{expected}; Ctrl-C keeps the ranking of those tried", err=True)
-    bar = mf.progress_bar(progress)
+    bar = mfp.progress_bar(progress)
     started = time.perf_counter()
     try:
-        search(diagnosis, solver_options, progress=bar or mf.no_progress)
+        search(diagnosis, solver_options, progress=bar or mfp.no_progress)
         if verify_with and not diagnosis.interrupted:
-            verify(diagnosis, verify_with, min(top, KEPT), progress=bar or mf.no_progress)
+            verify(diagnosis, verify_with, min(top, KEPT), progress=bar or mfp.no_progress)
     finally:
         if bar is not None:
             bar.close()
     seconds = time.perf_counter() - started
-    mf.save(dataset.to_dataset(diagnosis, wall), out, command=command_line(), protect=inputs)
+    mf.save(dataset.to_dataset(diagnosis, wall), out, command=mfp.command_line(), protect=inputs)
     _report(diagnosis, wall, top, as_json, seconds, out)
     if diagnosis.interrupted:
         raise mf.Interrupted(f"interrupted after {len(diagnosis.candidates) + len(diagnosis.failed)} scenario(s): "
@@ -147,7 +147,7 @@ def _report(diagnosis, wall: str, top: int, as_json: bool, seconds: float, out: 
     from . import dataset, scenarios
 
     survey = diagnosis.survey
-    ground = int(mf.support_blocks(diagnosis.model.block_role.values).sum())
+    ground = int(mfp.support_blocks(diagnosis.model.block_role.values).sum())
     _echo(f"diagnose {wall}: {ground} ground segments of {diagnosis.segment:.4g} m "
           f"({'given' if diagnosis.segment_given else 'the median unit length'}); {len(survey.cracks)} surveyed "
           f"line(s) run along {diagnosis.observed.joints.size} joints within {diagnosis.wall.tolerance:.3g} m, "

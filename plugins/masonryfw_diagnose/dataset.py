@@ -3,7 +3,7 @@
 The dataset holds the wall on its ground (the model variables, set under the best candidate's profile, so
 ``masonryfw solve diagnosis.nc`` would not do: ``masonryfw diagnose`` prints the table to paste), every
 candidate ranked best first, the best candidates' mechanisms (what the ``diagnosis`` plot draws) and the
-survey they were scored against. The JSON object is the contract of the issue that asked for the command:
+survey they were scored against. The JSON object is a contract others rely on:
 ``candidates`` (``rank``, ``settlement``, ``score``, ``plausible``, ``magnitude``), ``observed_joints``,
 ``unmatched_cracks``; the rest of its keys say more of the same.
 """
@@ -15,6 +15,7 @@ import numpy as np
 import xarray as xr
 
 import masonryfw as mf
+import masonryfw.plugin_api as mfp
 
 from . import scenarios
 from .diagnosis import EXPLAINED, KEPT, PLAUSIBLE_MARGIN, Diagnosis, profile_of
@@ -49,7 +50,7 @@ def _candidate_variables(diagnosis: Diagnosis) -> dict:
         columns["candidate_verified_damage_category"] = np.array(
             [-1 if v.get("damage_category") is None else int(v["damage_category"]) for v in verified], dtype=np.int8)
         columns["candidate_verified_minimum_reaction"] = np.array([_nan(v.get("minimum_reaction")) for v in verified])
-    return {name: ("candidate", values, mf.variable_attrs(name, "diagnosis")) for name, values in columns.items()}
+    return {name: ("candidate", values, mfp.variable_attrs(name, "diagnosis")) for name, values in columns.items()}
 
 
 def _kept_variables(diagnosis: Diagnosis) -> dict:
@@ -60,9 +61,9 @@ def _kept_variables(diagnosis: Diagnosis) -> dict:
                                     np.stack([c.result.block_displacement.values for c in kept])),
         "kept_block_rotation": (("kept", "block"), np.stack([c.result.block_rotation.values for c in kept])),
         "kept_crack_indicator": (("kept", "interface"), np.stack(
-            [mf.indicator_at(c.result, SURVEY_THRESHOLD) for c in kept])),
+            [mfp.indicator_at(c.result, SURVEY_THRESHOLD) for c in kept])),
     }
-    return {name: (dims, values, mf.variable_attrs(name, "diagnosis")) for name, (dims, values) in columns.items()}
+    return {name: (dims, values, mfp.variable_attrs(name, "diagnosis")) for name, (dims, values) in columns.items()}
 
 
 def _survey_variables(diagnosis: Diagnosis) -> dict:
@@ -85,19 +86,19 @@ def _survey_variables(diagnosis: Diagnosis) -> dict:
     if survey.levelling is not None:
         for k, name in enumerate(("levelling_x", "levelling_y", "levelling_dy")):
             columns[name] = (("levelling_point",), survey.levelling[:, k])
-    return {name: (dims, values, mf.variable_attrs(name, "diagnosis")) for name, (dims, values) in columns.items()}
+    return {name: (dims, values, mfp.variable_attrs(name, "diagnosis")) for name, (dims, values) in columns.items()}
 
 
 def to_dataset(diagnosis: Diagnosis, source_wall: str = "") -> xr.Dataset:
     """The diagnosis as a ``diagnosis`` dataset (module docstring)."""
     model = mf.over_profile(diagnosis.model, profile_of(diagnosis, diagnosis.best.table))
-    names = [n for n in model.data_vars if n in mf.load_schema("model")["variables"]]
+    names = [n for n in model.data_vars if n in mfp.load_schema("model")["variables"]]
     survey = diagnosis.survey
     attrs = {
         **{k: v for k, v in model.attrs.items() if k in ("title", "source_spec", "source_drawing",
                                                           "source_drawing_sha256", "settlement_profile")},
-        "masonryfw_format": "diagnosis", "masonryfw_format_version": mf.FORMAT_VERSION,
-        "solver": diagnosis.solver, "solver_version": mf.solver_version(diagnosis.solver),
+        "masonryfw_format": "diagnosis", "masonryfw_format_version": mfp.FORMAT_VERSION,
+        "solver": diagnosis.solver, "solver_version": mfp.solver_version(diagnosis.solver),
         "segment": diagnosis.segment, "tolerance": diagnosis.wall.tolerance, "unit_height": diagnosis.wall.unit_height,
         "plausible_margin": PLAUSIBLE_MARGIN, "explained_threshold": EXPLAINED, "verdict": diagnosis.verdict(),
         "families": ",".join(diagnosis.families), "failed_candidates": len(diagnosis.failed),

@@ -20,6 +20,7 @@ import numpy as np
 import xarray as xr
 
 import masonryfw as mf
+import masonryfw.plugin_api as mfp
 
 from . import scenarios, scoring
 from .survey import UNITS, Survey
@@ -62,7 +63,7 @@ class Diagnosis:
     verified_with: str = ""
     interrupted: bool = False  # Ctrl-C stopped the search: the candidates are those tried before
     tables: list[dict] = field(default_factory=list)  # the scenarios to try
-    expected: mf.Estimate | None = None  # the search's time, before it starts
+    expected: mfp.Estimate | None = None  # the search's time, before it starts
     verify_interrupted: bool = False  # Ctrl-C stopped the verification: the verified are those finished before
 
     @property
@@ -110,7 +111,7 @@ def wall_model(source: str) -> xr.Dataset:
     its supports, ``[settlement]`` and ``[loading]`` (:func:`masonryfw.load_wall`): the diagnosis sets them aside
     and makes its ground."""
     path = Path(source)
-    if path.is_file() and mf.is_spec(path):
+    if path.is_file() and mfp.is_spec(path):
         return mf.build(mf.load_wall(path))
     return mf.open_model(source)
 
@@ -118,8 +119,8 @@ def wall_model(source: str) -> xr.Dataset:
 def check_survey(survey: Survey, model: xr.Dataset, margin: float) -> None:
     """Refuse cracks and levelling points further than ``margin`` off the wall's masonry (a wrong unit, another
     drawing's coordinates), naming the item, the wall's extent and the unit."""
-    masonry = mf.masonry_blocks(model.block_role.values)
-    xmin, xmax, ymin, ymax = mf.block_bounds(model.node_x.values, model.node_y.values, model.block_node_count.values)
+    masonry = mfp.masonry_blocks(model.block_role.values)
+    xmin, xmax, ymin, ymax = mfp.block_bounds(model.node_x.values, model.node_y.values, model.block_node_count.values)
     wall = (xmin[masonry].min(), xmax[masonry].max(), ymin[masonry].min(), ymax[masonry].max())
     unit = survey.sources.get("unit", "m")
     scale = {"m": 1.0, "cm": 0.01, "mm": 0.001}[unit]
@@ -170,15 +171,15 @@ def _refuse_a_map_in_another_unit(survey: Survey, wall: tuple, unit: str, scale:
 
 def ground_pieces(model: xr.Dataset) -> np.ndarray:
     """``(n, 2)``: the x-extent of every ground piece (support block), left to right."""
-    ground = mf.support_blocks(model.block_role.values)
-    xmin, xmax, _, _ = mf.block_bounds(model.node_x.values, model.node_y.values, model.block_node_count.values)
+    ground = mfp.support_blocks(model.block_role.values)
+    xmin, xmax, _, _ = mfp.block_bounds(model.node_x.values, model.node_y.values, model.block_node_count.values)
     pieces = np.round(np.c_[xmin[ground], xmax[ground]], 12)
     return pieces[np.lexsort(pieces.T[::-1])]
 
 
 def diagnose(model: xr.Dataset, survey: Survey, families=scenarios.FAMILIES, segment: float | None = None,
              solver: str = "la", options: dict | None = None, tolerance: float | None = None,
-             progress=mf.no_progress) -> Diagnosis:
+             progress=mfp.no_progress) -> Diagnosis:
     """Try every scenario of ``families`` on ``model``'s wall and rank them against ``survey`` (module docstring):
     :func:`search` of :func:`prepare`."""
     return search(prepare(model, survey, families, segment, solver, options, tolerance), options, progress)
@@ -192,8 +193,8 @@ def prepare(model: xr.Dataset, survey: Survey, families=scenarios.FAMILIES, segm
     ``segment`` defaults to the median masonry block length (about a unit length); ``tolerance`` (how far a
     surveyed line may lie from the joint it follows) to half the median block height.
     """
-    masonry = mf.masonry_blocks(model.block_role.values)
-    xmin, xmax, _, _ = mf.block_bounds(model.node_x.values, model.node_y.values, model.block_node_count.values)
+    masonry = mfp.masonry_blocks(model.block_role.values)
+    xmin, xmax, _, _ = mfp.block_bounds(model.node_x.values, model.node_y.values, model.block_node_count.values)
     unit_length = float(np.median(xmax[masonry] - xmin[masonry]))
     segment_given = segment is not None
     segment = unit_length if segment is None else segment
@@ -227,7 +228,7 @@ def _refuse_too_many(count: int, pieces: np.ndarray, segment: float, families) -
                        f"{fitting:.3g} m, or fewer --profiles")
 
 
-def search(diagnosis: Diagnosis, options: dict | None = None, progress=mf.no_progress) -> Diagnosis:
+def search(diagnosis: Diagnosis, options: dict | None = None, progress=mfp.no_progress) -> Diagnosis:
     """Solve and score every scenario of a prepared ``diagnosis``, then rank them; Ctrl-C ends the search with
     those tried (``interrupted``), or propagates when none was."""
     tables = diagnosis.tables
@@ -274,7 +275,7 @@ def solved(diagnosis: Diagnosis, table: dict, options: dict | None) -> xr.Datase
     return mf.solve(mf.over_profile(diagnosis.model, profile_of(diagnosis, table)), diagnosis.solver, options or {})
 
 
-def verify(diagnosis: Diagnosis, solver: str = "fdem", count: int = KEPT, progress=mf.no_progress) -> None:
+def verify(diagnosis: Diagnosis, solver: str = "fdem", count: int = KEPT, progress=mfp.no_progress) -> None:
     """Run the best ``count`` candidates that have a magnitude forward with ``solver`` to that settlement (the
     model's ``settlement_target``): their widest crack, damage category and smallest reaction go into
     ``candidate.verified``."""

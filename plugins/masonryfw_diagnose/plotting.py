@@ -12,6 +12,7 @@ import numpy as np
 import xarray as xr
 
 import masonryfw as mf
+import masonryfw.plugin_api as mfp
 
 FAMILY_COLOURS = {"step": "tab:blue", "gaussian": "tab:orange", "linear": "tab:green"}
 SURVEY_COLOUR = "tab:red"
@@ -47,7 +48,7 @@ def _wall(ax, ds: xr.Dataset, x: np.ndarray, y: np.ndarray, moving: np.ndarray |
     from matplotlib.collections import PolyCollection
 
     blocks = np.arange(ds.sizes["block"])
-    support = mf.support_blocks(ds.block_role.values)
+    support = mfp.support_blocks(ds.block_role.values)
     face = np.where(support, "#b9b9b9", "#f1ece4").astype(object)
     if moving is not None:
         face[moving & ~support] = "#e8cfa6"
@@ -89,14 +90,14 @@ def _candidate_panel(ax, ds: xr.Dataset, kept: int, amplification: float | None)
     x, y, moving = _deformed(ds, kept, amplification)
     _wall(ax, ds, x, y, moving)
     indicator = ds.kept_crack_indicator.values[kept]
-    masonry = mf.masonry_blocks(ds.block_role.values)
+    masonry = mfp.masonry_blocks(ds.block_role.values)
     inner = masonry[ds.interface_blocks.values.astype(np.int64)].all(axis=1)
     cracked = np.flatnonzero(inner & (indicator > 0))
     _joints(ax, ds, cracked, CRACK_COLOUR, 0.6 + 2.4 * indicator[cracked])
     _survey_lines(ax, ds, width=0.9)
     magnitude = float(ds.candidate_magnitude.values[k])
     size = f", t {1e3 * magnitude:.3g} mm" if np.isfinite(magnitude) else ""
-    ax.set_title(f"{k + 1}: {mf.candidate_text(ds, k)}\nscore {float(ds.candidate_score.values[k]):.2f}{size}"
+    ax.set_title(f"{k + 1}: {mfp.candidate_text(ds, k)}\nscore {float(ds.candidate_score.values[k]):.2f}{size}"
                  + (" (plausible)" if ds.candidate_plausible.values[k] else ""), fontsize=8)
 
 
@@ -134,8 +135,8 @@ def _gaussian_panel(ax, ds: xr.Dataset) -> None:
     step = max(1, xs.size // 8)
     ax.set_xticks(np.arange(xs.size)[::step], [f"{v:.3g}" for v in xs[::step]], fontsize=7)
     ax.set_yticks(np.arange(ws.size), [f"{v:.3g}" for v in ws], fontsize=7)
-    masonry = mf.masonry_blocks(ds.block_role.values)
-    xmin, xmax, _, _ = mf.block_bounds(ds.node_x.values, ds.node_y.values, ds.block_node_count.values)
+    masonry = mfp.masonry_blocks(ds.block_role.values)
+    xmin, xmax, _, _ = mfp.block_bounds(ds.node_x.values, ds.node_y.values, ds.block_node_count.values)
     for edge in (xmin[masonry].min(), xmax[masonry].max()):
         ax.axvline(np.interp(edge, xs, np.arange(xs.size)), color="w", lw=0.8, ls="--")
     ax.set_xlabel("trough centre [m] (dashed: the wall's ends)")
@@ -167,7 +168,7 @@ def draw_diagnosis(datasets, ax, options) -> None:
     """The plot (module docstring) of one diagnosis dataset, drawn over ``ax``'s figure."""
     if len(datasets) != 1 or datasets[0].attrs.get("masonryfw_format") != "diagnosis":
         raise mf.MasonryError("the diagnosis plot draws one diagnosis dataset (written by `masonryfw diagnose`)")
-    ds = mf.derive_geometry(datasets[0])
+    ds = mfp.derive_geometry(datasets[0])
     figure = ax.figure
     figure.delaxes(ax)
     kept = ds.sizes.get("kept", 0)

@@ -27,7 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 import xarray as xr
 
-import masonryfw as mf
+import masonryfw.plugin_api as mfp
 
 #: The distance scale of the weights, in unit heights (docs/diagnose.md: chosen so that random lines score
 #: under 0.5 while a crack drawn a third of a joint off keeps 0.94 and one a whole joint off about 0.6).
@@ -87,8 +87,8 @@ class Wall:
 
 def wall_joints(model: xr.Dataset, tolerance: float | None = None) -> Wall:
     role = model.block_role.values
-    masonry = mf.masonry_blocks(role)
-    _, _, ymin, ymax = mf.block_bounds(model.node_x.values, model.node_y.values, model.block_node_count.values)
+    masonry = mfp.masonry_blocks(role)
+    _, _, ymin, ymax = mfp.block_bounds(model.node_x.values, model.node_y.values, model.block_node_count.values)
     height = float(np.median(ymax[masonry] - ymin[masonry]))
     inner = masonry[model.interface_blocks.values.astype(np.int64)].all(axis=1)
     index = np.flatnonzero(inner)
@@ -140,7 +140,7 @@ class Score:
 
 def score(wall: Wall, observed: Observed, result: xr.Dataset, widths_mm, levelling: np.ndarray | None) -> Score:
     """How well ``result`` (a mechanism per unit settlement) explains the survey (module docstring)."""
-    indicator = mf.indicator_at(result, SURVEY_THRESHOLD)
+    indicator = mfp.indicator_at(result, SURVEY_THRESHOLD)
     predicted = wall.inner[wall.joints.owner] & (indicator[wall.joints.owner] > 0)
     pred_xy = wall.joints.xy[predicted]
     c = indicator[wall.joints.owner][predicted] * wall.joints.length[predicted]
@@ -185,12 +185,12 @@ def levelling_fit(result: xr.Dataset, levelling: np.ndarray) -> tuple[float, flo
 def vertical_motion(result: xr.Dataset, x: np.ndarray, y: np.ndarray) -> np.ndarray:
     """The vertical motion (per unit settlement) at points, of the masonry block nearest each (by centroid among
     the blocks whose box holds the point, else the nearest centroid)."""
-    masonry = np.flatnonzero(mf.masonry_blocks(result.block_role.values))
+    masonry = np.flatnonzero(mfp.masonry_blocks(result.block_role.values))
     cx, cy = result.block_centroid_x.values[masonry], result.block_centroid_y.values[masonry]
-    xmin, xmax, ymin, ymax = (b[masonry] for b in mf.block_bounds(result.node_x.values, result.node_y.values,
+    xmin, xmax, ymin, ymax = (b[masonry] for b in mfp.block_bounds(result.node_x.values, result.node_y.values,
                                                                    result.block_node_count.values))
     inside = (x[:, None] >= xmin) & (x[:, None] <= xmax) & (y[:, None] >= ymin) & (y[:, None] <= ymax)
     far = np.hypot(x[:, None] - cx, y[:, None] - cy) + np.where(inside, 0.0, 1e9)
     block = masonry[np.argmin(far, axis=1)]
-    u = mf.block_motion(result)
+    u = mfp.block_motion(result)
     return u[block, 1] + u[block, 2] * (x - result.block_centroid_x.values[block])

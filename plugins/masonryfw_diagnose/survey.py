@@ -20,6 +20,7 @@ from pathlib import Path
 import numpy as np
 
 import masonryfw as mf
+import masonryfw.plugin_api as mfp
 
 UNITS = {"m": 1.0, "cm": 0.01, "mm": 0.001}
 INSUNITS = {4: "mm", 5: "cm", 6: "m"}
@@ -51,7 +52,7 @@ class Survey:
 
 def read_cracks(path: str | Path, unit: str | None = None, layer: str | None = None) -> Survey:
     """The crack map at ``path`` (module docstring)."""
-    path = mf.regular_file(path, "crack map")
+    path = mfp.regular_file(path, "crack map")
     suffix = path.suffix.lower()
     if suffix not in CRACK_FORMATS:
         raise mf.SpecError(f"crack map {str(path)!r}: unknown file type {suffix!r}; use {', '.join(CRACK_FORMATS)}")
@@ -131,8 +132,8 @@ def _width(value, where: str) -> float | None:
 
 
 def _geojson_cracks(path: Path):
-    text = mf.read_text(path, "crack map")
-    mf.fits_in_memory(JSON_BYTES_FACTOR * len(text), f"crack map {path.name!r}: reading it")
+    text = mfp.read_text(path, "crack map")
+    mfp.fits_in_memory(JSON_BYTES_FACTOR * len(text), f"crack map {path.name!r}: reading it")
     try:
         data = json.loads(text)
     except (ValueError, RecursionError) as exc:  # RecursionError: arrays nested thousands deep
@@ -170,7 +171,7 @@ def _csv_rows(path: Path, what: str, needed: tuple[str, ...], limit: int):
     """``(row number, {column: text})`` of a CSV file whose first row names ``needed`` columns (others kept),
     read one row at a time; refused past ``limit`` rows."""
     try:
-        reader = csv.reader(io.StringIO(mf.read_text(path, what), newline=""))
+        reader = csv.reader(io.StringIO(mfp.read_text(path, what), newline=""))
         header = [c.strip() for c in next(reader, [])]
         missing = [c for c in needed if c not in header]
         if header and missing:
@@ -215,7 +216,7 @@ def _csv_cracks(path: Path):
 
 def _dxf_cracks(path: Path, unit: str | None, layer: str | None):
     """Lines of a DXF drawing; the unit its ``$INSUNITS`` says unless ``unit`` is given."""
-    drawing = mf.read_dxf_lines(path, layer)
+    drawing = mfp.read_dxf_lines(path, layer)
     if unit is None:
         unit = INSUNITS.get(drawing.insunits)
         if unit is None:
@@ -227,7 +228,7 @@ def _dxf_cracks(path: Path, unit: str | None, layer: str | None):
 
 def read_levelling(path: str | Path, unit: str = "m") -> np.ndarray:
     """``(m, 3)`` x, y, dy [m] of a levelling CSV (module docstring)."""
-    path = mf.regular_file(path, "levelling")
+    path = mfp.regular_file(path, "levelling")
     values = []
     for number, row in _csv_rows(path, "levelling", ("x", "y", "dy"), MAX_LEVELLING_POINTS):
         where = f"levelling {path.name!r} row {number}"

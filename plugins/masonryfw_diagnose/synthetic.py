@@ -13,6 +13,7 @@ import numpy as np
 import xarray as xr
 
 import masonryfw as mf
+import masonryfw.plugin_api as mfp
 
 
 @dataclass(frozen=True)
@@ -30,7 +31,7 @@ def visible_cracks(result: xr.Dataset, threshold: float = mf.CRACK_THRESHOLD, wi
     """Joints between masonry blocks (a surveyor draws no base gap) that ``result`` cracks: an opening or
     slip over ``width`` [m] at the last record when given, else the core's cracked joints at ``threshold``
     (:func:`masonryfw.cracked_joints`)."""
-    masonry = mf.masonry_blocks(result.block_role.values)
+    masonry = mfp.masonry_blocks(result.block_role.values)
     inner = masonry[result.interface_blocks.values.astype(np.int64)].all(axis=1)
     if width is not None:
         motion = np.maximum(np.abs(result.interface_opening.values), np.abs(result.interface_slip.values)).max(axis=1)
@@ -68,8 +69,8 @@ def draw(result: xr.Dataset, joints: np.ndarray, surveyor: Surveyor, rng: np.ran
          widths_mm: dict[int, float] | None = None) -> dict:
     """A GeoJSON FeatureCollection of ``joints`` (the cracked ones) drawn by ``surveyor`` (module docstring):
     one MultiLineString per crack, with its ``width_mm`` when ``widths_mm`` (per joint) is given."""
-    masonry = mf.masonry_blocks(result.block_role.values)
-    xmin, xmax, ymin, ymax = mf.block_bounds(result.node_x.values, result.node_y.values,
+    masonry = mfp.masonry_blocks(result.block_role.values)
+    xmin, xmax, ymin, ymax = mfp.block_bounds(result.node_x.values, result.node_y.values,
                                              result.block_node_count.values)
     h = float(np.median(ymax[masonry] - ymin[masonry]))
     box = (xmin[masonry].min(), xmax[masonry].max(), ymin[masonry].min(), ymax[masonry].max())
@@ -105,10 +106,10 @@ def levelling(result: xr.Dataset, y: float, scale: float = 1.0, noise: float = 0
     masonry block the line crosses, its vertical motion (the block's ``block_displacement`` and
     ``block_rotation``, times ``scale``: the settlement for a mechanism per unit settlement) plus a normal
     error of standard deviation ``noise`` [m]."""
-    masonry = np.flatnonzero(mf.masonry_blocks(result.block_role.values))
-    _, _, ymin, ymax = mf.block_bounds(result.node_x.values, result.node_y.values, result.block_node_count.values)
+    masonry = np.flatnonzero(mfp.masonry_blocks(result.block_role.values))
+    _, _, ymin, ymax = mfp.block_bounds(result.node_x.values, result.node_y.values, result.block_node_count.values)
     crossed = masonry[(ymin[masonry] < y) & (ymax[masonry] > y)]
-    geometry = mf.derive_geometry(result)
+    geometry = mfp.derive_geometry(result)
     x = geometry.block_centroid_x.values[crossed]
     u = result.block_displacement.values[crossed]
     dy = scale * u[:, 1]  # at the centroid's x the rotation adds nothing

@@ -8,18 +8,18 @@ in its distribution's ``pyproject.toml``::
 
 The solve function gets a checked model with derived geometry and resolved
 options, and returns a dataset holding only the variables it computed. The records name it with
-``mf.lazy``, so listing the plugins imports no solver code (nor NumPy or xarray).
+``mfp.lazy``, so listing the plugins imports no solver code (nor NumPy or xarray).
 """
 from __future__ import annotations
 
-import masonryfw as mf
+import masonryfw.plugin_api as mfp
 
 #: The record, made once: every lookup returns the same object.
-STATICS = mf.Solver("statics", "load resultants and support dead reactions (no failure analysis)",
-                    mf.lazy("masonryfw_example.statics:solve_statics"), gallery=False)
+STATICS = mfp.Solver("statics", "load resultants and support dead reactions (no failure analysis)",
+                    mfp.lazy("masonryfw_example.statics:solve_statics"), gallery=False)
 
 
-@mf.hookimpl
+@mfp.hookimpl
 def masonryfw_solvers():
     """The records this plugin contributes (called once per lookup)."""
     return [STATICS]

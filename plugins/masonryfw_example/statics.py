@@ -5,6 +5,7 @@ import numpy as np
 import xarray as xr
 
 import masonryfw as mf
+import masonryfw.plugin_api as mfp
 
 
 def load_resultant(load: np.ndarray, cx: np.ndarray, cy: np.ndarray) -> tuple[np.ndarray, float]:
@@ -20,8 +21,8 @@ def solve_statics(model: xr.Dataset, options, progress) -> xr.Dataset:
     shared by the supports in proportion to their contact length with the wall:
     ``R_s = W * L_s / L_total`` (docs/format.md, settlement loading).
     """
-    is_support = mf.support_blocks(model.block_role.values)
-    dead, live = mf.block_loads(model, "dead"), mf.block_loads(model, "live")
+    is_support = mfp.support_blocks(model.block_role.values)
+    dead, live = mfp.block_loads(model, "dead"), mfp.block_loads(model, "live")
     cx, cy = model.block_centroid_x.values, model.block_centroid_y.values
     progress(0.0, "load resultants")
     weight = -dead[~is_support, 1].sum()

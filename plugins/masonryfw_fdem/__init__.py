@@ -8,23 +8,23 @@ stepping), :mod:`.simulation` (the gravity and settlement phases),
 """
 from __future__ import annotations
 
-import masonryfw as mf
+import masonryfw.plugin_api as mfp
 
 from .options import OPTIONS
 
 __version__ = "0.1.0"
 
 
-@mf.hookimpl
+@mfp.hookimpl
 def masonryfw_solvers():
     return [
-        mf.Solver(
+        mfp.Solver(
             name="fdem",
             summary="explicit discrete elements: rigid or CST-meshed blocks, penalty Coulomb contacts, support "
             "moved slowly down; reaction history, final mechanism, energy balance",
-            solve=mf.lazy("masonryfw_fdem.solver:solve"),
+            solve=mfp.lazy("masonryfw_fdem.solver:solve"),
             version=__version__,
             options=OPTIONS,
-            estimate=mf.lazy("masonryfw_fdem.estimate:estimate"),
+            estimate=mfp.lazy("masonryfw_fdem.estimate:estimate"),
         )
     ]

@@ -29,6 +29,7 @@ import numpy as np
 from numba import njit
 
 import masonryfw as mf
+import masonryfw.plugin_api as mfp
 
 from .kernels import (
     DISSIPATED_DAMPING,
@@ -100,7 +101,7 @@ def block_triangles(x0: np.ndarray, y0: np.ndarray, offs: np.ndarray) -> np.ndar
     if bad.size == 0:
         return fan
     n_poly = int(offs[-1])
-    triangles, _ = mf.triangulated(x0[:n_poly], y0[:n_poly], counts, bad)
+    triangles, _ = mfp.triangulated(x0[:n_poly], y0[:n_poly], counts, bad)
     return np.concatenate((fan[~np.isin(block, bad)], triangles))
 
 
@@ -124,10 +125,10 @@ def elastic_constants(model, n_block: int) -> tuple[np.ndarray, np.ndarray]:
     nu = model.block_poisson_ratio.values.astype(float)
     bad = np.flatnonzero(~(young > 0))
     if bad.size:
-        raise mf.ModelError(f"block(s) {mf.listed(bad)}: block_young_modulus must be positive")
+        raise mf.ModelError(f"block(s) {mfp.listed(bad)}: block_young_modulus must be positive")
     bad = np.flatnonzero(~((nu > -1.0) & (nu < 0.5)))
     if bad.size:
-        raise mf.ModelError(f"block(s) {mf.listed(bad)}: block_poisson_ratio must be in (-1, 0.5)")
+        raise mf.ModelError(f"block(s) {mfp.listed(bad)}: block_poisson_ratio must be in (-1, 0.5)")
     return np.broadcast_to(young, (n_block,)), np.broadcast_to(nu, (n_block,))
 
 
@@ -161,11 +162,11 @@ def check_supported(scene: Scene) -> None:
     load, has no nodal meaning here."""
     held = np.flatnonzero(~scene.driven & ~scene.free.all(axis=1))
     if held.size:
-        raise mf.ModelError(f"block(s) {mf.listed(held)}: block_fixed holds a component of a free block; "
+        raise mf.ModelError(f"block(s) {mfp.listed(held)}: block_fixed holds a component of a free block; "
                             "the fdem deformable mode does not support it (make the block a support)")
     moment = np.flatnonzero((scene.dead[:, 2] != 0) | (scene.live[:, 2] != 0))
     if moment.size:
-        raise mf.ModelError(f"block(s) {mf.listed(moment)}: dead_load / live_load has a moment component; "
+        raise mf.ModelError(f"block(s) {mfp.listed(moment)}: dead_load / live_load has a moment component; "
                             "the fdem deformable mode takes only forces (applied in proportion to the nodal masses)")
 
 

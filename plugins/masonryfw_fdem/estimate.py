@@ -20,7 +20,7 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
-import masonryfw as mf
+import masonryfw.plugin_api as mfp
 
 from .controls import make_controls, masonry_height
 from .costs import DEFORMABLE_FACTOR, STEP_SECONDS_PER_BLOCK
@@ -46,8 +46,8 @@ def threads(options: Mapping[str, Any], blocks: int) -> int:
     return min(options["threads"], available)
 
 
-def estimate(model: xr.Dataset, options: Mapping[str, Any]) -> mf.Estimate:
-    scene = mf.made_once(model, "fdem scene", build_scene)
+def estimate(model: xr.Dataset, options: Mapping[str, Any]) -> mfp.Estimate:
+    scene = mfp.made_once(model, "fdem scene", build_scene)
     controls = make_controls(scene, options)
     blocks = model.sizes["block"]
     gravity = GRAVITY_TIME * np.sqrt(masonry_height(scene)) / controls.dt  # scaled time: sqrt(length / g)
@@ -56,7 +56,7 @@ def estimate(model: xr.Dataset, options: Mapping[str, Any]) -> mf.Estimate:
         seconds = steps * blocks * STEP_SECONDS_PER_BLOCK * DEFORMABLE_FACTOR
     else:
         seconds = steps * blocks * STEP_SECONDS_PER_BLOCK / (1 + PARALLEL_EFFICIENCY * (threads(options, blocks) - 1))
-    return mf.Estimate(seconds=seconds, memory=BASE_MEMORY + MEMORY_PER_BLOCK * blocks,
+    return mfp.Estimate(seconds=seconds, memory=BASE_MEMORY + MEMORY_PER_BLOCK * blocks,
                        basis=f"at most {steps:,.0f} time steps of {blocks:,} blocks, as fitted on the 2-core machine "
                              "of docs/benchmarks.md",
                        advice="fewer blocks (fdem's memory grows with the blocks and their contacts, not the options)")

@@ -1,83 +1,83 @@
 """The options of the ``fdem`` solver (cheap to import: registration needs only these)."""
 from __future__ import annotations
 
-import masonryfw as mf
+import masonryfw.plugin_api as mfp
 
 OPTIONS = (
-    mf.Option("mode", str, "rigid",
+    mfp.Option("mode", str, "rigid",
               "rigid: every block a rigid body with 3 DOF (the paper's units have a very high E, "
               "so only the joints deform); deformable: every block a fan of constant-strain triangles "
               "(plane stress, block_young_modulus / block_poisson_ratio), the same joints",
               ("rigid", "deformable")),
-    mf.Option("settlement", float, None,
+    mfp.Option("settlement", float, None,
               "target settlement of the moving support [m] along settlement_direction (0: gravity only); "
               "auto: the model's settlement_target (a tunnel's S_max) if it has one, else settlement_ratio x "
               "masonry height", at_least=0.0),
-    mf.Option("settlement_ratio", float, 0.02,
+    mfp.Option("settlement_ratio", float, 0.02,
               "target settlement as a share of the masonry height when settlement is auto (0: gravity only)",
               at_least=0.0),
-    mf.Option("loading_rate", float, 2e-3,
+    mfp.Option("loading_rate", float, 2e-3,
               "settlement velocity over sqrt(g x masonry height) (quasi-static when << 1)", above=0.0),
-    mf.Option("ramp_fraction", float, 0.05,
+    mfp.Option("ramp_fraction", float, 0.05,
               "the velocity ramps up smoothly (half cosine) over this share of the target settlement time",
               at_least=0.0, at_most=1.0),
-    mf.Option("damping", float, 0.7,
+    mfp.Option("damping", float, 0.7,
               "local non-viscous damping coefficient (Cundall): each unbalanced force component is "
               "reduced by damping x |F| against the velocity; 0 = undamped dynamics", at_least=0.0, below=1.0),
-    mf.Option("contact_damping", float, 0.2,
+    mfp.Option("contact_damping", float, 0.2,
               "normal dashpot at every contact as a share of critical damping (damps contact chatter, "
               "not sliding)", at_least=0.0),
-    mf.Option("dt_safety", float, 0.3, "time step = dt_safety x estimated critical time step", above=0.0),
-    mf.Option("penetration_ratio", float, 1e-4,
+    mfp.Option("dt_safety", float, 0.3, "time step = dt_safety x estimated critical time step", above=0.0),
+    mfp.Option("penetration_ratio", float, 1e-4,
               "automatic contact stiffness: the mean base pressure of the wall's weight penetrates "
               "this share of the median unit height", above=0.0),
-    mf.Option("contact_stiffness", float, None,
+    mfp.Option("contact_stiffness", float, None,
               "normal contact stiffness per unit contact length [N m-2]; auto: from penetration_ratio", above=0.0),
-    mf.Option("min_contact_length", float, 0.01,
+    mfp.Option("min_contact_length", float, 0.01,
               "two faces overlapping less than this share of the median unit height are not in contact "
               "(blocks meeting corner to corner carry nothing)", above=0.0),
-    mf.Option("shear_stiffness_ratio", float, 0.5, "tangential / normal contact stiffness", above=0.0),
-    mf.Option("load_factor", float, None,
+    mfp.Option("shear_stiffness_ratio", float, 0.5, "tangential / normal contact stiffness", above=0.0),
+    mfp.Option("load_factor", float, None,
               "multiplier of live_load applied to the masonry blocks with the dead load; auto: 0, and a model "
               "without a moving support but with a live load (a tilting table) gets the load-factor search"),
-    mf.Option("search_first", float, 0.1, "load-factor search: the first trial multiplier (then doubled until "
+    mfp.Option("search_first", float, 0.1, "load-factor search: the first trial multiplier (then doubled until "
               "one is unstable, then bisected)", above=0.0),
-    mf.Option("search_tolerance", float, 1e-3, "load-factor search: stop when the stable and the unstable "
+    mfp.Option("search_tolerance", float, 1e-3, "load-factor search: stop when the stable and the unstable "
               "multipliers are this close", above=0.0),
-    mf.Option("search_limit", float, 10.0, "load-factor search: the largest multiplier tried", above=0.0),
-    mf.Option("collapse_motion", float, 1.0,
+    mfp.Option("search_limit", float, 10.0, "load-factor search: the largest multiplier tried", above=0.0),
+    mfp.Option("collapse_motion", float, 1.0,
               "load-factor search: a trial is unstable once a block has moved this share of the median unit "
               "height from where it rested (centroid plus rotation times radius)", above=0.0),
-    mf.Option("gravity_time", float, None,
+    mfp.Option("gravity_time", float, None,
               "duration of the gravity phase [s]; auto: until the unbalanced-force ratio is below rest_tolerance",
               above=0.0),
-    mf.Option("load_ramp", float, 0.0,
+    mfp.Option("load_ramp", float, 0.0,
               "the loads grow smoothly (half cosine) over this time [s] at the start; 0 = applied at once",
               at_least=0.0),
-    mf.Option("rest_tolerance", float, 1e-5, "unbalanced force / applied load at which the wall is at rest",
+    mfp.Option("rest_tolerance", float, 1e-5, "unbalanced force / applied load at which the wall is at rest",
               above=0.0),
-    mf.Option("max_steps", int, 20_000_000, "hard limit on the number of time steps", above=0),
-    mf.Option("records", int, 400, "history records over the target settlement", above=0),
-    mf.Option("plateau_tolerance", float, None,
+    mfp.Option("max_steps", int, 20_000_000, "hard limit on the number of time steps", above=0),
+    mfp.Option("records", int, 400, "history records over the target settlement", above=0),
+    mfp.Option("plateau_tolerance", float, None,
               "stop when the reaction varies less than this share of the dead reaction over "
               "plateau_window of the target settlement; 0 = always run to the target; auto: 0 when the target "
               "is the model's settlement_target, else 0.005", at_least=0.0),
-    mf.Option("plateau_window", float, 0.25, "share of the target settlement over which the plateau is judged",
+    mfp.Option("plateau_window", float, 0.25, "share of the target settlement over which the plateau is judged",
               above=0.0, at_most=1.0),
-    mf.Option("buffer_ratio", float, 0.1,
+    mfp.Option("buffer_ratio", float, 0.1,
               "contact detection buffer as a share of the median unit height; the pair list is rebuilt "
               "when a block has moved half of it", above=0.0),
-    mf.Option("max_contact_angle", float, 40.0, "largest angle [deg] between two faces still in contact",
+    mfp.Option("max_contact_angle", float, 40.0, "largest angle [deg] between two faces still in contact",
               above=0.0, below=90.0),
-    mf.Option("sleep", float, 0.0,
+    mfp.Option("sleep", float, 0.0,
               "blocks slower than this share of the settlement velocity for sleep_steps steps sleep "
               "(not integrated) until a contact moving faster wakes them; 0 = no sleeping", at_least=0.0),
-    mf.Option("sleep_steps", int, 200, "consecutive slow steps before a block sleeps", above=0),
-    mf.Option("wake_force", float, 0.01,
+    mfp.Option("sleep_steps", int, 200, "consecutive slow steps before a block sleeps", above=0),
+    mfp.Option("wake_force", float, 0.01,
               "a sleeping block wakes when its unbalanced force exceeds this share of its load", above=0.0),
-    mf.Option("threads", int, None,
+    mfp.Option("threads", int, None,
               "threads of the contact and block loops (numba); auto: all numba has (NUMBA_NUM_THREADS, the cores) "
               "from 300 blocks, one below; the trajectory does not depend on it, bit for bit", at_least=1),
-    mf.Option("snapshots", float, (), "settlements [m] at which block positions are stored (comma-separated)",
+    mfp.Option("snapshots", float, (), "settlements [m] at which block positions are stored (comma-separated)",
               many=True, at_least=0.0),
 )

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-import masonryfw as mf
+import masonryfw.plugin_api as mfp
 
 from .kernels import face_frames
 from .scene import Scene
@@ -49,7 +49,7 @@ def interface_forces(scene: Scene, faces: np.ndarray, props: np.ndarray, normal:
     # interface end points carried by side 0 into the current configuration
     u = block_displacement(scene, pos)
     ix, iy = model.interface_x.values[owner], model.interface_y.values[owner]
-    dux, duy = mf.point_motion(u, model.block_centroid_x.values, model.block_centroid_y.values, ix, iy,
+    dux, duy = mfp.point_motion(u, model.block_centroid_x.values, model.block_centroid_y.values, ix, iy,
                                sides[:, [0, 0]], "finite")
     ex, ey = (ix + dux) / scene.scales.length, (iy + duy) / scene.scales.length
     # nearest interface end of each contact end: (face, contact end, interface end)

@@ -14,9 +14,10 @@ import numpy as np
 import xarray as xr
 
 import masonryfw as mf
+import masonryfw.plugin_api as mfp
 
 GRAVITY = 9.81  # m s-2: turns unit weights into masses
-ROLE = mf.flags("block_role")
+ROLE = mfp.ROLE
 
 
 @dataclass(frozen=True)
@@ -64,26 +65,26 @@ def build_scene(model: xr.Dataset) -> Scene:
     """The non-dimensional arrays of ``model``; raises ModelError on what the method cannot take."""
     role = model.block_role.values.astype(np.int64)
     n_block = role.size
-    driven = mf.support_blocks(role)
+    driven = mfp.support_blocks(role)
     moving = role == ROLE["moving_support"]
-    offs = mf.block_offsets(model.block_node_count.values)
+    offs = mfp.block_offsets(model.block_node_count.values)
     area = model.block_area.values
     thickness = model.block_thickness.values
     weight = model.block_unit_weight.values * area * thickness
     total = float(weight[~driven].sum())
     if not total > 0:
         raise mf.ModelError("block_unit_weight: the masonry blocks weigh nothing; fdem needs their masses")
-    length = mf.model_scales(model).length
+    length = mfp.model_scales(model).length
     weightless = np.flatnonzero(~driven & ~(weight > 0))
     if weightless.size:
         raise mf.ModelError(
-            f"block(s) {mf.listed(weightless)}: block_unit_weight * area * thickness is not positive; "
+            f"block(s) {mfp.listed(weightless)}: block_unit_weight * area * thickness is not positive; "
             "a free block needs a mass in fdem"
         )
     scales = Scales(length=length, force=total, time=float(np.sqrt(length / GRAVITY)))
 
     cx, cy = model.block_centroid_x.values, model.block_centroid_y.values
-    owner = mf.node_block(model.block_node_count.values)
+    owner = mfp.node_block(model.block_node_count.values)
     lx = (model.node_x.values - cx[owner]) / length
     ly = (model.node_y.values - cy[owner]) / length
     radius = np.maximum.reduceat(np.hypot(lx, ly), offs[:-1])
@@ -91,7 +92,7 @@ def build_scene(model: xr.Dataset) -> Scene:
     nxt[offs[1:] - 1] = offs[:-1]
     perimeter = np.add.reduceat(np.hypot(lx[nxt] - lx, ly[nxt] - ly), offs[:-1])
     mass_share = weight / total
-    polar = mf.polar_moment(model.node_x.values, model.node_y.values, model.block_node_count.values)
+    polar = mfp.polar_moment(model.node_x.values, model.node_y.values, model.block_node_count.values)
     inertia = mass_share * polar / np.where(area > 0, area * length**2, 1.0)
     mass = np.stack((mass_share, mass_share, inertia), axis=1)
     mass[driven] = 1.0  # never used: driven blocks follow their imposed motion
@@ -101,8 +102,8 @@ def build_scene(model: xr.Dataset) -> Scene:
     direction[:, 2] *= length
     direction[~moving] = 0.0
     load_scale = np.array([total, total, total * length])
-    dead = np.where(driven[:, None], 0.0, mf.block_loads(model, "dead") / load_scale)
-    live = np.where(driven[:, None], 0.0, mf.block_loads(model, "live") / load_scale)
+    dead = np.where(driven[:, None], 0.0, mfp.block_loads(model, "dead") / load_scale)
+    live = np.where(driven[:, None], 0.0, mfp.block_loads(model, "live") / load_scale)
 
     height = np.maximum.reduceat(ly, offs[:-1]) - np.minimum.reduceat(ly, offs[:-1])
     unit_height = float(np.median(height[~driven]))

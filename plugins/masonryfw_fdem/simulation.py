@@ -25,6 +25,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 import masonryfw as mf
+import masonryfw.plugin_api as mfp
 
 from . import kernels
 from .controls import Controls
@@ -52,7 +53,7 @@ class Record:
 class History:
     """The records of a run, each added whole (one append: a Ctrl-C never leaves a half record).
 
-    ``weights`` are the settlement weights of the scene's supports (``mf.settlement_weights``, the rotation's
+    ``weights`` are the settlement weights of the scene's supports (``mfp.settlement_weights``, the rotation's
     made non-dimensional like the moments): the ``reaction`` column is the settlement reaction
     (``mf.settlement_reaction``) of the supports' wrenches. ``opening`` measures the widest openings of block positions (set by the solver).
     """
@@ -375,7 +376,7 @@ def run(scene: Scene, controls: Controls, state: State, load: np.ndarray, progre
     A KeyboardInterrupt keeps what was computed (``state.interrupted``, the state
     reached evaluated as a last record); one before the first record propagates.
     """
-    history = History(mf.settlement_weights(scene.model) * [1.0, 1.0, scene.scales.length], opening=opening)
+    history = History(mfp.settlement_weights(scene.model) * [1.0, 1.0, scene.scales.length], opening=opening)
     state.set_loads(scene, load)
     try:
         gravity_phase(scene, controls, state, history, progress)

@@ -14,6 +14,7 @@ import numpy as np
 import xarray as xr
 
 import masonryfw as mf
+import masonryfw.plugin_api as mfp
 
 from . import estimate, postprocess
 from .compilation import Compilations
@@ -23,7 +24,7 @@ from .simulation import History, State, initial_state, run
 
 LOG = logging.getLogger("masonryfw.fdem")
 #: Load-factor search (scaled time, sqrt(length / g)): the ramp to a trial multiplier, the longest hold.
-def solve(model: xr.Dataset, options: Mapping[str, Any], progress=mf.no_progress) -> xr.Dataset:
+def solve(model: xr.Dataset, options: Mapping[str, Any], progress=mfp.no_progress) -> xr.Dataset:
     """Settlement response of ``model``: gravity to rest, then the support moves down slowly.
 
     Numba's compilation of the kernels on a first run is measured apart and reported as ``compile_time_s``
@@ -47,8 +48,8 @@ def solve(model: xr.Dataset, options: Mapping[str, Any], progress=mf.no_progress
 
 
 def _solve(model: xr.Dataset, options: Mapping[str, Any], progress) -> xr.Dataset:
-    scene = mf.made_once(model, "fdem scene", build_scene)  # the one the estimate made
-    mf.refuse_rigid_settlement(model, "fdem")
+    scene = mfp.made_once(model, "fdem scene", build_scene)  # the one the estimate made
+    mfp.refuse_rigid_settlement(model, "fdem")
     controls = make_controls(scene, options)
     load = scene.dead + (options["load_factor"] or 0.0) * scene.live
     if options["mode"] == "deformable":
@@ -114,15 +115,15 @@ def history_variables(scene: Scene, history: History) -> dict:
 
     cracks = [r.cracks for r in history.records]
     settling = {
-        "step_settlement": ("step", rows["settlement"] * length, mf.variable_attrs("step_settlement")),
-        "step_reaction": ("step", rows["reaction"] * f, mf.variable_attrs("step_reaction")),
+        "step_settlement": ("step", rows["settlement"] * length, mfp.variable_attrs("step_settlement")),
+        "step_reaction": ("step", rows["reaction"] * f, mfp.variable_attrs("step_reaction")),
         "step_support_reaction": (("step", "block"),
                                   np.array([r.supports for r in history.records]).reshape(len(cracks), -1) * f,
-                                  mf.variable_attrs("step_support_reaction")),
-        "step_crack_width_max": ("step", np.array([c.width for c in cracks]), mf.variable_attrs("step_crack_width_max")),
+                                  mfp.variable_attrs("step_support_reaction")),
+        "step_crack_width_max": ("step", np.array([c.width for c in cracks]), mfp.variable_attrs("step_crack_width_max")),
         "step_crack_interface": ("step", np.array([c.interface for c in cracks], dtype=np.int32),
-                                 mf.variable_attrs("step_crack_interface")),
-        "step_base_gap_max": ("step", np.array([c.base_gap for c in cracks]), mf.variable_attrs("step_base_gap_max")),
+                                 mfp.variable_attrs("step_crack_interface")),
+        "step_base_gap_max": ("step", np.array([c.base_gap for c in cracks]), mfp.variable_attrs("step_base_gap_max")),
     } if scene.moving.any() else {
         "step_load_factor": var(rows["load_factor"], "1", "multiplier of the live load (tried) at the record"),
     }
@@ -154,15 +155,15 @@ def result_dataset(scene: Scene, state: State, history: History) -> xr.Dataset:
                                                  state.pairs.shear, state.pos)
     ie = ("interface", "end")
     data = {
-        **mf.motion_variables(postprocess.block_displacement(scene, state.pos)),
-        "interface_normal_force": (ie, normal, mf.variable_attrs("interface_normal_force")),
-        "interface_shear_force": (ie, shear, mf.variable_attrs("interface_shear_force")),
+        **mfp.motion_variables(postprocess.block_displacement(scene, state.pos)),
+        "interface_normal_force": (ie, normal, mfp.variable_attrs("interface_normal_force")),
+        "interface_shear_force": (ie, shear, mfp.variable_attrs("interface_shear_force")),
         **history_variables(scene, history),
     }
     if state.trials:
         factor, stable, motion = (np.array(column) for column in zip(*state.trials))
         data.update({
-            "collapse_multiplier": ((), state.collapse_bracket[0], mf.variable_attrs("collapse_multiplier")),
+            "collapse_multiplier": ((), state.collapse_bracket[0], mfp.variable_attrs("collapse_multiplier")),
             "trial_load_factor": ("trial", factor, {"units": "1", "long_name": "multiplier of the live load tried"}),
             "trial_stable": ("trial", stable.astype(np.int8), {
                 "units": "1", "long_name": "the wall came to rest under the trial multiplier",

@@ -11,29 +11,29 @@ the plastic picture.
 """
 from __future__ import annotations
 
-import masonryfw as mf
+import masonryfw.plugin_api as mfp
 
 from .options import INCREMENTAL_OPTIONS, LIMIT_OPTIONS
 
 
-@mf.hookimpl
+@mfp.hookimpl
 def masonryfw_solvers():
     return [
-        mf.Solver(
+        mfp.Solver(
             name="jmm",
             summary="continuum FE, Jointed Masonry Model (anisotropic Coulomb + cut-off on bed/head planes): "
                     "gravity, then settlement steps (Newton) to the reaction plateau; plastic points",
-            solve=mf.lazy("masonryfw_jmm.solver:solve"),
+            solve=mfp.lazy("masonryfw_jmm.solver:solve"),
             options=INCREMENTAL_OPTIONS,
-            estimate=mf.lazy("masonryfw_jmm.estimate:estimate"),
+            estimate=mfp.lazy("masonryfw_jmm.estimate:estimate"),
         ),
-        mf.Solver(
+        mfp.Solver(
             name="jmm-limit",
             summary="the JMM continuum's collapse state directly: one static (lower-bound) limit LP on the mesh; "
                     "smallest moving-support reaction, alpha, plastic points",
-            solve=mf.lazy("masonryfw_jmm.limit:solve"),
+            solve=mfp.lazy("masonryfw_jmm.limit:solve"),
             options=LIMIT_OPTIONS,
-            estimate=mf.lazy("masonryfw_jmm.estimate:estimate_limit"),
+            estimate=mfp.lazy("masonryfw_jmm.estimate:estimate_limit"),
             gallery=False,
         ),
     ]

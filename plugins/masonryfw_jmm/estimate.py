@@ -17,7 +17,7 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
-import masonryfw as mf
+import masonryfw.plugin_api as mfp
 
 from .mesh import axis_aligned, block_boxes, grid_lines, masonry
 
@@ -39,7 +39,7 @@ LIMIT_MEMORY_PER_DOF = 12e3
 def structured_cells(model: xr.Dataset, size: float) -> int:
     """The cells of :func:`.mesh.structured_mesh`, counted on its grid lines without building it."""
     box = block_boxes(model)[masonry(model)]
-    tol = 1e-9 * mf.model_scale(model.node_x.values, model.node_y.values)
+    tol = 1e-9 * mfp.model_scale(model.node_x.values, model.node_y.values)
     xs = grid_lines(box[:, [0, 2]].ravel(), size, tol)
     ys = grid_lines(box[:, [1, 3]].ravel(), size, tol)
     across = np.searchsorted(xs, box[:, 2] - tol) - np.searchsorted(xs, box[:, 0] - tol)
@@ -65,7 +65,7 @@ def mesh_dofs(model: xr.Dataset, options: Mapping[str, Any], element: str = "p2"
 def masonry_perimeter(model: xr.Dataset, blocks: np.ndarray) -> float:
     """The summed perimeters of ``blocks``."""
     x, y = model.node_x.values, model.node_y.values
-    start = mf.block_offsets(model.block_node_count.values)
+    start = mfp.block_offsets(model.block_node_count.values)
     following = np.arange(x.size) + 1
     following[start[1:] - 1] = start[:-1]  # each block's last node closes on its first
     sides = np.hypot(x[following] - x, y[following] - y)
@@ -76,17 +76,17 @@ def advice(size: float) -> str:
     return f"a larger --option mesh_size (now {size:.3g} m; the DOFs grow as 1 / mesh_size^2)"
 
 
-def estimate(model: xr.Dataset, options: Mapping[str, Any]) -> mf.Estimate:
+def estimate(model: xr.Dataset, options: Mapping[str, Any]) -> mfp.Estimate:
     dofs, size = mesh_dofs(model, options, options["element"])
     seconds = NEWTON_ITERATIONS * ITERATION_SECONDS * (dofs / ITERATION_DOFS) ** TIME_EXPONENT
-    return mf.Estimate(seconds=seconds, memory=BASE_MEMORY + MEMORY_PER_DOF * dofs,
+    return mfp.Estimate(seconds=seconds, memory=BASE_MEMORY + MEMORY_PER_DOF * dofs,
                        basis=f"about {dofs:,} DOFs and {NEWTON_ITERATIONS} Newton iterations, as fitted on the 2-core "
                              "machine of docs/benchmarks.md", advice=advice(size))
 
 
-def estimate_limit(model: xr.Dataset, options: Mapping[str, Any]) -> mf.Estimate:
+def estimate_limit(model: xr.Dataset, options: Mapping[str, Any]) -> mfp.Estimate:
     dofs, size = mesh_dofs(model, options)  # the mesh's size in P2 DOFs, the unit its constants are fitted in
     seconds = LIMIT_LP_SECONDS * (dofs / LIMIT_LP_DOFS) ** 1.4
-    return mf.Estimate(seconds=seconds, memory=BASE_MEMORY + LIMIT_MEMORY_PER_DOF * dofs,
+    return mfp.Estimate(seconds=seconds, memory=BASE_MEMORY + LIMIT_MEMORY_PER_DOF * dofs,
                        basis=f"about {dofs:,} DOFs, as fitted on the 2-core machine of docs/benchmarks.md",
                        advice=advice(size))

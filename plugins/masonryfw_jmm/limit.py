@@ -50,13 +50,14 @@ import xarray as xr
 from skfem import MeshTri
 
 import masonryfw as mf
+import masonryfw.plugin_api as mfp
 
 from .fabric import stress_rotation
 from .material import failure_mode
 from .output import block_mechanism, mesh_variables, point_variables, variable, with_mechanism
 from .problem import Domain, live_body_force, support_facets, wall_domain
 
-ROLE = mf.flags("block_role")
+ROLE = mfp.ROLE
 #: a strength row is plastic when its multiplier per unit volume exceeds this fraction of the largest
 PLASTIC_DUAL_FRACTION = 1e-4
 #: local corner pairs of the three edges of a triangle
@@ -229,7 +230,7 @@ def solve_lp(cost: np.ndarray, equalities: sp.spmatrix, rhs: np.ndarray, inequal
         sp.vstack([equalities, inequalities], format="csc"), np.concatenate([rhs, bounds]),
         [clarabel.ZeroConeT(n_eq), clarabel.NonnegativeConeT(n_in)], settings,
     )
-    sol = mf.interruptible(solver.solve)
+    sol = mfp.interruptible(solver.solve)
     seconds = time.perf_counter() - start
     status = str(sol.status).split(".")[-1]
     if status in ("PrimalInfeasible", "AlmostPrimalInfeasible"):
@@ -380,7 +381,7 @@ def wall_lp(domain: Domain, model: xr.Dataset, A: np.ndarray, b: np.ndarray, nam
     headless = domain.headless[blocks]
     if moving.size:
         return settlement_lp(field, unit_weight, strong, A, b, fixed, moving, to_bed, head, headless)
-    if not np.any(mf.block_loads(model, "live")[blocks]):
+    if not np.any(mfp.block_loads(model, "live")[blocks]):
         raise mf.ModelError("jmm-limit: no moving support to settle and no live load to raise: nothing to analyse")
     dead = np.stack([np.zeros(field.n_el), -unit_weight], axis=1)
     return load_factor_lp(field, dead, live_body_force(model, blocks, domain.unit_weight), strong, A, b, fixed,

@@ -23,8 +23,9 @@ import numpy as np
 import xarray as xr
 
 import masonryfw as mf
+import masonryfw.plugin_api as mfp
 
-KIND = mf.flags("interface_kind")
+KIND = mfp.flags("interface_kind")
 
 
 @dataclass(frozen=True)
@@ -41,7 +42,7 @@ class WallMesh:
 
 def masonry(model: xr.Dataset) -> np.ndarray:
     """Indices of the units and lintels (the blocks the mesh covers)."""
-    found = np.flatnonzero(mf.masonry_blocks(model.block_role.values))
+    found = np.flatnonzero(mfp.masonry_blocks(model.block_role.values))
     if found.size == 0:
         raise mf.ModelError("jmm: the model has no unit or lintel blocks to mesh")
     return found
@@ -49,7 +50,7 @@ def masonry(model: xr.Dataset) -> np.ndarray:
 
 def block_boxes(model: xr.Dataset) -> np.ndarray:
     """``(block, 4)`` = x0, y0, x1, y1 of every block's bounding box."""
-    xmin, xmax, ymin, ymax = mf.block_bounds(model.node_x.values, model.node_y.values, model.block_node_count.values)
+    xmin, xmax, ymin, ymax = mfp.block_bounds(model.node_x.values, model.node_y.values, model.block_node_count.values)
     return np.stack([xmin, ymin, xmax, ymax], axis=1)
 
 
@@ -64,7 +65,7 @@ def axis_aligned(model: xr.Dataset) -> bool:
 def support_segments(model: xr.Dataset) -> tuple[np.ndarray, np.ndarray]:
     """``(segments (k, end, xy), support block (k,))``: every interface between masonry and a support."""
     sides = model.interface_blocks.values.astype(np.int64)
-    support = mf.support_blocks(model.block_role.values)
+    support = mfp.support_blocks(model.block_role.values)
     on = support[sides].any(axis=1) & ~support[sides].all(axis=1)
     segments = np.stack([model.interface_x.values[on], model.interface_y.values[on]], axis=2)
     return segments, np.where(support[sides[on, 0]], sides[on, 0], sides[on, 1])
@@ -84,7 +85,7 @@ def structured_mesh(model: xr.Dataset, size: float) -> tuple[np.ndarray, np.ndar
     """``(points, triangles, block)`` of the grid mesh of an axis-aligned wall (module docstring)."""
     box = block_boxes(model)
     b = masonry(model)
-    tol = 1e-9 * mf.model_scale(model.node_x.values, model.node_y.values)
+    tol = 1e-9 * mfp.model_scale(model.node_x.values, model.node_y.values)
     xs = grid_lines(box[:, [0, 2]].ravel(), size, tol)
     ys = grid_lines(box[b][:, [1, 3]].ravel(), size, tol)
     cx, cy = 0.5 * (xs[1:] + xs[:-1]), 0.5 * (ys[1:] + ys[:-1])
@@ -120,7 +121,7 @@ def gmsh_mesh(model: xr.Dataset, size: float) -> tuple[np.ndarray, np.ndarray, n
                             f"which does not load here ({exc})") from None
     blocks = masonry(model)
     x, y = model.node_x.values, model.node_y.values
-    start = mf.block_offsets(model.block_node_count.values)
+    start = mfp.block_offsets(model.block_node_count.values)
     gmsh.initialize(interruptible=False)
     try:
         gmsh.option.setNumber("General.Terminal", 0)

@@ -4,7 +4,7 @@ from __future__ import annotations
 import numpy as np
 import xarray as xr
 
-import masonryfw as mf
+import masonryfw.plugin_api as mfp
 
 
 def variable(dims, values, units: str, long_name: str, **attrs) -> xr.Variable:
@@ -17,14 +17,14 @@ def mesh_variables(points: np.ndarray, triangles: np.ndarray) -> dict[str, xr.Va
         "mesh_node_x": variable("mesh_node", points[0], "m", "continuum mesh node x"),
         "mesh_node_y": variable("mesh_node", points[1], "m", "continuum mesh node y"),
         "mesh_face_nodes": variable(("mesh_face", "mesh_face_node"), triangles.T.astype(np.int32), "1",
-                                    mf.variable_attrs("mesh_face_nodes")["long_name"]),
+                                    mfp.variable_attrs("mesh_face_nodes")["long_name"]),
     }
 
 
 def point_variables(xy: np.ndarray, failure: np.ndarray, stress: np.ndarray, where: str, when: str,
                     ) -> dict[str, xr.Variable]:
     """``qp_x/y`` (``where`` the points are), ``qp_failure`` and ``qp_stress_*`` [Pa] (``when`` they hold)."""
-    flags = mf.flags("qp_failure")
+    flags = mfp.flags("qp_failure")
     return {
         "qp_x": variable("qp", xy[0], "m", f"{where} x"),
         "qp_y": variable("qp", xy[1], "m", f"{where} y"),
@@ -42,8 +42,8 @@ def block_mechanism(model: xr.Dataset, block, x, y, ux, uy, weight, settlement: 
     (block, 3): projected onto each block's rigid motions (:func:`masonryfw.rigid_fit`), the supports moving
     by ``settlement`` along their ``settlement_direction`` (fixed ones stay). None when a block gets no
     motion (no point in it)."""
-    fitted = mf.rigid_fit(block, x, y, ux, uy, weight, model.block_centroid_x.values, model.block_centroid_y.values)
-    supports = mf.support_blocks(model.block_role.values)
+    fitted = mfp.rigid_fit(block, x, y, ux, uy, weight, model.block_centroid_x.values, model.block_centroid_y.values)
+    supports = mfp.support_blocks(model.block_role.values)
     fitted[supports] = model.settlement_direction.values[supports] * settlement
     return None if np.isnan(fitted).any() else fitted
 
@@ -53,4 +53,4 @@ def with_mechanism(result: xr.Dataset, motion: np.ndarray | None, flow_rule: str
     ``flow_rule`` says how its joints dilate (docs/format.md)."""
     if motion is None:
         return result
-    return result.assign(mf.motion_variables(motion)).assign_attrs(rotations="small", flow_rule=flow_rule)
+    return result.assign(mfp.motion_variables(motion)).assign_attrs(rotations="small", flow_rule=flow_rule)

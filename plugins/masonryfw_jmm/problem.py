@@ -15,14 +15,15 @@ import xarray as xr
 from skfem import MeshTri
 
 import masonryfw as mf
+import masonryfw.plugin_api as mfp
 
 from .fabric import bed_angles, extents_along, head_joints, stress_rotation
 from .fem import Discretisation
 from .material import JointStrength, ReturnMap, elastic_matrix
 from .mesh import WallMesh, block_boxes, masonry, wall_mesh
 
-ROLE = mf.flags("block_role")
-KIND = mf.flags("interface_kind")
+ROLE = mfp.ROLE
+KIND = mfp.flags("interface_kind")
 
 
 @dataclass
@@ -87,7 +88,7 @@ def unit_size(model: xr.Dataset, angles: np.ndarray) -> tuple[float, float]:
     if not units.any():
         raise mf.ModelError("jmm: no unit blocks to take the unit size b x a from; give options beta and mesh_size")
     length, height = extents_along(model, angles)
-    tol = 1e-6 * mf.model_scale(model.node_x.values, model.node_y.values)
+    tol = 1e-6 * mfp.model_scale(model.node_x.values, model.node_y.values)
     return _modal(length[units], tol), _modal(height[units], tol)
 
 
@@ -113,7 +114,7 @@ def joint_planes(model: xr.Dataset, angles: np.ndarray) -> np.ndarray:
     runs within 45 deg of its side-0 block's bed direction (the interface kind in a wall of courses);
     a joint on a support is neither."""
     sides = model.interface_blocks.values.astype(np.int64)
-    on_support = mf.support_blocks(model.block_role.values)[sides].any(axis=1)
+    on_support = mfp.support_blocks(model.block_role.values)[sides].any(axis=1)
     direction = np.arctan2(np.diff(model.interface_y.values, axis=1)[:, 0], np.diff(model.interface_x.values, axis=1)[:, 0])
     off = np.abs(np.sin(direction - angles[sides[:, 0]]))
     return np.where(on_support, "", np.where(off < np.sqrt(0.5), "bed", "head"))
@@ -190,7 +191,7 @@ def support_facets(points: np.ndarray, ends: np.ndarray, segments: np.ndarray, t
     bx, by = segments[:, 1, 0], segments[:, 1, 1]
     near = np.ones((ends.shape[1], segments.shape[0]), dtype=bool)
     for end in (0, 1):
-        near &= mf.point_segment_distance(px[end][:, None], py[end][:, None], ax, ay, bx, by) <= tol
+        near &= mfp.point_segment_distance(px[end][:, None], py[end][:, None], ax, ay, bx, by) <= tol
     return np.where(near.any(axis=1), near.argmax(axis=1), -1)
 
 
@@ -290,10 +291,10 @@ def wall_domain(model: xr.Dataset, mesh_size: float | None, beta: float | None,
 def live_body_force(model: xr.Dataset, blocks: np.ndarray, unit_weight: float) -> np.ndarray:
     """``(triangles, 2)`` the live load of every masonry block spread uniformly over its volume, over
     ``unit_weight`` (the non-dimensional body force); a live moment has no such meaning and is refused."""
-    live = mf.block_loads(model, "live")
+    live = mfp.block_loads(model, "live")
     moment = np.flatnonzero(live[blocks, 2] != 0)
     if moment.size:
-        raise mf.ModelError(f"block(s) {mf.listed(np.unique(blocks[moment]))}: live_load has a moment; jmm "
+        raise mf.ModelError(f"block(s) {mfp.listed(np.unique(blocks[moment]))}: live_load has a moment; jmm "
                             "spreads a block's live load over its volume, which carries forces only")
     volume = model.block_area.values * model.block_thickness.values
     return live[blocks, :2] / volume[blocks, None] / unit_weight
@@ -349,8 +350,8 @@ def build_problem(model: xr.Dataset, options) -> Problem:
     fixed, moving, direction, support_uy, support_of = _support_dofs(mesh, disc, model, H, 1e-6 * size / H)
     searches_load = moving.size == 0
     if not searches_load:
-        mf.refuse_rigid_settlement(model, "jmm")
-    if searches_load and not np.any(mf.block_loads(model, "live")[masonry(model)]):
+        mfp.refuse_rigid_settlement(model, "jmm")
+    if searches_load and not np.any(mfp.block_loads(model, "live")[masonry(model)]):
         raise mf.ModelError("jmm: no moving support to settle and no live load to raise: nothing to analyse")
     live = disc.body_force(live_body_force(model, blocks, domain.unit_weight))
     to_bed, from_bed = bed_rotations(np.repeat(domain.angles[blocks], disc.nqp)[masonry_points])

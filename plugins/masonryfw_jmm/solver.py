@@ -17,6 +17,7 @@ import numpy as np
 import xarray as xr
 
 import masonryfw as mf
+import masonryfw.plugin_api as mfp
 
 from .newton import NewtonSolver, State
 from .output import block_mechanism, mesh_variables, point_variables, variable, with_mechanism
@@ -263,18 +264,11 @@ def _load_path(options, progress) -> Path:
 
 def run(problem: Problem, options, progress) -> tuple[State, History, dict]:
     """Gravity, then settlement steps until the plateau (or the target); every converged step kept."""
-    newton, history, info, state = _start(problem, options)
-    try:
-        state, failed = _gravity(newton, state, history, info, progress)
-        if failed:
-            return state, history, info
+    def settling(newton: NewtonSolver, state: State, info: dict) -> Path:
         unloading, slope = elastic_unloading_settlement(newton, state)
         info["jmm_elastic_unloading_settlement_m"] = unloading * problem.displacement
-        state = _continue(newton, state, history, info, _settlement_path(problem, options, unloading, slope, progress),
-                          options)
-    except KeyboardInterrupt:
-        _interrupted(info)
-    return state, history, info
+        return _settlement_path(problem, options, unloading, slope, progress)
+    return _gravity_then(problem, options, progress, settling)
 
 
 def _load_plateau(history: History, options) -> bool:
@@ -291,12 +285,17 @@ def _load_plateau(history: History, options) -> bool:
 
 def run_load_factor(problem: Problem, options, progress) -> tuple[State, History, dict]:
     """Gravity, then load steps of the live load until no step converges (module docstring)."""
+    return _gravity_then(problem, options, progress, lambda newton, state, info: _load_path(options, progress))
+
+
+def _gravity_then(problem: Problem, options, progress, path: Callable[[NewtonSolver, State, dict], Path]):
+    """The gravity stage, then the steps along ``path(newton, state at rest, info)``: ``(last state, history,
+    info)``, what was converged kept on Ctrl-C."""
     newton, history, info, state = _start(problem, options)
     try:
         state, failed = _gravity(newton, state, history, info, progress)
-        if failed:
-            return state, history, info
-        state = _continue(newton, state, history, info, _load_path(options, progress), options)
+        if not failed:
+            state = _continue(newton, state, history, info, path(newton, state, info), options)
     except KeyboardInterrupt:
         _interrupted(info)
     return state, history, info
@@ -335,9 +334,9 @@ def crack_interfaces(problem: Problem, model: xr.Dataset, history: History) -> n
     cracked = point >= 0
     if cracked.any():
         role = model.block_role.values
-        inside = mf.masonry_blocks(role)[model.interface_blocks.values.astype(np.int64)].all(axis=1)
+        inside = mfp.masonry_blocks(role)[model.interface_blocks.values.astype(np.int64)].all(axis=1)
         qx, qy = problem.disc.qp_xy * problem.length
-        out[cracked] = mf.nearest_interface(model, qx[point[cracked]], qy[point[cracked]],
+        out[cracked] = mfp.nearest_interface(model, qx[point[cracked]], qy[point[cracked]],
                                             0.25 * problem.mesh_size, among=inside)
     return out
 
@@ -358,15 +357,15 @@ def result_dataset(problem: Problem, model: xr.Dataset, state: State, history: H
         **point_variables((qx, qy), failure, stress, "quadrature point", "in the last step"),
         **(load_factor_variables(history, U) if p.searches_load else {
             "step_settlement": variable("step", np.asarray(history.settlement) * U, "m", "imposed settlement"),
-            "step_reaction": ("step", np.asarray(history.reaction) * p.force, mf.variable_attrs("step_reaction")),
+            "step_reaction": ("step", np.asarray(history.reaction) * p.force, mfp.variable_attrs("step_reaction")),
             "step_support_reaction": variable(("step", "block"), np.array(history.supports) * p.force, "N",
-                                              mf.variable_attrs("step_support_reaction")["long_name"]),
+                                              mfp.variable_attrs("step_support_reaction")["long_name"]),
             "step_crack_width_max": variable(
                 "step", np.asarray(history.crack_width) * U, "m",
                 "widest crack estimated as the plastic opening strain across the joints times the mesh size "
                 "(a smeared crack band, Bazant & Oh 1983)"),
             "step_crack_interface": ("step", crack_interfaces(p, model, history),
-                                     mf.variable_attrs("step_crack_interface")),
+                                     mfp.variable_attrs("step_crack_interface")),
         }),
         "step_newton_iterations": variable("step", np.asarray(history.iterations, dtype=np.int32), "1",
                                        "Newton iterations of the step (step 0: the whole gravity stage)"),

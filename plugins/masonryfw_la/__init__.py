@@ -5,20 +5,20 @@ Registration only (the solve is imported on first use); the method lives in
 """
 from __future__ import annotations
 
-import masonryfw as mf
+import masonryfw.plugin_api as mfp
 
 from .options import OPTIONS, VARIANTS
 
 
-@mf.hookimpl
+@mfp.hookimpl
 def masonryfw_solvers():
     return [
-        mf.Solver(
+        mfp.Solver(
             name="la",
             summary="limit analysis: rigid blocks, no-tension dilatant Coulomb joints; alpha, mechanism, contact forces",
-            solve=mf.lazy("masonryfw_la.solver:solve"),
+            solve=mfp.lazy("masonryfw_la.solver:solve"),
             options=OPTIONS,
             variants=VARIANTS,
-            estimate=mf.lazy("masonryfw_la.estimate:estimate"),
+            estimate=mfp.lazy("masonryfw_la.estimate:estimate"),
         )
     ]

@@ -34,9 +34,9 @@ import numpy as np
 import scipy.sparse as sp
 import xarray as xr
 
-import masonryfw as mf
+import masonryfw.plugin_api as mfp
 
-ROLE = mf.flags("block_role")
+ROLE = mfp.ROLE
 
 
 @dataclass(frozen=True)
@@ -46,7 +46,7 @@ class Wall:
     role: np.ndarray  # (block,)
     fixed: np.ndarray  # (block, dof) bool
     direction: np.ndarray  # (block, dof) settlement direction
-    settlement_weights: np.ndarray  # (block, dof) mf.settlement_weights: the settlement reaction's
+    settlement_weights: np.ndarray  # (block, dof) mfp.settlement_weights: the settlement reaction's
     dead: np.ndarray  # (block, dof)
     live: np.ndarray
     thickness: np.ndarray
@@ -72,9 +72,9 @@ class Wall:
             role=v["block_role"],
             fixed=v["block_fixed"] != 0,
             direction=v["settlement_direction"].astype(float),
-            settlement_weights=mf.settlement_weights(model),
-            dead=mf.block_loads(model, "dead"),
-            live=mf.block_loads(model, "live"),
+            settlement_weights=mfp.settlement_weights(model),
+            dead=mfp.block_loads(model, "dead"),
+            live=mfp.block_loads(model, "live"),
             thickness=v["block_thickness"].astype(float),
             area=v["block_area"],
             centroid=np.c_[v["block_centroid_x"], v["block_centroid_y"]],
@@ -102,7 +102,7 @@ class Wall:
     @property
     def support(self) -> np.ndarray:
         """Blocks that are supports (ground)."""
-        return mf.support_blocks(self.role)
+        return mfp.support_blocks(self.role)
 
     @property
     def moving(self) -> np.ndarray:
@@ -169,7 +169,7 @@ class KinematicLP:
 def model_scales(model: xr.Dataset, wall: Wall) -> Scales:
     """The model's scales (:func:`masonryfw.model_scales`), the force being the total dead load
     (the live load's when there is no dead load): the dual forces are then of order one."""
-    scales = mf.model_scales(model)
+    scales = mfp.model_scales(model)
     for loads in (wall.dead, wall.live):
         force = float(np.hypot(loads[:, 0], loads[:, 1]).sum())
         if force > 0:

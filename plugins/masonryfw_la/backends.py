@@ -30,6 +30,7 @@ import numpy as np
 import scipy.sparse as sp
 
 import masonryfw as mf
+import masonryfw.plugin_api as mfp
 
 OSQP_REGULARISATION = 1e-3
 OSQP_FIRST_STEP_TOLERANCE = 1e-5
@@ -139,7 +140,7 @@ def solve_clarabel(cost, constraints, live, tolerance) -> LPSolution:
         [clarabel.ZeroConeT(1), clarabel.NonnegativeConeT(n_row)],
         settings,
     )
-    sol = mf.interruptible(solver.solve)
+    sol = mfp.interruptible(solver.solve)
     status = str(sol.status).split(".")[-1]
     if status in ("PrimalInfeasible", "AlmostPrimalInfeasible"):
         raise mf.SolveError(UNBOUNDED_MESSAGE)

@@ -12,7 +12,7 @@ from typing import Any
 
 import xarray as xr
 
-import masonryfw as mf
+import masonryfw.plugin_api as mfp
 
 SECONDS_AT_10K_BLOCKS = 5.9
 TIME_EXPONENT = 1.4
@@ -21,10 +21,10 @@ BASE_MEMORY = 160 * 2**20  # the interpreter, numpy, scipy, xarray, cvxopt
 MEMORY_PER_BLOCK = 25e3  # bytes
 
 
-def estimate(model: xr.Dataset, options: Mapping[str, Any]) -> mf.Estimate:
+def estimate(model: xr.Dataset, options: Mapping[str, Any]) -> mfp.Estimate:
     blocks = model.sizes["block"]
     seconds = SECONDS_AT_10K_BLOCKS * (blocks / 10_000) ** TIME_EXPONENT
     if options["flow"] == "nonassociative":
         seconds *= NONASSOCIATIVE_FACTOR
-    return mf.Estimate(seconds=seconds, memory=BASE_MEMORY + MEMORY_PER_BLOCK * blocks,
+    return mfp.Estimate(seconds=seconds, memory=BASE_MEMORY + MEMORY_PER_BLOCK * blocks,
                        basis=f"{blocks:,} blocks, as fitted on the 2-core machine of docs/benchmarks.md")

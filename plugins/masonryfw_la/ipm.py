@@ -34,7 +34,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-import masonryfw as mf
+import masonryfw.plugin_api as mfp
 
 MAX_ITERATIONS = 100
 STEP_TO_BOUNDARY = 0.995  # fraction of the step to the boundary of s >= 0, y >= 0
@@ -75,7 +75,7 @@ class NormalMatrix:
         self.pairs = pairs.T  # values = pairs @ d
         self.diagonal = diagonal_slots(self.pattern)
         self.d = None
-        self.factor = mf.cholesky_factor(self.pattern)
+        self.factor = mfp.cholesky_factor(self.pattern)
 
     def factorise(self, d: np.ndarray) -> None:
         """Factor ``M(d)`` with each diagonal entry raised by ``REGULARISATION`` of itself (more if needed)."""

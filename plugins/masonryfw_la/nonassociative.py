@@ -58,6 +58,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 import masonryfw as mf
+import masonryfw.plugin_api as mfp
 
 from . import assembly, backends, postprocess
 
@@ -159,7 +160,7 @@ def least_compression(lp: assembly.KinematicLP, alpha: float, tolerance: float) 
     settings.tol_gap_abs = settings.tol_gap_rel = settings.tol_feas = SELECTION_TOLERANCE
     solver = clarabel.DefaultSolver(sp.diags(weight, format="csc"), np.zeros(n_row + 1), matrix, rhs,
                                     [clarabel.ZeroConeT(n_col), clarabel.NonnegativeConeT(n_row + 1)], settings)
-    solution = mf.interruptible(solver.solve)
+    solution = mfp.interruptible(solver.solve)
     status = str(solution.status).split(".")[-1]
     if status not in ("Solved", "AlmostSolved"):
         raise mf.SolveError(f"la: the least-compression contact forces at alpha = {alpha:.6g} were not found "
@@ -231,7 +232,7 @@ def admissible(selection: Selection, lp: assembly.KinematicLP, solution: backend
 
 
 def solve(wall: assembly.Wall, scales: assembly.Scales, kin: assembly.Kinematics, options,
-          progress=mf.no_progress) -> FlowIteration:
+          progress=mfp.no_progress) -> FlowIteration:
     """The sequence of LPs of the module docstring."""
     backend, lp_tolerance = options["solver"], options["tolerance"]
     tolerance, cap, relaxation = options["flow_tolerance"], options["flow_iterations"], options["flow_relaxation"]

@@ -1,14 +1,14 @@
 """The options and variants of the ``la`` solver (cheap to import: registration needs only these)."""
 from __future__ import annotations
 
-import masonryfw as mf
+import masonryfw.plugin_api as mfp
 
 #: LP backends, highs first: the exact vertex, the gallery's reference.
 BACKENDS = ("highs", "ipm", "clarabel", "osqp")
 DEFAULT_BACKEND = "ipm"
 
 OPTIONS = (
-    mf.Option(
+    mfp.Option(
         "solver",
         str,
         DEFAULT_BACKEND,
@@ -19,20 +19,20 @@ OPTIONS = (
         "(ADMM with proximal regularisation; slow, a cross-check)",
         BACKENDS,
     ),
-    mf.Option("tolerance", float, 1e-9, "feasibility / optimality tolerance of the backend", above=0.0, below=1.0),
-    mf.Option("flow", str, "associative",
+    mfp.Option("tolerance", float, 1e-9, "feasibility / optimality tolerance of the backend", above=0.0, below=1.0),
+    mfp.Option("flow", str, "associative",
               "associative: a sliding joint opens by mu |slip| (dilatant, the paper's and ALMA's; an upper bound); "
               "nonassociative: joints slide without opening, by a sequence of LPs with the shear capacity of the "
               "previous normal forces (Gilbert, Casapulla & Ahmed 2006; docs/la.md)",
               ("associative", "nonassociative")),
-    mf.Option("flow_tolerance", float, 1e-6,
+    mfp.Option("flow_tolerance", float, 1e-6,
               "nonassociative: stop when alpha (relative) and every end's normal force (over the dead load) "
               "change by less than this between two LPs", above=0.0, below=1.0),
-    mf.Option("flow_iterations", int, 100, "nonassociative: the largest number of LPs", above=0),
-    mf.Option("flow_relaxation", float, 1.0,
+    mfp.Option("flow_iterations", int, 100, "nonassociative: the largest number of LPs", above=0),
+    mfp.Option("flow_relaxation", float, 1.0,
               "nonassociative: share of the change of the normal forces taken from one LP to the next",
               above=0.0, at_most=1.0),
 )
 
 #: Every backend, run side by side by the gallery (their mechanisms may differ where the optimum is degenerate).
-VARIANTS = tuple(mf.Variant(backend, {"solver": backend}) for backend in BACKENDS)
+VARIANTS = tuple(mfp.Variant(backend, {"solver": backend}) for backend in BACKENDS)

@@ -15,6 +15,7 @@ import numpy as np
 import xarray as xr
 
 import masonryfw as mf
+import masonryfw.plugin_api as mfp
 
 from . import assembly, backends, nonassociative, postprocess, topology
 
@@ -28,7 +29,7 @@ def check_live_load(lp: assembly.KinematicLP) -> None:
         )
 
 
-def solve(model: xr.Dataset, options: Mapping[str, Any], progress=mf.no_progress) -> xr.Dataset:
+def solve(model: xr.Dataset, options: Mapping[str, Any], progress=mfp.no_progress) -> xr.Dataset:
     """Collapse multiplier, mechanism and contact forces of ``model`` (checked, options resolved by the core)."""
     clock = time.perf_counter()
     progress(0.0, "la: assembling the kinematic programme")
@@ -94,10 +95,10 @@ def result_dataset(
     forces = postprocess.contact_forces(lp, sol.y, wall.n_interface, scales)
     ie = ("interface", "end")
     data = {
-        "collapse_multiplier": ((), sol.alpha_primal, mf.variable_attrs("collapse_multiplier")),
-        **mf.motion_variables(postprocess.mechanism(lp, sol.x, scales)),
-        "interface_normal_force": (ie, forces.normal, mf.variable_attrs("interface_normal_force")),
-        "interface_shear_force": (ie, forces.shear, mf.variable_attrs("interface_shear_force")),
+        "collapse_multiplier": ((), sol.alpha_primal, mfp.variable_attrs("collapse_multiplier")),
+        **mfp.motion_variables(postprocess.mechanism(lp, sol.x, scales)),
+        "interface_normal_force": (ie, forces.normal, mfp.variable_attrs("interface_normal_force")),
+        "interface_shear_force": (ie, forces.shear, mfp.variable_attrs("interface_shear_force")),
         "lp_status": ((), sol.status, {"long_name": "status of the linear programme", "units": "1"}),
         "lp_iterations": ((), np.int64(sol.iterations), {"long_name": "iterations of the LP backend", "units": "1"}),
     }
@@ -105,7 +106,7 @@ def result_dataset(
         data["moving_support_reaction"] = (
             (),
             postprocess.moving_support_reaction(wall, forces),
-            mf.variable_attrs("moving_support_reaction"),
+            mfp.variable_attrs("moving_support_reaction"),
         )
     return xr.Dataset(data, attrs={"la_alpha_dual": float(sol.alpha_dual), "rotations": "small",
                                    "flow_rule": flow_rule})

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import lazy_loader
 
-import masonryfw as mf
+import masonryfw.plugin_api as mfp
 
 from .commands import available_commands
 
@@ -24,12 +24,13 @@ from .commands import available_commands
 # no __dir__: pluggy finds the hook implementations by dir(module)
 __getattr__, _, __all__ = lazy_loader.attach(__name__, submod_attrs={
     "archive": ["verify_archive", "write_archive"],
-    "params": ["Param", "parse_param"],
+    "params": ["Param", "parse_param", "point_assignments", "with_values"],
     "store": ["Store", "content_key"],
+    "tasks": ["run_point"],
     "sweep": ["SweepPlan", "combine", "dask_client", "failed_points", "plan_sweep", "run_sweep"],
 })
 
 
-@mf.hookimpl
+@mfp.hookimpl
 def masonryfw_commands():
     return available_commands()

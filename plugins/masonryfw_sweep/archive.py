@@ -32,6 +32,7 @@ from pathlib import Path
 import numpy as np
 
 import masonryfw as mf
+import masonryfw.plugin_api as mfp
 
 from .store import RESULTS, Store, model_hash
 from .tasks import STATUS
@@ -110,10 +111,10 @@ def _manifest(root: Path, sweep, sweep_file: Path, source: Store, command: str) 
         "created": datetime.now(timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ"),
         "masonryfw_version": mf.__version__,
         "commands": {"sweep": sweep.attrs.get("sweep_command", ""), "archive": command},
-        "source": {"sweep_file": str(sweep_file.resolve()), "sweep_file_sha256": mf.sha256_file(sweep_file),
+        "source": {"sweep_file": str(sweep_file.resolve()), "sweep_file_sha256": mfp.sha256_file(sweep_file),
                    "store": str(source.root)},
         "files": {
-            name: {"sha256": mf.sha256_file(root / name), "bytes": (root / name).stat().st_size}
+            name: {"sha256": mfp.sha256_file(root / name), "bytes": (root / name).stat().st_size}
             for name in _relative_files(root)
         },
     }
@@ -125,7 +126,7 @@ def write_archive(target: str | os.PathLike, sweep_file: str | os.PathLike, comm
     if target.exists() and (not target.is_dir() or any(target.iterdir())):
         raise mf.ModelError(f"{target}: exists and is not an empty folder; archive into a new folder")
     if not target.exists():
-        mf.check_output_path(target)  # its folder exists and is writable
+        mfp.check_output_path(target)  # its folder exists and is writable
     sweep = mf.open_dataset(sweep_file)
     if sweep.attrs.get("masonryfw_format") != "sweep":
         raise mf.ModelError(f"{sweep_file}: not a sweep dataset (masonryfw_format is "
@@ -183,7 +184,7 @@ def verify_archive(root: str | os.PathLike) -> list[str]:
             problems.append(f"{name}: missing")
         elif path.stat().st_size != entry.get("bytes"):
             problems.append(f"{name}: {path.stat().st_size} bytes, the manifest says {entry.get('bytes')}")
-        elif mf.sha256_file(path) != entry.get("sha256"):
+        elif mfp.sha256_file(path) != entry.get("sha256"):
             problems.append(f"{name}: SHA-256 differs from the manifest")
     problems += [f"{name}: not in the manifest" for name in _relative_files(root) if name not in listed]
     problems += _reopen_problems(root, [n for n in listed if n.endswith(".nc") and (root / n).is_file()])

@@ -9,7 +9,7 @@ from pathlib import Path
 import click
 
 import masonryfw as mf
-from masonryfw.command_kit import command_line
+import masonryfw.plugin_api as mfp
 
 #: At most this many failed points are listed on the terminal (all are in the output file).
 LISTED_FAILURES = 10
@@ -59,14 +59,14 @@ def sweep_command(spec: str, solver: str, params: tuple[str, ...], zipped: bool,
 
     if scheduler and workers:
         raise click.UsageError("--workers sizes the local cluster; it cannot be used with --scheduler")
-    plan = plan_sweep(spec, solver, params, mf.parse_option_pairs(options), zipped)
+    plan = plan_sweep(spec, solver, params, mfp.parse_option_pairs(options), zipped)
     out = Path(output) if output else _default_output(spec, solver)
-    mf.check_output_path(out, mf.input_files(spec))
+    mfp.check_output_path(out, mfp.input_files(spec))
     store_dir = Path(store) if store else out.with_name(out.name.removesuffix(".nc") + ".store")
     if not store_dir.is_dir():
-        mf.check_output_path(store_dir)  # its folder exists and is writable: the store is made in it
-    mf.claim(store_dir.resolve(), f"sweep store {store_dir}")  # two sweeps on one store would solve its points twice
-    command = command_line()
+        mfp.check_output_path(store_dir)  # its folder exists and is writable: the store is made in it
+    mfp.claim(store_dir.resolve(), f"sweep store {store_dir}")  # two sweeps on one store would solve its points twice
+    command = mfp.command_line()
     kept: list[int] = []
     try:
         with dask_client(scheduler, workers) as client, _progress(len(plan.points), not no_progress) as on_point:
@@ -121,7 +121,7 @@ def archive_command(directory: str, sweep_file: str | None, verify: bool) -> Non
             click.get_current_context().exit(1)
         click.echo(f"OK: {directory}: every checksum matches and every file reopens")
         return
-    target = write_archive(directory, sweep_file, command_line())
+    target = write_archive(directory, sweep_file, mfp.command_line())
     click.echo(f"archive: {target}")
 
 

@@ -21,6 +21,7 @@ from dataclasses import dataclass, replace
 from typing import Any
 
 import masonryfw as mf
+import masonryfw.plugin_api as mfp
 
 try:  # Python >= 3.11
     import tomllib
@@ -230,7 +231,7 @@ def _first_new(spec: Mapping, path: KeyPath) -> KeyPath:
 # --------------------------------------------------------------------------- options
 
 
-def resolve_option_params(solver: mf.Solver, params: Sequence[Param]) -> list[Param]:
+def resolve_option_params(solver: mfp.Solver, params: Sequence[Param]) -> list[Param]:
     """``params`` with every ``option.<name>`` value parsed by the solver's declared option."""
     declared = {o.name: o for o in solver.options}
     out = []
@@ -239,7 +240,7 @@ def resolve_option_params(solver: mf.Solver, params: Sequence[Param]) -> list[Pa
             option = declared.get(param.option_name)
             if option is None:
                 raise mf.PluginError(f"--param {param.key}: solver {solver.name!r}: "
-                                     + mf.unknown_name_message("option", param.option_name, list(declared)))
+                                     + mfp.unknown_name_message("option", param.option_name, list(declared)))
             owner = f"--param {param.key}: solver {solver.name!r}"
             param = replace(param, values=tuple(option.parse(v, owner) for v in param.values))
         out.append(param)

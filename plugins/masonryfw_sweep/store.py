@@ -28,6 +28,7 @@ from typing import Any
 import xarray as xr
 
 import masonryfw as mf
+import masonryfw.plugin_api as mfp
 
 RESULTS = "results"
 
@@ -40,14 +41,14 @@ def content_key(model_sha256: str, solver: str, solver_version: str, core_versio
         "solver": solver,
         "solver_version": solver_version,
         "core_version": core_version,
-        "solver_options": json.loads(mf.options_json(options)),
+        "solver_options": json.loads(mfp.options_json(options)),
     }
     return hashlib.sha256(json.dumps(identity, sort_keys=True).encode("utf-8")).hexdigest()
 
 
 def model_hash(model: xr.Dataset) -> str:
     """The content hash of a model (what it holds, not how a file stores it)."""
-    return mf.content_sha256(model)
+    return mfp.content_sha256(model)
 
 
 def _synced_text(text: str):
@@ -94,7 +95,7 @@ class Store:
         except (KeyError, TypeError):
             return None
         path = self.result_path(key)
-        if derived != key or not path.is_file() or mf.sha256_file(path) != record.get("result_sha256"):
+        if derived != key or not path.is_file() or mfp.sha256_file(path) != record.get("result_sha256"):
             return None
         try:
             result = mf.open_dataset(path)
@@ -106,7 +107,7 @@ class Store:
             and attrs.get("solver") == record["solver"]
             and str(attrs.get("solver_version")) == str(record["solver_version"])
             and str(attrs.get("core_version")) == str(record["core_version"])
-            and attrs.get("solver_options") == mf.options_json(record["solver_options"])
+            and attrs.get("solver_options") == mfp.options_json(record["solver_options"])
         )
         return result if consistent else None
 
@@ -124,9 +125,9 @@ class Store:
             "plugin": result.attrs.get("plugin", ""),
             "plugin_version": str(result.attrs.get("plugin_version", "")),
             "result": f"{RESULTS}/{result_file.name}",
-            "result_sha256": mf.sha256_file(result_file),
+            "result_sha256": mfp.sha256_file(result_file),
             "created": datetime.now(timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ"),
             **provenance,
         }
-        mf.write_atomically({self.record_path(key): _synced_text(json.dumps(record, indent=2, sort_keys=True) + "\n")})
+        mfp.write_atomically({self.record_path(key): _synced_text(json.dumps(record, indent=2, sort_keys=True) + "\n")})
         return result_file

@@ -25,6 +25,7 @@ import numpy as np
 import xarray as xr
 
 import masonryfw as mf
+import masonryfw.plugin_api as mfp
 
 from .params import (
     Param,
@@ -100,8 +101,8 @@ def plan_sweep(
         spec=spec_dict,
         spec_text=text,
         solver=solver_record.name,
-        solver_version=mf.solver_version(solver_record.name),
-        options=mf.resolve_options(f"solver {solver_record.name!r}", solver_record.options, dict(options or {})),
+        solver_version=mfp.solver_version(solver_record.name),
+        options=mfp.resolve_options(f"solver {solver_record.name!r}", solver_record.options, dict(options or {})),
         params=tuple(parsed),
         zipped=zipped,
         shape=shape,
@@ -250,11 +251,11 @@ def combine(plan: SweepPlan, records: Sequence[dict], output_dir: Path, store_ro
     attrs = {
         "Conventions": "CF-1.11",
         "masonryfw_format": "sweep",
-        "masonryfw_format_version": mf.FORMAT_VERSION,
+        "masonryfw_format_version": mfp.FORMAT_VERSION,
         "title": f"sweep of {plan.spec.get('title', '')}".strip(),
         "solver": plan.solver,
         "solver_version": plan.solver_version,
-        "solver_options": mf.options_json(plan.options),
+        "solver_options": mfp.options_json(plan.options),
         "sweep_mode": "zip" if plan.zipped else "grid",
         "sweep_keys": " ".join(p.key for p in plan.params),
         "sweep_store": store_root,

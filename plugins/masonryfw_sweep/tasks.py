@@ -14,6 +14,7 @@ from typing import Any
 import xarray as xr
 
 import masonryfw as mf
+import masonryfw.plugin_api as mfp
 
 from .params import KeyPath, with_values
 from .store import Store, content_key, model_hash
@@ -78,7 +79,7 @@ def _solve_point(record: dict, base_spec, assignments, solver_name, options, sto
     try:
         model = mf.build(with_values(base_spec, assignments))
         model_sha256 = model_hash(model)
-        key = content_key(model_sha256, solver_name, mf.solver_version(solver_name), mf.core_version(),
+        key = content_key(model_sha256, solver_name, mfp.solver_version(solver_name), mfp.core_version(),
                           options)
         store = Store(store_root)
         result = store.load_verified(key)

@@ -20,7 +20,7 @@ import numpy as np
 import pytest
 import xarray as xr
 
-import masonryfw as mf
+import masonryfw.plugin_api as mfp
 
 RECTANGLES = [  # xmin, xmax, ymin, ymax, role
     (0.0, 0.4, 0.0, 0.2, "unit"),
@@ -42,12 +42,12 @@ MOVING_SUPPORT_LOAD = 216.0  # W * 0.6 / 1.0
 
 
 def _var(name, dims, values):
-    return (dims, np.asarray(values), mf.variable_attrs(name))
+    return (dims, np.asarray(values), mfp.variable_attrs(name))
 
 
 def hand_model() -> xr.Dataset:
     """The model drawn in the module docstring, docs/format.md-complete, built without the builder."""
-    roles, kinds = mf.flags("block_role"), mf.flags("interface_kind")
+    roles, kinds = mfp.flags("block_role"), mfp.flags("interface_kind")
     rects = np.array([r[:4] for r in RECTANGLES])
     node_x = np.stack([rects[:, 0], rects[:, 1], rects[:, 1], rects[:, 0]], axis=1).ravel()
     node_y = np.stack([rects[:, 2], rects[:, 2], rects[:, 3], rects[:, 3]], axis=1).ravel()
@@ -86,9 +86,9 @@ def hand_model() -> xr.Dataset:
             "live_moment": _var("live_moment", "block", live[:, 2]),
             "block_fixed": _var("block_fixed", ("block", "dof"), fixed),
             "settlement_direction": _var("settlement_direction", ("block", "dof"), direction),
-            "block_geometry": ((), np.int32(0), mf.variable_attrs("block_geometry")),
+            "block_geometry": ((), np.int32(0), mfp.variable_attrs("block_geometry")),
         },
-        coords={"dof": ("dof", ["ux", "uy", "rz"], mf.variable_attrs("dof"))},
+        coords={"dof": ("dof", ["ux", "uy", "rz"], mfp.variable_attrs("dof"))},
         attrs={
             "Conventions": "CF-1.11",
             "masonryfw_format": "model",
@@ -123,7 +123,7 @@ class _SolverPlugin:
     def __init__(self, solver):
         self.solver = solver
 
-    @mf.hookimpl
+    @mfp.hookimpl
     def masonryfw_solvers(self):
         return [self.solver]
 
@@ -134,10 +134,10 @@ def registered():
     from masonryfw import registry
 
     registry.reset()
-    manager = mf.plugin_manager()
+    manager = mfp.plugin_manager()
 
     def register(solve, name="tipping", **record):
-        manager.register(_SolverPlugin(mf.Solver(name, "hand mechanism", solve, **record)), name=name)
+        manager.register(_SolverPlugin(mfp.Solver(name, "hand mechanism", solve, **record)), name=name)
     yield register
     registry.reset()
 

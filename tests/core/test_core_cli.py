@@ -18,6 +18,7 @@ import xarray as xr
 from click.testing import CliRunner
 
 import masonryfw as mf
+import masonryfw.plugin_api as mfp
 from masonryfw import registry
 from masonryfw.cli import cli
 
@@ -25,34 +26,34 @@ from masonryfw.cli import cli
 class ToolsPlugin:
     """In-process plugin: a solver with a settable alpha, a comparator and a plotter."""
 
-    @mf.hookimpl
+    @mfp.hookimpl
     def masonryfw_solvers(self):
         def constant(model, options, progress):
-            return xr.Dataset({"collapse_multiplier": ((), options["alpha"], mf.variable_attrs("collapse_multiplier"))})
+            return xr.Dataset({"collapse_multiplier": ((), options["alpha"], mfp.variable_attrs("collapse_multiplier"))})
 
-        return [mf.Solver("constant", "alpha from an option", constant, "1", (mf.Option("alpha", float, 0.5),))]
+        return [mfp.Solver("constant", "alpha from an option", constant, "1", (mfp.Option("alpha", float, 0.5),))]
 
-    @mf.hookimpl
+    @mfp.hookimpl
     def masonryfw_comparators(self):
         def gap(a, b, options):
             value = abs(float(a.collapse_multiplier) - float(b.collapse_multiplier))
             return xr.Dataset({"alpha_gap": ((), value, {"units": "1", "long_name": "|alpha_a - alpha_b|"})})
 
-        return [mf.Comparator("alpha-gap", "difference of the multipliers", gap, "1")]
+        return [mfp.Comparator("alpha-gap", "difference of the multipliers", gap, "1")]
 
-    @mf.hookimpl
+    @mfp.hookimpl
     def masonryfw_plotters(self):
         def nodes(datasets, ax, options):
             ax.plot(datasets[0].node_x.values, datasets[0].node_y.values, "k.")
 
-        return [mf.Plotter("nodes", "the polygon vertices", nodes, "1")]
+        return [mfp.Plotter("nodes", "the polygon vertices", nodes, "1")]
 
 
 @pytest.fixture
 def tools():
     """The real plugins plus :class:`ToolsPlugin`."""
     registry.reset()
-    mf.plugin_manager().register(ToolsPlugin(), name="tools")
+    mfp.plugin_manager().register(ToolsPlugin(), name="tools")
     yield
     registry.reset()
 
@@ -193,11 +194,11 @@ def test_solve_refuses_an_output_onto_its_input_before_solving(no_plugins, model
     calls = []
 
     class Spy:
-        @mf.hookimpl
+        @mfp.hookimpl
         def masonryfw_solvers(self):
-            return [mf.Solver("spy", "records its calls", lambda m, o, p: calls.append(1), "0")]
+            return [mfp.Solver("spy", "records its calls", lambda m, o, p: calls.append(1), "0")]
 
-    mf.plugin_manager().register(Spy(), name="spy")
+    mfp.plugin_manager().register(Spy(), name="spy")
     run = invoke("solve", model_file, "--plugin", "spy", "-o", model_file)
     assert run.exit_code == 1 and "refusing to overwrite the input" in run.stderr
     assert calls == []
@@ -274,7 +275,7 @@ class CommandsPlugin:
     def __init__(self, *names):
         self.names = names
 
-    @mf.hookimpl
+    @mfp.hookimpl
     def masonryfw_commands(self):
         def make(name):
             @click.command(name)
@@ -289,7 +290,7 @@ class CommandsPlugin:
 
 
 def test_plugin_commands_join_the_cli(no_plugins):
-    mf.plugin_manager().register(CommandsPlugin("hello"), name="greeter")
+    mfp.plugin_manager().register(CommandsPlugin("hello"), name="greeter")
     run = invoke("hello", "world")
     assert (run.exit_code, run.stdout) == (0, "hello world from hello\n")
     assert "hello" in invoke("--help").stdout
@@ -297,13 +298,13 @@ def test_plugin_commands_join_the_cli(no_plugins):
 
 
 def test_plugin_commands_that_clash_are_errors_naming_the_plugins(no_plugins):
-    mf.plugin_manager().register(CommandsPlugin("hello", "solve"), name="greeter")
+    mfp.plugin_manager().register(CommandsPlugin("hello", "solve"), name="greeter")
     run = invoke("hello", "world")
     assert run.exit_code == 1
     assert run.stderr == "error: command 'solve' of plugin 'greeter' clashes with the built-in command\n"
-    mf.plugin_manager().unregister(name="greeter")
-    mf.plugin_manager().register(CommandsPlugin("hello"), name="first")
-    mf.plugin_manager().register(CommandsPlugin("hello"), name="second")
+    mfp.plugin_manager().unregister(name="greeter")
+    mfp.plugin_manager().register(CommandsPlugin("hello"), name="first")
+    mfp.plugin_manager().register(CommandsPlugin("hello"), name="second")
     run = invoke("hello", "world")
     assert run.exit_code == 1
     assert "command 'hello' is provided twice: by plugin 'first' and by plugin 'second'" in run.stderr

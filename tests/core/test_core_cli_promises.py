@@ -24,6 +24,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import xarray as xr
+from support import tilted_drawing_spec
 
 import masonryfw as mf
 
@@ -59,21 +60,22 @@ from pathlib import Path
 import xarray as xr
 
 import masonryfw as mf
+import masonryfw.plugin_api as mfp
 
 
 def solve(model, options, progress):
     Path(os.environ["MASONRYFW_SPY_MARK"]).write_text("ran")
-    return xr.Dataset({"collapse_multiplier": ((), 0.5, mf.variable_attrs("collapse_multiplier"))})
+    return xr.Dataset({"collapse_multiplier": ((), 0.5, mfp.variable_attrs("collapse_multiplier"))})
 
 
 def estimate(model, options):
-    return mf.Estimate(seconds=float(os.environ.get("MASONRYFW_SPY_SECONDS", "1")), memory=1e6,
+    return mfp.Estimate(seconds=float(os.environ.get("MASONRYFW_SPY_SECONDS", "1")), memory=1e6,
                        basis="the spy's guess")
 
 
-@mf.hookimpl
+@mfp.hookimpl
 def masonryfw_solvers():
-    return [mf.Solver("spy", "leaves a mark", solve, estimate=estimate)]
+    return [mfp.Solver("spy", "leaves a mark", solve, estimate=estimate)]
 '''
 
 
@@ -312,21 +314,7 @@ def test_numba_compilation_is_recorded_apart_from_the_wall_time(spec, tmp_path):
 
 # ---------------------------------------------------------------- drawings
 
-DRAWN_SPEC = """title = "drawn"
-[geometry]
-dxf = "wall.dxf"
-[wall]
-thickness = 0.1
-[material]
-unit_weight = 12000.0
-friction_angle = 30.0
-[supports.base]
-kind = "fixed"
-select = "lowest"
-[loading]
-type = "tilt"
-direction = 1
-"""
+DRAWN_SPEC = tilted_drawing_spec("wall.dxf", unit_weight=12000.0)
 
 
 def test_a_broken_drawing_is_named_and_an_overlapping_one_can_still_be_drawn(tmp_path):

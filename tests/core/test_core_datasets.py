@@ -5,7 +5,8 @@ import numpy as np
 import pytest
 
 import masonryfw
-from masonryfw import ModelError, build, bundled_cases, bundled_spec_path, flags, load_spec
+from masonryfw import ModelError, build, bundled_cases, bundled_spec_path, load_spec
+from masonryfw.plugin_api import flags
 
 ROLE = flags("block_role")
 

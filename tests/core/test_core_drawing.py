@@ -13,11 +13,12 @@ import numpy as np
 import pytest
 
 import masonryfw as mf
+import masonryfw.plugin_api as mfp
 from masonryfw.datasets.drawings import generate
 from masonryfw.drawing import read_drawing
 
-ROLE = mf.flags("block_role")
-KIND = mf.flags("interface_kind")
+ROLE = mfp.flags("block_role")
+KIND = mfp.flags("interface_kind")
 
 
 def spec(drawing: str, **sections) -> dict:
@@ -65,7 +66,7 @@ def test_the_lact3_wall_drawing_reads_as_its_generator_drew_it(tmp_path):
     assert drawing.block_node_count.size == len(polygons) == 183
     masonry = drawing.block_node_count[:-1]
     assert (masonry == 4).all()  # every unit and the lintel: four corners
-    area = mf.polygon_area_centroid(drawing.node_x, drawing.node_y, drawing.block_node_count)[0]
+    area = mfp.polygon_area_centroid(drawing.node_x, drawing.node_y, drawing.block_node_count)[0]
     assert area[-2] == pytest.approx(0.750 * (500 / 9) * 1e-3)  # the lintel, 750 mm long, one course high
     assert (area > 0).all()
 
@@ -92,7 +93,7 @@ def test_a_polyline_going_on_past_its_start_and_points_around_it(tmp_path):
     assert drawing.block_node_count[4] == 4
     assert drawing.ignored == {"POINT": sum(len(p) for p in polygons)}
     assert drawing.block_node_count[-1] == 12  # the base with the springers: non-convex
-    assert not mf.convex_blocks(drawing.node_x, drawing.node_y, drawing.block_node_count)[-1]
+    assert not mfp.convex_blocks(drawing.node_x, drawing.node_y, drawing.block_node_count)[-1]
 
 
 def test_arcs_become_chords_within_the_tolerance(tmp_path):
@@ -102,7 +103,7 @@ def test_arcs_become_chords_within_the_tolerance(tmp_path):
     generate.write_dxf(path, polygons, layers)
     drawing = read_drawing(path, chord_tolerance=1.0)
     arch = generate.ARCH
-    start = mf.block_offsets(drawing.block_node_count)
+    start = mfp.block_offsets(drawing.block_node_count)
     cx, cy = (c / 1000 for c in arch["centre"])
     for b in range(arch["voussoirs"]):
         x, y = drawing.node_x[start[b]:start[b + 1]], drawing.node_y[start[b]:start[b + 1]]
@@ -219,7 +220,7 @@ def test_a_drawing_relative_to_its_spec_builds_a_checked_model(tmp_path):
     assert model.block_role.values.tolist() == [ROLE["unit"], ROLE["unit"], ROLE["fixed_support"]]
     assert model.attrs["source_drawing"] == "w.dxf" and len(model.attrs["source_drawing_sha256"]) == 64
     weight = 12000.0 * 0.2 * 0.1 * 0.1
-    np.testing.assert_allclose(mf.block_loads(model, "live")[:2, 0], [weight, weight])  # tilt: weight towards +x
+    np.testing.assert_allclose(mfp.block_loads(model, "live")[:2, 0], [weight, weight])  # tilt: weight towards +x
 
 
 def test_settlement_loads_as_for_built_walls(tmp_path):
@@ -301,7 +302,7 @@ def test_the_same_drawing_in_m_and_in_mm_gives_the_same_model(tmp_path):
     in_mm = mf.build(write_spec(tmp_path, "mm.dxf", **sections))
     in_m = mf.build(write_spec(tmp_path, "m.dxf", geometry={"drawing_unit": None}, **sections))
     np.testing.assert_allclose(in_m.node_x.values, in_mm.node_x.values, rtol=1e-12, atol=1e-15)
-    np.testing.assert_allclose(mf.block_loads(in_m, "dead"), mf.block_loads(in_mm, "dead"), rtol=1e-12)
+    np.testing.assert_allclose(mfp.block_loads(in_m, "dead"), mfp.block_loads(in_mm, "dead"), rtol=1e-12)
 
 
 @pytest.mark.parametrize("name", mf.DRAWN_NAMES)

@@ -8,6 +8,7 @@ from pathlib import Path
 
 import pytest
 from click.testing import CliRunner
+from support import tilted_drawing_spec
 
 import masonryfw as mf
 from masonryfw.cli import cli
@@ -29,22 +30,8 @@ REFUSED = {
 
 def spec(tmp_path: Path, drawing: str, friction: float = 30.0) -> Path:
     path = tmp_path / "spec.toml"
-    path.write_text(f"""title = "{drawing}"
-[geometry]
-dxf = "{CORPUS / drawing}"
-drawing_unit = "mm"
-[wall]
-thickness = 1.0
-[material]
-unit_weight = 25000.0
-friction_angle = {friction}
-[supports.base]
-kind = "fixed"
-select = "lowest"
-[loading]
-type = "tilt"
-direction = 1
-""")
+    path.write_text(tilted_drawing_spec(CORPUS / drawing, unit="mm", thickness=1.0, unit_weight=25000.0,
+                                        friction=friction, title=drawing))
     return path
 
 

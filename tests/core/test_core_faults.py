@@ -17,9 +17,10 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from support import cli, hidden, peak_memory, refused
+from support import cli, hidden, peak_memory, refused, tilted_drawing_spec
 
 import masonryfw as mf
+import masonryfw.plugin_api as mfp
 
 #: A wall of 23,090 blocks: its model takes about 0.3 s to write, long enough to signal the writer.
 BIG_SPEC = """title = "big"
@@ -250,10 +251,7 @@ _GEOJSON_CASES = {
 
 def _drawn_spec(folder: Path, drawing: str, key: str = "polygons", name: str = "w.toml") -> None:
     """A spec of a wall drawn in ``drawing`` (in metres) standing on its lowest block, tilted."""
-    (folder / name).write_text(f'title = "w"\n[geometry]\n{key} = "{drawing}"\ndrawing_unit = "m"\n'
-                               '[wall]\nthickness = 0.1\n[material]\nunit_weight = 18000.0\nfriction_angle = 30.0\n'
-                               '[supports.base]\nkind = "fixed"\nselect = "lowest"\n'
-                               '[loading]\ntype = "tilt"\ndirection = 1\n')
+    (folder / name).write_text(tilted_drawing_spec(drawing, key, "m", title="w"))
 
 
 @pytest.mark.parametrize("case", list(_GEOJSON_CASES))
@@ -407,12 +405,12 @@ def test_a_second_command_writing_the_same_output_is_refused_while_the_first_run
 def test_a_sweep_refuses_a_store_another_sweep_is_using(tmp_path):
     store = (tmp_path / "s.store").resolve()
     store.mkdir()
-    mf.claim(store, f"sweep store {store}")  # this process stands in for the other sweep
+    mfp.claim(store, f"sweep store {store}")  # this process stands in for the other sweep
     try:
         done = cli(["sweep", "panel-1", "--plugin", "la", "--param", "wall.thickness=0.05,0.1", "--store", store,
                     "-o", "s.nc", "--no-progress"], tmp_path)
     finally:
-        mf.release(store)
+        mfp.release(store)
     refused(done, "sweep store", "being written by another masonryfw process", f"pid {os.getpid()}")
     assert not (store / "results").exists()
 

@@ -18,7 +18,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from support import Command, cli, hidden, peak_memory, refused
+from support import Command, cli, hidden, peak_memory, refused, tilted_drawing_spec
 
 import masonryfw as mf
 
@@ -123,22 +123,7 @@ def test_a_stale_lock_of_ours_is_reused(tmp_path):
 
 # ---------------------------------------------------------------- outputs onto what a command reads
 
-DRAWN = """title = "d"
-[geometry]
-dxf = "wall.dxf"
-drawing_unit = "mm"
-[wall]
-thickness = 0.3
-[material]
-unit_weight = 20000.0
-friction_angle = 30.0
-[supports.base]
-kind = "fixed"
-select = "lowest"
-[loading]
-type = "tilt"
-direction = 1
-"""
+DRAWN = tilted_drawing_spec("wall.dxf", unit="mm", thickness=0.3, unit_weight=20000.0, title="d")
 
 
 def _drawn_folder(folder):

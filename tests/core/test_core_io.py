@@ -11,6 +11,7 @@ import pytest
 import xarray as xr
 
 import masonryfw
+import masonryfw.plugin_api
 from masonryfw import io as mio
 from masonryfw.errors import ModelError
 
@@ -78,7 +79,7 @@ def test_content_hash_ignores_file_details_and_order(tmp_path):
     )
     assert list(permuted.data_vars) != list(ds.data_vars)
     assert mio.content_sha256(permuted) == reference
-    with_geometry = masonryfw.derive_geometry(ds)  # derived values are not content
+    with_geometry = masonryfw.plugin_api.derive_geometry(ds)  # derived values are not content
     assert mio.content_sha256(with_geometry) == reference
 
 
@@ -100,8 +101,8 @@ def test_derived_variable_list_matches_derive_geometry():
         interface_x=(("interface", "end"), np.array([[1.0, 1.0]])),
         interface_y=(("interface", "end"), np.array([[0.0, 1.0]])),
     )
-    added = set(masonryfw.derive_geometry(ds).variables) - set(ds.variables)
-    assert added == set(masonryfw.DERIVED_GEOMETRY_VARIABLES)
+    added = set(masonryfw.plugin_api.derive_geometry(ds).variables) - set(ds.variables)
+    assert added == set(masonryfw.plugin_api.DERIVED_GEOMETRY_VARIABLES)
 
 
 # ------------------------------------------------------------------ reading errors

@@ -1,11 +1,11 @@
-"""mf.cholesky_factor: CHOLMOD and its SuperLU fallback against a dense solve."""
+"""mfp.cholesky_factor: CHOLMOD and its SuperLU fallback against a dense solve."""
 import sys
 
 import numpy as np
 import pytest
 import scipy.sparse as sp
 
-import masonryfw as mf
+import masonryfw.plugin_api as mfp
 
 BACKENDS = [pytest.param(True, id="cholmod"), pytest.param(False, id="superlu")]
 
@@ -19,7 +19,7 @@ def laplacian_2d(n: int) -> sp.csc_matrix:
 def factor_of(matrix, use_cholmod):
     lower = sp.tril(matrix, format="csc")
     lower.sort_indices()
-    factor = mf.cholesky_factor(lower, use_cholmod=use_cholmod)
+    factor = mfp.cholesky_factor(lower, use_cholmod=use_cholmod)
     return factor, lower
 
 
@@ -53,7 +53,7 @@ def test_an_indefinite_matrix_is_reported_and_the_factor_recovers(use_cholmod):
 
 def test_an_explicit_zero_stays_in_the_pattern():
     lower = sp.csc_matrix((np.array([2.0, 0.0, 3.0]), np.array([0, 1, 1]), np.array([0, 2, 3])), shape=(2, 2))
-    factor = mf.cholesky_factor(lower, use_cholmod=True)
+    factor = mfp.cholesky_factor(lower, use_cholmod=True)
     assert factor.factorise(np.array([2.0, 1.0, 3.0]))  # the zero slot now holds the off-diagonal 1
     np.testing.assert_allclose(factor.solve(np.array([1.0, 0.0])), np.linalg.solve([[2, 1], [1, 3]], [1, 0]))
 
@@ -61,7 +61,7 @@ def test_an_explicit_zero_stays_in_the_pattern():
 def test_without_cvxopt_the_fallback_is_used(monkeypatch):
     monkeypatch.setitem(sys.modules, "cvxopt", None)  # `import cvxopt` now raises ImportError
     monkeypatch.setitem(sys.modules, "cvxopt.cholmod", None)
-    assert not mf.has_cholmod()
+    assert not mfp.has_cholmod()
     factor, lower = factor_of(laplacian_2d(4), None)
     assert factor.name == "superlu"
     assert factor.factorise(lower.data)

@@ -8,6 +8,7 @@ import pytest
 import xarray as xr
 
 import masonryfw as mf
+import masonryfw.plugin_api as mfp
 from masonryfw import api
 
 
@@ -17,14 +18,14 @@ def counting_solver(registered):
     calls = []
 
     def still(model, options, progress):
-        return xr.Dataset(mf.motion_variables(np.zeros((model.sizes["block"], 3))),
+        return xr.Dataset(mfp.motion_variables(np.zeros((model.sizes["block"], 3))),
                           attrs={"rotations": "small", "flow_rule": "associative"})
 
     def estimate(model, options):
         calls.append(options["scale"])
-        return mf.Estimate(seconds=0.1, memory=1e6, basis="counted")
+        return mfp.Estimate(seconds=0.1, memory=1e6, basis="counted")
 
-    registered(still, "still", estimate=estimate, options=(mf.Option("scale", float, 1.0, "unused", above=0.0),))
+    registered(still, "still", estimate=estimate, options=(mfp.Option("scale", float, 1.0, "unused", above=0.0),))
     return calls
 
 

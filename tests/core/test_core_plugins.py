@@ -23,6 +23,7 @@ import xarray as xr
 from click.testing import CliRunner
 
 import masonryfw as mf
+import masonryfw.plugin_api as mfp
 from masonryfw import registry
 from masonryfw.cli import cli, main
 from masonryfw.errors import ModelError, PluginError, SolveError
@@ -35,15 +36,15 @@ class ToyPlugin:
     def __init__(self, solvers=(), comparators=(), plotters=()):
         self.solvers, self.comparators, self.plotters = list(solvers), list(comparators), list(plotters)
 
-    @mf.hookimpl
+    @mfp.hookimpl
     def masonryfw_solvers(self):
         return self.solvers
 
-    @mf.hookimpl
+    @mfp.hookimpl
     def masonryfw_comparators(self):
         return self.comparators
 
-    @mf.hookimpl
+    @mfp.hookimpl
     def masonryfw_plotters(self):
         return self.plotters
 
@@ -51,12 +52,12 @@ class ToyPlugin:
 def constant_alpha(model, options, progress):
     """A solver whose collapse multiplier is its option ``alpha``."""
     return xr.Dataset(
-        {"collapse_multiplier": ((), float(options["alpha"]), mf.variable_attrs("collapse_multiplier"))},
+        {"collapse_multiplier": ((), float(options["alpha"]), mfp.variable_attrs("collapse_multiplier"))},
         attrs={"constant_backend": "none"},  # a plugin's own detail, kept in its result
     )
 
 
-CONSTANT = mf.Solver("constant", "alpha from an option", constant_alpha, "3.1", (mf.Option("alpha", float, 0.5, "alpha"),))
+CONSTANT = mfp.Solver("constant", "alpha from an option", constant_alpha, "3.1", (mfp.Option("alpha", float, 0.5, "alpha"),))
 
 
 def alpha_gap(a, b, options):
@@ -67,18 +68,18 @@ def failing_solver(exception):
     def solve(model, options, progress):
         raise exception
 
-    return mf.Solver("failing", "raises", solve, "0")
+    return mfp.Solver("failing", "raises", solve, "0")
 
 
 def returning_solver(produced):
-    return mf.Solver("returning", "returns a fixed dataset", lambda model, options, progress: produced(model), "0")
+    return mfp.Solver("returning", "returns a fixed dataset", lambda model, options, progress: produced(model), "0")
 
 
 @pytest.fixture
 def manager():
     """The real plugin manager (entry points loaded afresh), reset afterwards."""
     registry.reset()
-    yield mf.plugin_manager()
+    yield mfp.plugin_manager()
     registry.reset()
 
 
@@ -87,7 +88,7 @@ def empty_manager(monkeypatch):
     """A plugin manager that sees no entry point at all."""
     monkeypatch.setattr(registry, "entry_points", lambda group: [])
     registry.reset()
-    yield mf.plugin_manager()
+    yield mfp.plugin_manager()
     registry.reset()
 
 
@@ -100,7 +101,7 @@ def test_builtin_plugins_come_from_the_entry_point_group():
     try:
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
-            manager = mf.plugin_manager()
+            manager = mfp.plugin_manager()
         failed = {re.match(r"masonryfw plugin '([^']+)'", str(w.message)).group(1) for w in caught
                   if issubclass(w.category, registry.PluginLoadWarning)}
         info = {p.name: p for p in registry.installed_plugins()}
@@ -109,7 +110,7 @@ def test_builtin_plugins_come_from_the_entry_point_group():
         assert info["example"].version == dist_version("masonryfw")
         assert [s.name for s in info["example"].solvers] == ["statics"]
         assert mf.get_solver("statics").solve is info["example"].solvers[0].solve
-        assert mf.plugin_manager() is manager  # cached
+        assert mfp.plugin_manager() is manager  # cached
     finally:
         registry.reset()
 
@@ -121,7 +122,7 @@ def test_a_plugin_that_fails_to_import_is_a_warning_and_the_others_load(monkeypa
     registry.reset()
     try:
         with pytest.warns(registry.PluginLoadWarning, match=r"'ghost'.*no_such_module_for_masonryfw.*ModuleNotFoundError"):
-            mf.plugin_manager()
+            mfp.plugin_manager()
         assert mf.get_solver("statics").name == "statics"
     finally:
         registry.reset()
@@ -129,7 +130,7 @@ def test_a_plugin_that_fails_to_import_is_a_warning_and_the_others_load(monkeypa
 
 def test_a_hook_that_raises_is_a_warning(empty_manager):
     class Raising:
-        @mf.hookimpl
+        @mfp.hookimpl
         def masonryfw_solvers(self):
             raise RuntimeError("cannot list")
 
@@ -194,9 +195,9 @@ def test_result_carries_the_model_and_the_provenance(manager, model):
 def test_statics_refuses_a_wall_that_touches_no_support(model):
     from masonryfw_example.statics import solve_statics
 
-    floating = mf.derive_geometry(model.isel(interface=[0, 1, 2]))  # bed and head joints only
+    floating = mfp.derive_geometry(model.isel(interface=[0, 1, 2]))  # bed and head joints only
     with pytest.raises(SolveError, match="statics: no wall block rests on a support block"):
-        solve_statics(floating, {}, mf.no_progress)
+        solve_statics(floating, {}, mfp.no_progress)
 
 
 def test_statics_on_the_bundled_test_12c(manager):
@@ -207,7 +208,7 @@ def test_statics_on_the_bundled_test_12c(manager):
     model = mf.open_model("test-12c")
     result = mf.solve(model, "statics")
     assert float(result.masonry_weight) == pytest.approx(792.0)
-    roles = mf.flags("block_role")
+    roles = mfp.flags("block_role")
     role = result.block_role.values
     assert result.support_dead_reaction.values[role == roles["fixed_support"]] == pytest.approx([792 * 0.5 / 1.1])
     moving = role == roles["moving_support"]
@@ -248,7 +249,7 @@ def test_options_are_resolved_and_recorded(empty_manager, model):
 
 def test_an_invalid_model_is_refused_before_the_solver_runs(empty_manager, model):
     calls = []
-    empty_manager.register(ToyPlugin([mf.Solver("spy", "", lambda m, o, p: calls.append(1), "0")]), name="toy")
+    empty_manager.register(ToyPlugin([mfp.Solver("spy", "", lambda m, o, p: calls.append(1), "0")]), name="toy")
     model["block_thickness"][1] = -0.1
     model["interface_friction"][2] = -1.0
     with pytest.raises(ModelError) as caught:
@@ -294,12 +295,12 @@ def test_a_solver_returning_a_bad_result_is_a_solve_error(empty_manager, model, 
 # ---------------------------------------------------------------- compare and render
 
 def test_compare_builds_a_comparison_dataset_with_the_schema_attributes(empty_manager, model):
-    empty_manager.register(ToyPlugin([CONSTANT], [mf.Comparator("alpha-gap", "|alpha a - alpha b|", alpha_gap, "1.2")]), name="toy")
+    empty_manager.register(ToyPlugin([CONSTANT], [mfp.Comparator("alpha-gap", "|alpha a - alpha b|", alpha_gap, "1.2")]), name="toy")
     a = mf.solve(model, "constant", {"alpha": 0.5})
     b = mf.solve(model, "constant", {"alpha": 0.125})
     comparison = mf.compare(a, b)  # the only comparator installed
     assert float(comparison.alpha_gap) == 0.375
-    required = [k for k, v in mf.load_schema("comparison")["global_attributes"].items() if v["required"]]
+    required = [k for k, v in mfp.load_schema("comparison")["global_attributes"].items() if v["required"]]
     assert set(required) <= set(comparison.attrs)
     assert comparison.attrs["masonryfw_format"] == "comparison"
     assert comparison.attrs["comparator"] == "alpha-gap"
@@ -319,7 +320,7 @@ def test_render_draws_with_the_plotter(empty_manager, model):
         for ds in datasets:
             ax.plot(ds.node_x.values, ds.node_y.values, options["style"])
 
-    empty_manager.register(ToyPlugin(plotters=[mf.Plotter("nodes", "", outline, "1", (mf.Option("style", str, "k."),))]), name="toy")
+    empty_manager.register(ToyPlugin(plotters=[mfp.Plotter("nodes", "", outline, "1", (mfp.Option("style", str, "k."),))]), name="toy")
     figure = mf.render([model], None, {"style": "r+"})
     (line,) = figure.axes[0].lines
     np.testing.assert_array_equal(line.get_xdata(), model.node_x.values)
@@ -335,21 +336,22 @@ import xarray as xr
 from click.testing import CliRunner
 
 import masonryfw as mf
+import masonryfw.plugin_api as mfp
 
 
 def solve_null(model, options, progress):
     """Zero motion (so no crack); alpha = scale * sum|live| / sum|dead|."""
     alpha = options["scale"] * np.abs(model.live_load.values).sum() / np.abs(model.dead_load.values).sum()
     return xr.Dataset({
-        **mf.motion_variables(np.zeros((model.sizes["block"], 3))),
-        "collapse_multiplier": ((), alpha, mf.variable_attrs("collapse_multiplier")),
+        **mfp.motion_variables(np.zeros((model.sizes["block"], 3))),
+        "collapse_multiplier": ((), alpha, mfp.variable_attrs("collapse_multiplier")),
     }, attrs={"rotations": "small", "flow_rule": "associative"})
 
 
-@mf.hookimpl
+@mfp.hookimpl
 def masonryfw_solvers():
-    return [mf.Solver("tp-null", "null solver", solve_null, "2.5",
-                      (mf.Option("scale", float, 1.0, "multiplies alpha"),))]
+    return [mfp.Solver("tp-null", "null solver", solve_null, "2.5",
+                      (mfp.Option("scale", float, 1.0, "multiplies alpha"),))]
 '''
 
 

@@ -17,6 +17,7 @@ import numpy as np
 import pytest
 
 import masonryfw as mf
+import masonryfw.plugin_api as mfp
 
 README = (Path(__file__).resolve().parents[2] / "README.md").read_text()
 
@@ -39,7 +40,7 @@ def test_the_spec_of_the_tour_builds_a_valid_wall(tmp_path):
     model = mf.build(spec)
     assert mf.check(model) == []
     # 2 x 1 m of 0.2 x 0.05 units, a 0.4 x 0.4 window: masonry area by hand
-    masonry = model.block_area.values[model.block_role.values <= mf.flags("block_role")["lintel"]].sum()
+    masonry = model.block_area.values[model.block_role.values <= mfp.flags("block_role")["lintel"]].sum()
     assert abs(masonry - (2.0 * 1.0 - 0.4 * 0.4)) < 1e-12
 
 
@@ -73,9 +74,9 @@ def test_the_third_party_solver_of_the_tour_installs_and_solves(tmp_path):
     # the core derived the cracks: the head joints along the settling support's edge (x = 0.5 m) and the
     # base joints over it; the units standing over the settling support are one macro-block
     cracked = result.crack_indicator.values > 0
-    head = result.interface_kind.values == mf.flags("interface_kind")["head"]
+    head = result.interface_kind.values == mfp.flags("interface_kind")["head"]
     assert np.all(np.isclose(result.interface_x.values[cracked & head], 0.5, atol=0.1))
-    assert np.unique(result.macro_block.values[mf.block_motion(result)[:, 1] < 0]).size == 1
+    assert np.unique(result.macro_block.values[mfp.block_motion(result)[:, 1] < 0]).size == 1
 
 
 def test_the_conformance_kit_of_the_tour_passes_for_the_tour_plugin(tmp_path):
@@ -97,7 +98,7 @@ def test_the_trough_of_the_tour_builds_under_the_tour_wall(tmp_path):
                                              "its [supports.*] tables")))
     model = mf.build(spec)
     assert mf.check(model) == []
-    assert (model.block_role.values == mf.flags("block_role")["moving_support"]).sum() >= 5
+    assert (model.block_role.values == mfp.flags("block_role")["moving_support"]).sum() >= 5
 
 
 def test_the_tour_ends_with_a_report_and_its_last_step_runs_as_written(tmp_path):

@@ -6,6 +6,7 @@ import re
 import pytest
 
 import masonryfw as mf
+import masonryfw.plugin_api as mfp
 from masonryfw.resources import available_memory, parse_bytes, require_memory
 
 
@@ -31,16 +32,16 @@ def test_the_variable_overrides_the_system(monkeypatch):
 
 def test_a_run_over_the_limit_is_refused_with_the_advice(monkeypatch):
     monkeypatch.setenv("MASONRYFW_MEMORY_LIMIT", "1GiB")
-    require_memory("x", mf.Estimate(seconds=1.0, memory=2**30, basis="b"))  # exactly fits
+    require_memory("x", mfp.Estimate(seconds=1.0, memory=2**30, basis="b"))  # exactly fits
     with pytest.raises(mf.SolveError, match=r"solver x: this run needs about 2.0 GiB .* 1.0 GiB is available "
                                             r".*; to make it smaller: use less"):
-        require_memory("x", mf.Estimate(seconds=1.0, memory=2**31, basis="b", advice="use less"))
+        require_memory("x", mfp.Estimate(seconds=1.0, memory=2**31, basis="b", advice="use less"))
 
 
 def test_an_interruptible_call_returns_its_value_and_raises_its_error():
-    assert mf.interruptible(lambda: 42) == 42
+    assert mfp.interruptible(lambda: 42) == 42
     with pytest.raises(ZeroDivisionError):
-        mf.interruptible(lambda: 1 / 0)
+        mfp.interruptible(lambda: 1 / 0)
 
 
 def test_ctrl_c_reaches_the_caller_during_a_long_call_that_releases_the_gil():
@@ -57,7 +58,7 @@ def test_ctrl_c_reaches_the_caller_during_a_long_call_that_releases_the_gil():
         timer.start()
         clock = time.perf_counter()
         with pytest.raises(KeyboardInterrupt):
-            mf.interruptible(lambda: time.sleep(30))
+            mfp.interruptible(lambda: time.sleep(30))
         assert time.perf_counter() - clock < 5
     finally:
         signal.signal(signal.SIGINT, inherited)

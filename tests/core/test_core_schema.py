@@ -7,6 +7,7 @@ from pathlib import Path
 import pytest
 
 import masonryfw as mf
+import masonryfw.plugin_api as mfp
 
 ROOT = Path(__file__).resolve().parents[2]
 FORMAT_MD = ROOT / "docs" / "format.md"
@@ -35,7 +36,7 @@ def _names(cell: str) -> list[str]:
     [("## Model variables", "model"), ("## Result variables", "result"), ("## Diagnosis variables", "diagnosis")],
 )
 def test_every_documented_variable_is_in_the_schema(section, kind):
-    schema = mf.load_schema(kind)
+    schema = mfp.load_schema(kind)
     documented = [n for row in _table_rows(section) for n in _names(row[0])]
     assert len(documented) > 10
     missing = [n for n in documented if n not in schema["variables"]]
@@ -47,7 +48,7 @@ def test_every_documented_variable_is_in_the_schema(section, kind):
     [("## Model variables", "model"), ("## Result variables", "result"), ("## Diagnosis variables", "diagnosis")],
 )
 def test_documented_dims_match_the_schema(section, kind):
-    schema = mf.load_schema(kind)
+    schema = mfp.load_schema(kind)
     for row in _table_rows(section):
         dims = [d.strip() for d in row[1].split(",")] if row[1] != "scalar" else []
         for name in _names(row[0]):
@@ -64,18 +65,18 @@ def test_documented_flags_match_the_schema():
         ("interface_state", "intact open slide open_slide"),
         ("qp_failure", "elastic tensile shear tensile_shear"),
     ]:
-        assert list(mf.flags(name)) == meanings.split()
-        assert list(mf.flags(name).values()) == list(range(4))
+        assert list(mfp.flags(name)) == meanings.split()
+        assert list(mfp.flags(name).values()) == list(range(4))
         assert name in text
 
 
 def test_global_attributes_are_required_by_every_kind():
     for kind in mf.schema.KINDS:
-        attrs = mf.load_schema(kind)["global_attributes"]
+        attrs = mfp.load_schema(kind)["global_attributes"]
         assert attrs["Conventions"]["contains"] == "CF-1.11"
         assert attrs["masonryfw_format"]["value"] == kind
-        assert attrs["masonryfw_format_version"]["value"] == mf.FORMAT_VERSION
-    result_attrs = mf.load_schema("result")["global_attributes"]
+        assert attrs["masonryfw_format_version"]["value"] == mfp.FORMAT_VERSION
+    result_attrs = mfp.load_schema("result")["global_attributes"]
     for name in ("plugin", "plugin_version", "solver", "solver_version", "core_version", "solver_options",
                  "wall_time_s"):
         assert result_attrs[name]["required"]
@@ -83,12 +84,12 @@ def test_global_attributes_are_required_by_every_kind():
 
 def test_unknown_kind_and_version_are_clear_errors():
     with pytest.raises(mf.ModelError, match="unknown dataset kind"):
-        mf.load_schema("mesh")
+        mfp.load_schema("mesh")
     with pytest.raises(mf.ModelError, match="unknown format version 7"):
-        mf.load_schema("model", 7)
+        mfp.load_schema("model", 7)
 
 
 def test_every_diagnosis_variable_is_documented():
-    own = set(mf.load_schema("diagnosis")["variables"]) - set(mf.load_schema("model")["variables"])
+    own = set(mfp.load_schema("diagnosis")["variables"]) - set(mfp.load_schema("model")["variables"])
     documented = {n for row in _table_rows("## Diagnosis variables") for n in _names(row[0])}
     assert own == documented

@@ -8,8 +8,9 @@ import xarray as xr
 from scipy.sparse.csgraph import connected_components
 
 import masonryfw as mf
+import masonryfw.plugin_api as mfp
 import masonryfw.testing as mt
-from masonryfw import connected_components as components
+from masonryfw.plugin_api import connected_components as components
 
 
 def rectangle_nodes(x0, y0, b, h):
@@ -44,7 +45,7 @@ def test_labels_follow_the_lowest_block():
 def test_polar_moment_of_a_rectangle_and_a_triangle_far_from_the_origin():
     rx, ry = rectangle_nodes(1e4, -2e3, 0.3, 0.1)
     tx, ty = np.array([5e3, 5e3 + 3.0, 5e3]), np.array([7e3, 7e3, 7e3 + 4.0])
-    moment = mf.polar_moment(np.concatenate([rx, tx]), np.concatenate([ry, ty]), [4, 3])
+    moment = mfp.polar_moment(np.concatenate([rx, tx]), np.concatenate([ry, ty]), [4, 3])
     assert moment[0] == pytest.approx(0.03 * (0.3**2 + 0.1**2) / 12, rel=1e-9)
     # triangle: J_c = A (a^2 + b^2 + c^2) / 36, sides 3, 4, 5, A = 6
     assert moment[1] == pytest.approx(6 * (9 + 16 + 25) / 36, rel=1e-9)
@@ -73,7 +74,7 @@ def test_finite_rotation_about_a_corner_opens_the_far_end_by_l_sin_theta(theta):
     model = two_blocks()
     u = np.zeros((2, 3))
     u[1] = rotation_about(np.array([0.0, 0.0]), theta, [0.5, 0.25])
-    opening, slip = mf.relative_motion(model, u, "finite")
+    opening, slip = mfp.relative_motion(model, u, "finite")
     assert opening[0] == pytest.approx([0.0, np.sin(theta)], abs=1e-14)
     assert slip[0] == pytest.approx([0.0, np.cos(theta) - 1.0], abs=1e-14)
 
@@ -84,7 +85,7 @@ def test_a_mechanism_moves_points_by_the_linearised_rotation():
     theta = 0.3
     u = np.zeros((2, 3))
     u[1] = (-theta * 0.25, theta * 0.5, theta)  # v_c = w x (c - pivot), c - pivot = (0.5, 0.25)
-    opening, slip = mf.relative_motion(model, u, "small")
+    opening, slip = mfp.relative_motion(model, u, "small")
     assert opening[0] == pytest.approx([0.0, theta], abs=1e-14)
     assert slip[0] == pytest.approx([0.0, 0.0], abs=1e-14)
 
@@ -95,36 +96,36 @@ def test_side_one_minus_side_zero_with_the_interface_frame():
     u = np.zeros((2, 3))
     u[1, :2] = (0.02, 0.005)
     for rotations in ("small", "finite"):
-        opening, slip = mf.relative_motion(model, u, rotations)
+        opening, slip = mfp.relative_motion(model, u, rotations)
         assert opening[0] == pytest.approx([0.005, 0.005]) and slip[0] == pytest.approx([0.02, 0.02])
 
 
 # ---------------------------------------------------------------- states, indicator, macro-blocks
 
-STATE = mf.flags("interface_state")
+STATE = mfp.flags("interface_state")
 
 
 def test_states_by_hand():
     """Threshold 0.1; rows: still, tipping, sliding with dilatancy mu = 0.5, sliding and lifting, closing."""
     opening = np.array([[0.0, 0.05], [0.0, 1.0], [0.5, 0.5], [1.0, 0.6], [-1.0, -1.0]])
     slip = np.array([[0.0, 0.0], [0.05, 0.05], [1.0, 1.0], [1.0, 1.0], [0.0, 0.0]])
-    associative = mf.interface_states(opening, slip, 0.5, 0.1)
+    associative = mfp.interface_states(opening, slip, 0.5, 0.1)
     assert associative.tolist() == [STATE["intact"], STATE["open"], STATE["slide"], STATE["open_slide"],
                                     STATE["intact"]]
     # without dilatancy the same opening beside a slip is an opening beyond it
-    nonassociative = mf.interface_states(opening, slip, 0.0, 0.1)
+    nonassociative = mfp.interface_states(opening, slip, 0.0, 0.1)
     assert nonassociative[2] == STATE["open_slide"]
-    assert mf.joint_motion(opening, slip).tolist() == pytest.approx(
+    assert mfp.joint_motion(opening, slip).tolist() == pytest.approx(
         [0.05, np.hypot(1.0, 0.05), np.hypot(0.5, 1), np.hypot(1, 1), 0.0])  # closing is no motion
 
 
 def test_crack_indicator_is_relative_to_the_largest_masonry_joint():
     motion = np.array([2.0, 1.0, 0.3, 0.19, 5.0])
     masonry = np.array([True, True, True, True, False])  # the last is ground against ground
-    indicator = mf.crack_indicator(motion, masonry)
+    indicator = mfp.crack_indicator(motion, masonry)
     assert indicator.tolist() == pytest.approx([1.0, 0.5, 0.15, 0.0, 0.0])  # 0.19 / 2 is below a tenth
     assert mf.CRACK_THRESHOLD == 0.1
-    assert mf.crack_indicator(motion, masonry, 0.05).tolist() == pytest.approx([1.0, 0.5, 0.15, 0.095, 0.0])
+    assert mfp.crack_indicator(motion, masonry, 0.05).tolist() == pytest.approx([1.0, 0.5, 0.15, 0.095, 0.0])
 
 
 def segment_distances(model, x, y):
@@ -150,7 +151,7 @@ def test_points_go_to_their_nearest_joint_within_half_the_sampling(spacing):
     rng = np.random.default_rng(3)
     x, y = rng.uniform(0, 0.8, 2000), rng.uniform(-0.05, 0.4, 2000)
     exact = segment_distances(model, x, y)
-    found = mf.nearest_interface(model, x, y, spacing)
+    found = mfp.nearest_interface(model, x, y, spacing)
     assert (exact[np.arange(x.size), found] <= exact.min(axis=1) + spacing / 2 + 1e-12).all()
     assert (found == exact.argmin(axis=1)).mean() > (0.95 if spacing == 0.01 else 0.8)
 
@@ -161,11 +162,11 @@ def test_a_continuum_s_crack_indicator_is_the_yielding_share_of_the_nearest_poin
     gx, gy = np.meshgrid(np.arange(0.005, 0.8, 0.01), np.arange(0.005, 0.4, 0.01))
     x, y = gx.ravel(), gy.ravel()
     plastic = (x > 0.6) & (y > 0.2)
-    indicator = mf.plastic_crack_indicator(model, x, y, plastic)
+    indicator = mfp.plastic_crack_indicator(model, x, y, plastic)
     nearest = segment_distances(model, x, y).argmin(axis=1)
     by_hand = np.array([plastic[nearest == i].mean() if (nearest == i).any() else 0.0
                         for i in range(model.sizes["interface"])])
-    base = mf.masonry_joints(model.block_role.values, model.interface_blocks.values)
+    base = mfp.masonry_joints(model.block_role.values, model.interface_blocks.values)
     np.testing.assert_allclose(indicator, np.where(base, by_hand, 0.0), atol=0.03)
     assert indicator.max() > 0.3 and (indicator[by_hand == 0] == 0).all()
 
@@ -179,7 +180,7 @@ def test_a_continuum_result_gets_the_core_s_crack_indicator(registered):
 
     registered(continuum)
     result = mf.solve(model, "tipping")
-    cracked = mf.nearest_interface(model, x[:1], y[:1], 0.01)[0]
+    cracked = mfp.nearest_interface(model, x[:1], y[:1], 0.01)[0]
     assert np.flatnonzero(result.crack_indicator.values).tolist() == [cracked]
     assert result.crack_indicator.values[cracked] == 1.0
 
@@ -203,7 +204,7 @@ def test_macro_blocks_are_the_groups_joined_by_intact_joints(seed):
     n = 40
     pairs = rng.integers(0, n, size=(60, 2))
     state = rng.choice([STATE["intact"], STATE["open"], STATE["slide"]], size=60)
-    labels = mf.macro_blocks(n, pairs, state)
+    labels = mfp.macro_blocks(n, pairs, state)
     groups = union_find_groups(n, pairs[state == STATE["intact"]])
     same = np.equal.outer(labels, labels)
     assert np.array_equal(same, np.equal.outer(groups, groups))
@@ -218,7 +219,7 @@ def test_a_third_party_mechanism_gets_the_core_s_fields(registered):
     def tipping(model, options, progress):
         u = np.zeros((2, 3))
         u[1] = (-theta * 0.25, theta * 0.5, theta)
-        return xr.Dataset(mf.motion_variables(u), attrs={"rotations": "small", "flow_rule": "associative"})
+        return xr.Dataset(mfp.motion_variables(u), attrs={"rotations": "small", "flow_rule": "associative"})
 
     registered(tipping)
     result = mf.solve(two_blocks(), "tipping")
@@ -235,7 +236,7 @@ def test_a_third_party_mechanism_gets_the_core_s_fields(registered):
 ])
 def test_the_core_refuses_a_mechanism_it_cannot_read(registered, attrs, returned, message):
     def solve(model, options, progress):
-        return xr.Dataset({**mf.motion_variables(np.zeros((2, 3))), **returned}, attrs=attrs)
+        return xr.Dataset({**mfp.motion_variables(np.zeros((2, 3))), **returned}, attrs=attrs)
 
     registered(solve)
     with pytest.raises(mf.SolveError, match=message):

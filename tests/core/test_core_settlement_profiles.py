@@ -7,8 +7,9 @@ import numpy as np
 import pytest
 
 import masonryfw as mf
+import masonryfw.plugin_api as mfp
 
-ROLE = mf.flags("block_role")
+ROLE = mfp.flags("block_role")
 BASE = {
     "title": "long wall", "length_unit": "m",
     "wall": {"width": 4.0, "height": 1.2, "thickness": 0.1},
@@ -58,9 +59,9 @@ def test_gaussian_trough_segments_follow_peck_and_oreilly_new():
     assert (~moving).sum() == 2  # [0, 0.2] and [1.8, 4] each merged
     np.testing.assert_array_equal(model.block_fixed.values[supports[moving]], [[0, 0, 0]] * 16)
     # the paper's loading per support: the uniform share of the weight, up (dead) and down (live)
-    weight = -mf.block_loads(model, "dead")[mf.masonry_blocks(role), 1].sum()
-    np.testing.assert_allclose(mf.block_loads(model, "dead")[supports[moving], 1], weight * 0.1 / 4.0)
-    np.testing.assert_allclose(mf.block_loads(model, "live")[supports[moving], 1], -weight * 0.1 / 4.0)
+    weight = -mfp.block_loads(model, "dead")[mfp.masonry_blocks(role), 1].sum()
+    np.testing.assert_allclose(mfp.block_loads(model, "dead")[supports[moving], 1], weight * 0.1 / 4.0)
+    np.testing.assert_allclose(mfp.block_loads(model, "live")[supports[moving], 1], -weight * 0.1 / 4.0)
 
 
 def test_profile_lengths_in_millimetres_give_the_metre_model():
@@ -143,20 +144,20 @@ def test_profile_distortion_closed_forms():
     """Three points: the middle one 1 below the chord of the ends 2 apart: deflection ratio 1/2 (sagging,
     positive), angular distortion 1; raised instead: -1/2. A tilt (a straight profile) distorts nothing."""
     x = np.array([0.0, 1.0, 2.0])
-    assert mf.distortion(x, np.array([0.0, -1.0, 0.0])) == pytest.approx((0.5, 1.0))
-    assert mf.distortion(x, np.array([-1.0, 0.0, -1.0])) == pytest.approx((-0.5, 1.0))
-    assert mf.distortion(x, np.array([0.0, -0.5, -1.0])) == pytest.approx((0.0, 0.0))
+    assert mfp.distortion(x, np.array([0.0, -1.0, 0.0])) == pytest.approx((0.5, 1.0))
+    assert mfp.distortion(x, np.array([-1.0, 0.0, -1.0])) == pytest.approx((-0.5, 1.0))
+    assert mfp.distortion(x, np.array([0.0, -0.5, -1.0])) == pytest.approx((0.0, 0.0))
     # a trough: Peck's profile sampled finely, its steepest slope at the inflection point (x0 +- i)
     i = 0.3
     xs = np.linspace(-2, 2, 4001)
-    ratio, beta = mf.distortion(xs, -np.exp(-0.5 * (xs / i) ** 2))
+    ratio, beta = mfp.distortion(xs, -np.exp(-0.5 * (xs / i) ** 2))
     assert ratio == pytest.approx(1.0 / 4.0, rel=1e-3)  # the axis 1 below the chord, over the 4 m span
     assert beta == pytest.approx(math.exp(-0.5) / i, rel=1e-4)
 
 
 def test_support_profile_of_a_trough_model():
     model = mf.build({**BASE, "settlement": TROUGH})
-    x, v = mf.support_profile(model)
+    x, v = mfp.support_profile(model)
     assert np.all(np.diff(x) > 0)
     moving = v < 0  # 0.1 m segments: the ground at a midpoint is the mean of its ends' (less the cutoff)
     ends = np.exp(-0.5 * ((x[moving, None] + [-0.05, 0.05] - 1.0) / 0.3) ** 2)

@@ -11,6 +11,7 @@ import xarray as xr
 from click.testing import CliRunner
 
 import masonryfw as mf
+import masonryfw.plugin_api as mfp
 from masonryfw.cli import cli
 from masonryfw.progress import StderrBar
 
@@ -223,7 +224,7 @@ def test_one_dead_reaction_for_la_and_fdem(source, within):
 
 def test_jmm_takes_plateau_slope_zero():
     """docs/settlements.md's advice for running jmm to a settlement is accepted: no plateau stop."""
-    options = mf.resolve_options("jmm", mf.get_solver("jmm").options, {"plateau_slope": "0"})
+    options = mfp.resolve_options("jmm", mf.get_solver("jmm").options, {"plateau_slope": "0"})
     assert options["plateau_slope"] == 0.0
 
 

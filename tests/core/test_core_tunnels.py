@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 import masonryfw as mf
+import masonryfw.plugin_api as mfp
 from masonryfw.assessment import E_OVER_G, deep_beam_strains, ltsm_category, ltsm_parts
 from masonryfw.profiles import Profile
 
@@ -129,7 +130,7 @@ def drawn_copy(model, path) -> dict:
     role = model.block_role.values
     starts = np.r_[0, np.cumsum(model.block_node_count.values)]
     features = []
-    for b in np.flatnonzero(mf.masonry_blocks(role)):
+    for b in np.flatnonzero(mfp.masonry_blocks(role)):
         ring = np.c_[model.node_x.values[starts[b]:starts[b + 1]], model.node_y.values[starts[b]:starts[b + 1]]]
         features.append({"type": "Feature", "properties": {"layer": "0"},
                          "geometry": {"type": "Polygon", "coordinates": [ring.tolist() + [ring[0].tolist()]]}})
@@ -160,13 +161,13 @@ def test_a_drawn_ground_block_is_cut_into_the_continuous_ground():
     spec["loading"] = {"type": "settlement"}
     spec["settlement"] = {"profile": "gaussian", "center": 1.0, "width": 0.5, "ground_select": "lowest"}
     model = mf.build(spec)
-    moving = np.flatnonzero(model.block_role.values == mf.flags("block_role")["moving_support"])
+    moving = np.flatnonzero(model.block_role.values == mfp.flags("block_role")["moving_support"])
     assert moving.size > 20
     x0 = model.node_x.values[np.r_[0, np.cumsum(model.block_node_count.values)][moving]]
     order = moving[np.argsort(x0)]
     d = model.settlement_direction.values[order]
     cx = model.block_centroid_x.values[order]
-    xmin, xmax, _, _ = mf.block_bounds(model.node_x.values, model.node_y.values, model.block_node_count.values)
+    xmin, xmax, _, _ = mfp.block_bounds(model.node_x.values, model.node_y.values, model.block_node_count.values)
     left = d[:, 1] + d[:, 2] * (xmin[order] - cx)
     right = d[:, 1] + d[:, 2] * (xmax[order] - cx)
     np.testing.assert_allclose(left[1:], right[:-1], atol=1e-12)  # the ground has no steps

@@ -17,6 +17,7 @@ import pytest
 import xarray as xr
 
 import masonryfw as mf
+import masonryfw.plugin_api as mfp
 import masonryfw.testing as mt
 
 B, H = 0.2, 0.1  # unit length and height [m]
@@ -25,11 +26,11 @@ THICKNESS = 0.1
 
 
 #: What the core writes on crack_indicator, with the threshold the fixtures' hand-made indicators stand for.
-INDICATOR_ATTRS = {**mf.variable_attrs("crack_indicator"), "crack_threshold": mf.CRACK_THRESHOLD}
+INDICATOR_ATTRS = {**mfp.variable_attrs("crack_indicator"), "crack_threshold": mf.CRACK_THRESHOLD}
 
 
 def _attrs(name: str) -> dict:
-    return mf.variable_attrs(name)
+    return mfp.variable_attrs(name)
 
 
 def grid_model(rows: int = 4, cols: int = 6, split: int = 3, title: str = "Grid wall") -> xr.Dataset:
@@ -86,7 +87,7 @@ def la_result(model: xr.Dataset, first_moving_column: int = 3, cracked=None, bac
     ``cracked`` (interface mask) defaults to every joint whose blocks move apart.
     """
     u = _translation_mechanism(model, first_moving_column)
-    opening, slip = mf.relative_motion(model, u, "small")
+    opening, slip = mfp.relative_motion(model, u, "small")
     moving_apart = (np.abs(opening).max(axis=1) > 0) | (np.abs(slip).max(axis=1) > 0)
     cracked = moving_apart if cracked is None else np.asarray(cracked, dtype=bool)
     state = np.where(opening.max(axis=1) > 0, 1, 0) + np.where(np.abs(slip).max(axis=1) > 0, 2, 0)
@@ -94,7 +95,7 @@ def la_result(model: xr.Dataset, first_moving_column: int = 3, cracked=None, bac
     macro = np.where(u[:, 1] < 0, 1, 0)
     return model.assign(
         collapse_multiplier=((), 0.3, _attrs("collapse_multiplier")),
-        **mf.motion_variables(u),
+        **mfp.motion_variables(u),
         interface_opening=(("interface", "end"), opening, _attrs("interface_opening")),
         interface_slip=(("interface", "end"), slip, _attrs("interface_slip")),
         interface_normal_force=(("interface", "end"), normal, _attrs("interface_normal_force")),
@@ -112,9 +113,9 @@ def fdem_result(model: xr.Dataset, first_moving_column: int = 3) -> xr.Dataset:
     u = 0.005 * _translation_mechanism(model, first_moving_column)
     steps = np.linspace(0.0, 0.005, 11)
     crack = head_line(model, first_moving_column).astype(float)
-    opening, slip = mf.relative_motion(model, u, "finite")
+    opening, slip = mfp.relative_motion(model, u, "finite")
     return model.assign(
-        **mf.motion_variables(u),
+        **mfp.motion_variables(u),
         interface_opening=(("interface", "end"), opening, _attrs("interface_opening")),
         interface_slip=(("interface", "end"), slip, _attrs("interface_slip")),
         crack_indicator=("interface", crack, INDICATOR_ATTRS),

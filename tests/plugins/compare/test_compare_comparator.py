@@ -8,6 +8,7 @@ import pytest
 import xarray as xr
 
 import masonryfw as mf
+import masonryfw.plugin_api as mfp
 
 
 def compare(a, b, options):
@@ -27,7 +28,7 @@ def _with_cracks(result: xr.Dataset, indicator: np.ndarray) -> xr.Dataset:
     (the comparison's threshold then applies to the indicator itself, :func:`masonryfw.at_threshold`)."""
     bare = result.drop_vars(["interface_opening", "interface_slip"])
     return bare.assign(crack_indicator=("interface", np.asarray(indicator, dtype=float),
-                                        mf.variable_attrs("crack_indicator")))
+                                        mfp.variable_attrs("crack_indicator")))
 
 
 @pytest.mark.parametrize("kind", ["la", "fdem", "jmm"])
@@ -53,7 +54,7 @@ def test_scores_not_computable_are_absent_never_nan(results):
 def test_hand_made_patterns_give_the_hand_computed_scores(model, build):
     # on ten head joints h (all of length H): A = {h0, h1, h2, h3, h9}, B = {h1, h2, h5, h9} at threshold 0.1
     # (0.09 and 0.05 stay intact)
-    h = np.flatnonzero(model.interface_kind.values == mf.flags("interface_kind")["head"])[:10]
+    h = np.flatnonzero(model.interface_kind.values == mfp.flags("interface_kind")["head"])[:10]
     a = np.zeros(model.sizes["interface"])
     a[h[[0, 1, 2, 3, 4, 9]]] = [0.9, 0.5, 0.2, 0.15, 0.05, 0.11]
     b = np.zeros(model.sizes["interface"])
@@ -160,7 +161,7 @@ def test_through_the_core_the_comparison_is_a_valid_dataset_with_input_hashes(re
     from_file = mf.open_dataset(path)
     comparison = mf.compare(from_file, results["fdem"], "crack", {"threshold": "0.2"})
     assert mf.check(comparison, kind="comparison") == []
-    assert comparison.attrs["input_a_sha256"] == mf.sha256_file(path)
+    assert comparison.attrs["input_a_sha256"] == mfp.sha256_file(path)
     assert json.loads(comparison.attrs["comparator_options"]) == {"threshold": 0.2}
     scores = {n: comparison[n].item() for n in comparison.data_vars}
     assert json.loads(json.dumps(scores))["crack_f1"] == 1.0

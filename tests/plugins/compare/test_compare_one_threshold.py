@@ -15,10 +15,11 @@ from click.testing import CliRunner
 from matplotlib.collections import LineCollection
 
 import masonryfw as mf
+import masonryfw.plugin_api as mfp
 from masonryfw.cli import cli
 from masonryfw_diagnose.synthetic import visible_cracks
 
-SUPPORT_ROLES = [mf.flags("block_role")["fixed_support"], mf.flags("block_role")["moving_support"]]
+SUPPORT_ROLES = [mfp.flags("block_role")["fixed_support"], mfp.flags("block_role")["moving_support"]]
 
 
 @pytest.fixture(scope="module", params=["la", "fdem"])

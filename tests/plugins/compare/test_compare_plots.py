@@ -7,6 +7,7 @@ import xarray as xr
 from PIL import Image
 
 import masonryfw as mf
+import masonryfw.plugin_api as mfp
 from masonryfw_compare.block_plots import default_amplification, thrust_segments
 
 
@@ -82,15 +83,15 @@ def test_compare_refuses_results_of_different_models(results, build):
 
 def test_default_amplification_draws_the_largest_motion_as_a_tenth_of_the_wall(results):
     # LA mechanism: units translate by 1 (unit settlement); wall + supports: 1.2 m x 0.5 m, diagonal 1.3 m
-    geo = mf.derive_geometry(results["la"])
-    assert default_amplification(geo, mf.block_motion(results["la"])) == pytest.approx(0.13)
+    geo = mfp.derive_geometry(results["la"])
+    assert default_amplification(geo, mfp.block_motion(results["la"])) == pytest.approx(0.13)
     # FEM/DEM: 5 mm -> 0.13 / 0.005
-    assert default_amplification(geo, mf.block_motion(results["fdem"])) == pytest.approx(26.0)
+    assert default_amplification(geo, mfp.block_motion(results["fdem"])) == pytest.approx(26.0)
 
 
 def test_thrust_passes_through_the_centre_of_pressure(results):
     """Interface 0: head joint x = 0.2, end 0 at y = 0.1, end 1 at y = 0; N = (10, 30) -> y = 0.1 - 0.75*0.1."""
-    geo = mf.derive_geometry(results["la"])
+    geo = mfp.derive_geometry(results["la"])
     normal = np.zeros((geo.sizes["interface"], 2))
     normal[0] = [10.0, 30.0]
     shear = np.zeros_like(normal)

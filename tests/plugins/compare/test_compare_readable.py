@@ -15,6 +15,7 @@ import xarray as xr
 from click.testing import CliRunner
 
 import masonryfw as mf
+import masonryfw.plugin_api as mfp
 from masonryfw.cli import cli
 from masonryfw_compare.block_plots import DOMINANT_SHARE
 from masonryfw_compare.history_plot import STRIP_SHARE, gravity_records
@@ -72,8 +73,8 @@ def test_compare_of_three_results_scores_every_pair(test_12c_files, opened):
 def test_a_continuum_result_is_scored_by_its_mechanism_too(opened):
     scores = mf.compare(opened["la"], opened["jmm"], "crack")
     assert {"mechanism_cosine", "macro_block_ari"} <= set(scores.data_vars)
-    masonry = mf.masonry_blocks(opened["jmm"].block_role.values)
-    assert np.isfinite(mf.block_motion(opened["jmm"])[masonry]).all()
+    masonry = mfp.masonry_blocks(opened["jmm"].block_role.values)
+    assert np.isfinite(mfp.block_motion(opened["jmm"])[masonry]).all()
 
 
 def test_history_csv_holds_the_curves_numbers_and_la_s_collapse_reaction(test_12c_files, opened, tmp_path):
@@ -126,7 +127,7 @@ def test_the_history_overlays_results_with_the_dead_load_and_la_s_collapse_react
 def test_the_mechanism_numbers_the_pieces_holding_two_percent_of_the_masonry(opened, threshold):
     """At the core's threshold Test 12C's mechanism has only dominant pieces; at 1 % it has small ones too."""
     ds = opened["la"]
-    masonry = mf.masonry_blocks(ds.block_role.values)
+    masonry = mfp.masonry_blocks(ds.block_role.values)
     derived = mf.at_threshold(ds, threshold)
     labels, inverse = np.unique(derived.macro_block.values[masonry], return_inverse=True)
     area = np.bincount(inverse, weights=np.abs(ds.block_area.values[masonry]))
@@ -140,7 +141,7 @@ def test_the_mechanism_numbers_the_pieces_holding_two_percent_of_the_masonry(ope
     assert (labels.size > dominant) == (threshold < 0.05)
     opening, slip = ds.interface_opening.values, ds.interface_slip.values
     motion = np.hypot(np.maximum(opening, 0.0), slip).max(axis=1)  # docs/format.md, by hand
-    inner = ~mf.support_blocks(ds.block_role.values)[ds.interface_blocks.values].all(axis=1)
+    inner = ~mfp.support_blocks(ds.block_role.values)[ds.interface_blocks.values].all(axis=1)
     cracked = int((inner & (motion > threshold * motion[inner].max())).sum())
     assert f"cracked joints ({cracked})" in legend
     faces = [c for c in ax.collections if c.get_linewidths()[0] > 1.0]

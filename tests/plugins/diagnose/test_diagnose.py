@@ -15,6 +15,7 @@ import pytest
 from click.testing import CliRunner
 
 import masonryfw as mf
+import masonryfw.plugin_api as mfp
 from masonryfw.cli import cli
 from masonryfw_diagnose import synthetic as sy
 from masonryfw_diagnose.dataset import to_dataset
@@ -268,7 +269,7 @@ def test_bad_input_is_named_and_nothing_is_written(tmp_path, case, expected):
 
 def test_a_wall_without_a_ground_to_cut_is_refused():
     model = mf.open_model("test-12c")
-    support = mf.support_blocks(model.block_role.values)
+    support = mfp.support_blocks(model.block_role.values)
     lowered = np.where(np.repeat(support, model.block_node_count.values), model.node_y.values - 1.0,
                        model.node_y.values)
     with pytest.raises(mf.SpecError, match="no masonry rests on the wall's ground"):
@@ -414,7 +415,7 @@ def test_the_stand_in_ground_of_a_bare_spec_is_replaced():
     a, b = mf.ground_model(built, SEGMENT), mf.ground_model(mf.open_model("test-12c"), SEGMENT)
 
     def boxes(model):
-        bounds = np.c_[mf.block_bounds(model.node_x.values, model.node_y.values, model.block_node_count.values)]
+        bounds = np.c_[mfp.block_bounds(model.node_x.values, model.node_y.values, model.block_node_count.values)]
         return bounds[np.lexsort(bounds[::-1])]
 
     np.testing.assert_allclose(boxes(a), boxes(b), atol=1e-12)

@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 
 import masonryfw as mf
+import masonryfw.plugin_api as mfp
 from masonryfw_diagnose import synthetic as sy
 from masonryfw_diagnose.diagnosis import diagnose
 from masonryfw_diagnose.survey import Survey
@@ -69,9 +70,9 @@ def test_thirty_random_walls_as_in_the_study():
 
 
 def settling_edges(model) -> list[float]:
-    moving = model.block_role.values == mf.flags("block_role")["moving_support"]
-    masonry = mf.masonry_blocks(model.block_role.values)
-    xmin, xmax, _, _ = mf.block_bounds(model.node_x.values, model.node_y.values, model.block_node_count.values)
+    moving = model.block_role.values == mfp.flags("block_role")["moving_support"]
+    masonry = mfp.masonry_blocks(model.block_role.values)
+    xmin, xmax, _, _ = mfp.block_bounds(model.node_x.values, model.node_y.values, model.block_node_count.values)
     inside = (xmin[masonry].min() + 1e-9, xmax[masonry].max() - 1e-9)
     return [e for e in (xmin[moving].min(), xmax[moving].max()) if inside[0] < e < inside[1]]
 

@@ -11,8 +11,9 @@ import numpy as np
 import pytest
 
 import masonryfw as mf
+import masonryfw.plugin_api as mfp
 
-ROLE = mf.flags("block_role")
+ROLE = mfp.flags("block_role")
 LONG_WALL = {"title": "long wall", "length_unit": "m", "wall": {"width": 4.0, "height": 1.2, "thickness": 0.1},
              "unit": {"length": 0.4, "height": 0.1}, "material": {"unit_weight": 12000.0, "friction_angle": 30.0},
              "loading": {"type": "settlement"}}
@@ -129,7 +130,7 @@ def test_fdem_symmetric_trough_gives_a_mirror_symmetric_crack_pattern(sagging):
 
 def widest_masonry_joint(result) -> tuple[float, float]:
     """Midpoint of the joint between two masonry blocks that opens most."""
-    ground = mf.support_blocks(result.block_role.values)[result.interface_blocks.values].any(axis=1)
+    ground = mfp.support_blocks(result.block_role.values)[result.interface_blocks.values].any(axis=1)
     opening = np.where(ground, -np.inf, result.interface_opening.values.max(axis=1))
     i = int(np.argmax(opening))
     return float(result.interface_x.values[i].mean()), float(result.interface_y.values[i].mean())

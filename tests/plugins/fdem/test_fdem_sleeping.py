@@ -12,9 +12,10 @@ import numpy as np
 import pytest
 
 import masonryfw as mf
+import masonryfw.plugin_api as mfp
 
 TO_TARGET = {"plateau_tolerance": 0.0}  # both runs settle by the same amount
-MOVING_SUPPORT = mf.flags("block_role")["moving_support"]
+MOVING_SUPPORT = mfp.flags("block_role")["moving_support"]
 
 
 def dead_reaction(model) -> float:

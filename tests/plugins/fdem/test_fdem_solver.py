@@ -6,9 +6,10 @@ import numpy as np
 import pytest
 
 import masonryfw as mf
+import masonryfw.plugin_api as mfp
 from masonryfw_fdem.scene import build_scene
 
-ROLE = mf.flags("block_role")
+ROLE = mfp.flags("block_role")
 RESULT_VARIABLES = (
     "block_displacement", "interface_opening", "interface_slip", "interface_normal_force",
     "interface_shear_force", "interface_state", "crack_indicator", "macro_block", "step_settlement",
@@ -50,7 +51,7 @@ def test_result_holds_format_variables_and_run_attributes(small_wall):
     np.testing.assert_allclose(result.snapshot_block_displacement.values[:, moving, 1].ravel(),
                                -result.snapshot_settlement.values, rtol=1e-12)
     # the moving support went down by the last recorded settlement
-    assert mf.block_motion(result)[moving, 1] == pytest.approx(-result.step_settlement.values[-1])
+    assert mfp.block_motion(result)[moving, 1] == pytest.approx(-result.step_settlement.values[-1])
 
 
 def test_keyboard_interrupt_returns_the_state_reached(small_wall):
@@ -67,7 +68,7 @@ def test_keyboard_interrupt_returns_the_state_reached(small_wall):
     settled = result.step_settlement.values[-1]
     assert 0 < settled < result.attrs["fdem_target_settlement"]
     moving = small_wall.block_role.values == ROLE["moving_support"]
-    assert mf.block_motion(result)[moving, 1] == pytest.approx(-settled)
+    assert mfp.block_motion(result)[moving, 1] == pytest.approx(-settled)
     assert mf.check(result) == []
 
 

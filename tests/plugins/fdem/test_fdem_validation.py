@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 import masonryfw as mf
+import masonryfw.plugin_api as mfp
 
 G = 9.81
 
@@ -27,14 +28,14 @@ def test_block_slides_down_incline_with_g_sin_minus_mu_cos(walls):
     theta, mu = np.radians(angle), np.tan(np.radians(friction_angle))
     expected = G * (np.sin(theta) - mu * np.cos(theta))
     assert settled_acceleration(result, after=0.05) == pytest.approx(expected, rel=2e-3)
-    assert mf.block_motion(result)[0, 0] > 0.08  # 0.5 a t^2 = 0.089 m, down the slope (+x)
+    assert mfp.block_motion(result)[0, 0] > 0.08  # 0.5 a t^2 = 0.089 m, down the slope (+x)
 
 
 def test_block_rests_on_incline_flatter_than_friction_angle(walls):
     model = walls.gravity_rotated(mf.build(walls.single_block_spec(0.4, 0.2, 30.0)), 20.0)
     result = mf.solve(model, "fdem", {"damping": 0.0, "gravity_time": 0.3, "load_factor": 0.0})
     # only the elastic shear deflection of the contact springs: << 1e-4 of the block length
-    assert abs(mf.block_motion(result)[0, 0]) < 4e-5
+    assert abs(mfp.block_motion(result)[0, 0]) < 4e-5
     assert result.step_kinetic_energy.values[-1] < 1e-6 * np.hypot(*model.dead_load.values[0, :2]) * 0.2
 
 
@@ -59,7 +60,7 @@ def test_cohesion_holds_block_on_steep_incline_until_exceeded(walls):
         strength = model.interface_cohesion * 0 + strength_force / area
         cohesive = model.assign(interface_cohesion=strength, interface_tensile_strength=strength)
         result = mf.solve(cohesive, "fdem", {"gravity_time": 0.3, "load_ramp": 0.1, "load_factor": 0.0})
-        moved = mf.block_motion(result)[0, 0]
+        moved = mfp.block_motion(result)[0, 0]
         assert (moved > 0.005) if slides else (abs(moved) < 4e-5), (strength_force, moved)
 
 
@@ -70,12 +71,12 @@ def test_single_block_tips_above_horizontal_acceleration_b_over_h(walls, share, 
     width, height = 0.1, 0.4
     model = mf.build(walls.single_block_spec(width, height, 30.0))
     result = mf.solve(model, "fdem", {"gravity_time": 1.0, "load_factor": share * width / height})
-    rotation = mf.block_motion(result)[0, 2]
+    rotation = mfp.block_motion(result)[0, 2]
     if tips:
         assert rotation < -0.05  # clockwise about the right toe, still accelerating
     else:
         assert abs(rotation) < 2e-3  # the rocking of the elastic contact only
-    assert abs(mf.block_motion(result)[0, 0] - 0.5 * height * np.sin(-rotation)) < 0.01
+    assert abs(mfp.block_motion(result)[0, 0] - 0.5 * height * np.sin(-rotation)) < 0.01
 
 
 def plateau_reaction(result, share: float = 0.3) -> float:
@@ -120,14 +121,14 @@ def test_same_wall_scaled_gives_scaled_results(small_wall):
         scaled[name] = small_wall[name] * s**3
     for name in ("dead_moment", "live_moment"):
         scaled[name] = small_wall[name] * s**4
-    scaled = mf.derive_geometry(scaled.drop_vars(list(mf.DERIVED_GEOMETRY_VARIABLES), errors="ignore"))
+    scaled = mfp.derive_geometry(scaled.drop_vars(list(mfp.DERIVED_GEOMETRY_VARIABLES), errors="ignore"))
     options = {"plateau_tolerance": 0.0}
     reference = mf.solve(small_wall, "fdem", options)
     result = mf.solve(scaled, "fdem", options)
     # identical up to rounding, which frictional explicit dynamics amplifies a little
     np.testing.assert_allclose(result.step_reaction.values, s**3 * reference.step_reaction.values,
                                rtol=1e-4, atol=1e-4 * s**3 * reference.step_reaction.values.max())
-    u, u_ref = mf.block_motion(result)[:, :2], mf.block_motion(reference)[:, :2] * s
+    u, u_ref = mfp.block_motion(result)[:, :2], mfp.block_motion(reference)[:, :2] * s
     assert np.abs(u - u_ref).max() < 1e-4 * np.abs(u_ref).max()
     np.testing.assert_array_equal(result.macro_block.values, reference.macro_block.values)
 

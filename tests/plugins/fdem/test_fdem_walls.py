@@ -8,8 +8,9 @@ import numpy as np
 import pytest
 
 import masonryfw as mf
+import masonryfw.plugin_api as mfp
 
-ROLE = mf.flags("block_role")
+ROLE = mfp.flags("block_role")
 
 
 def la_collapse_reaction(model, la) -> float:

@@ -9,6 +9,7 @@ import pytest
 import shapely
 
 import masonryfw as mf
+import masonryfw.plugin_api as mfp
 from masonryfw.datasets.drawings import generate
 from masonryfw_jmm.fabric import bed_angles, head_joints, stress_rotation
 from masonryfw_jmm.mesh import wall_mesh
@@ -38,7 +39,7 @@ def test_beds_follow_the_voussoirs_and_stay_level_in_courses():
     np.testing.assert_allclose(angles[:25], expected, atol=math.radians(2))
     assert not head_joints(arch, angles)[:25].any()
     wall = mf.open_model("test-12c")
-    units = wall.block_role.values == mf.flags("block_role")["unit"]
+    units = wall.block_role.values == mfp.flags("block_role")["unit"]
     assert np.abs(bed_angles(wall)[units]).max() == 0.0
     assert head_joints(wall, bed_angles(wall))[units].all()
 
@@ -52,10 +53,10 @@ def test_gmsh_meshes_non_convex_blocks_conforming():
     p, t = mesh.points, mesh.triangles
     area = 0.5 * ((p[0, t[1]] - p[0, t[0]]) * (p[1, t[2]] - p[1, t[0]]) - (p[0, t[2]] - p[0, t[0]]) * (p[1, t[1]] - p[1, t[0]]))
     assert (area > 0).all()
-    masonry = mf.masonry_blocks(model.block_role.values)
+    masonry = mfp.masonry_blocks(model.block_role.values)
     np.testing.assert_allclose(np.bincount(mesh.block, area, minlength=masonry.size)[masonry],
                                model.block_area.values[masonry], rtol=1e-9)
-    start = mf.block_offsets(model.block_node_count.values)
+    start = mfp.block_offsets(model.block_node_count.values)
     shapes = [shapely.Polygon(np.c_[model.node_x.values[a:b], model.node_y.values[a:b]]).buffer(1e-9)
               for a, b in zip(start[:-1], start[1:])]
     centroid = p[:, t].mean(axis=1)

@@ -7,6 +7,7 @@ import scipy.sparse.linalg as spla
 from skfem import MeshTri
 
 import masonryfw as mf
+import masonryfw.plugin_api as mfp
 from masonryfw_jmm.fem import Discretisation
 from masonryfw_jmm.material import JointStrength, ReturnMap, elastic_matrix
 from masonryfw_jmm.newton import NewtonSolver, State
@@ -160,7 +161,7 @@ def test_the_estimated_dofs_are_the_meshs_to_ten_percent(case, options):
     from masonryfw_jmm.problem import build_problem
 
     model = mf.checked_model(mf.open_model(case))
-    resolved = mf.resolve_options("jmm", mf.get_solver("jmm").options, options)
+    resolved = mfp.resolve_options("jmm", mf.get_solver("jmm").options, options)
     estimated, _ = mesh_dofs(model, resolved, resolved["element"])
     actual = build_problem(model, resolved).disc.ndof
     assert abs(estimated / actual - 1) < 0.1, (estimated, actual)
@@ -173,7 +174,7 @@ def test_the_estimated_dofs_of_drawn_walls_are_the_meshs_to_a_quarter(case):
     from masonryfw_jmm.problem import build_problem
 
     model = mf.checked_model(mf.open_model(case))
-    resolved = mf.resolve_options("jmm", mf.get_solver("jmm").options, {})
+    resolved = mfp.resolve_options("jmm", mf.get_solver("jmm").options, {})
     estimated, _ = mesh_dofs(model, resolved)
     actual = build_problem(model, resolved).disc.ndof
     assert abs(estimated / actual - 1) < 0.25, (estimated, actual)

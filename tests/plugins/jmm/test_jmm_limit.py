@@ -19,13 +19,14 @@ import scipy.sparse as sp
 from skfem import MeshTri
 
 import masonryfw as mf
+import masonryfw.plugin_api as mfp
 from masonryfw_jmm.limit import StaticField, settlement_lp, solve_lp
 from masonryfw_jmm.material import JointStrength
 
 MU = 0.4
 STRENGTH = JointStrength(MU, MU, beta=0.8)
-ROLE = mf.flags("block_role")
-FLAG = mf.flags("qp_failure")
+ROLE = mfp.flags("block_role")
+FLAG = mfp.flags("qp_failure")
 
 
 def rectangle_field(width, height, nx, ny):

@@ -5,8 +5,9 @@ import numpy as np
 import pytest
 
 import masonryfw as mf
+import masonryfw.plugin_api as mfp
 
-ROLE = mf.flags("block_role")
+ROLE = mfp.flags("block_role")
 WALL = {"title": "trough wall", "length_unit": "m", "wall": {"width": 2.4, "height": 0.4, "thickness": 0.1},
         "unit": {"length": 0.2, "height": 0.1},
         "material": {"unit_weight": 12000.0, "friction_angle": 30.0, "young_modulus": 1.2e9, "poisson_ratio": 0.2},
@@ -25,9 +26,9 @@ def test_jmm_support_reactions_carry_the_weight_at_every_step(trough):
     Newton tolerance), and masonry blocks carry nothing."""
     model, result = trough
     per_support = result.step_support_reaction.values
-    weight = -mf.block_loads(model, "dead")[mf.masonry_blocks(model.block_role.values), 1].sum()
+    weight = -mfp.block_loads(model, "dead")[mfp.masonry_blocks(model.block_role.values), 1].sum()
     np.testing.assert_allclose(per_support.sum(axis=1), weight, rtol=2e-3)
-    assert np.all(per_support[:, mf.masonry_blocks(model.block_role.values)] == 0)
+    assert np.all(per_support[:, mfp.masonry_blocks(model.block_role.values)] == 0)
 
 
 @pytest.mark.parametrize("solver", ["jmm", "fdem"])
@@ -72,8 +73,8 @@ def test_crack_band_width_is_the_plastic_opening_strain_times_the_mesh_size():
     from masonryfw_jmm.solver import crack_band_width
 
     model = mf.build({**WALL, "settlement": TROUGH})
-    options = mf.resolve_options("jmm", mf.get_solver("jmm").options, {"mesh_size": 0.05})
-    problem = build_problem(mf.derive_geometry(model), options)
+    options = mfp.resolve_options("jmm", mf.get_solver("jmm").options, {"mesh_size": 0.05})
+    problem = build_problem(mfp.derive_geometry(model), options)
     state = State.initial(problem)
     state.strain[:, 1] = 2e-3  # opening across the (horizontal) beds
     state.strain[:, 0] = 1e-3

@@ -6,6 +6,7 @@ import pytest
 import scipy.sparse.linalg as spla
 
 import masonryfw as mf
+import masonryfw.plugin_api as mfp
 from masonryfw_jmm.newton import NewtonSolver, State
 from masonryfw_jmm.options import INCREMENTAL_OPTIONS
 from masonryfw_jmm.problem import build_problem
@@ -132,7 +133,7 @@ def test_elastic_unloading_settlement_is_one_linear_solve(model):
     # the reference solves K_ff du_f = -K_fm d_m with SciPy on the gravity state's tangent: the settlement
     # that would unload the support if the wall stayed on that tangent (it sizes the steps and the plateau)
     options = {**{o.name: o.default for o in INCREMENTAL_OPTIONS}, **FAST}
-    problem = build_problem(mf.derive_geometry(model), options)
+    problem = build_problem(mfp.derive_geometry(model), options)
     newton = NewtonSolver(problem, options["tolerance"], options["max_iterations"])
     state, _ = _gravity_stage(newton, State.initial(problem), History())
     K = problem.disc.stiffness(newton._regularised(state, False)).tocsc()

@@ -7,9 +7,10 @@ import numpy as np
 import pytest
 
 import masonryfw as mf
+import masonryfw.plugin_api as mfp
 import masonryfw.testing as mt
 
-ROLE = mf.flags("block_role")
+ROLE = mfp.flags("block_role")
 
 
 def running_bond(n_courses, width, unit_length, unit_height, *, half_first=True, y0=0.0):
@@ -76,9 +77,9 @@ def static_alpha(model) -> float:
     contact = sp.csr_matrix((vals, (rows, cols)), shape=(3 * n_block, n_var))
     # forces over the largest load, so that HiGHS's absolute tolerances (1e-7) are relative ones: unscaled,
     # the LACT3 portal's 7 kN blocks end 2e-5 short of the optimum
-    force = max(np.abs(mf.block_loads(model, "dead")).max(), np.abs(mf.block_loads(model, "live")).max())
-    dead = mf.block_loads(model, "dead").ravel() / force
-    live = mf.block_loads(model, "live").ravel() / force
+    force = max(np.abs(mfp.block_loads(model, "dead")).max(), np.abs(mfp.block_loads(model, "live")).max())
+    dead = mfp.block_loads(model, "dead").ravel() / force
+    live = mfp.block_loads(model, "live").ravel() / force
     total = (contact + sp.csr_matrix((live, (np.arange(3 * n_block), np.full(3 * n_block, n_var - 1))),
                                      shape=(3 * n_block, n_var))).tocsr()
     free = ((model.block_fixed.values == 0) & ~support[:, None]).ravel()

@@ -4,10 +4,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-import masonryfw as mf
+import masonryfw.plugin_api as mfp
 
 BACKENDS = ("highs", "clarabel", "osqp")
-STATE = mf.flags("interface_state")
+STATE = mfp.flags("interface_state")
 
 
 def single_unit(walls, b, h, **material):
@@ -27,7 +27,7 @@ def test_la_single_unit_under_its_weight_sideways(walls, backend, b, h, mu, regi
     """alpha = min(b/h, mu): rocking about the toe (b/h) or sliding with dilatancy (mu)."""
     result = walls.solve(single_unit(walls, b, h, friction=mu), solver=backend)
     assert float(result.collapse_multiplier) == pytest.approx(min(b / h, mu), rel=1e-7)
-    u = mf.block_motion(result)[1]
+    u = mfp.block_motion(result)[1]
     base_joint = result.interface_state.values[0]
     if regime == "rocking":  # turns clockwise, the heel lifts, nothing slides
         assert u[2] < 0
@@ -62,7 +62,7 @@ def test_la_unit_over_a_settling_support(walls, backend, a):
     result = walls.solve(model, solver=backend)
     assert float(result.collapse_multiplier) == pytest.approx(expected, abs=1e-7)
     # the moving support moves a unit distance down (docs/format.md normalisation)
-    np.testing.assert_allclose(mf.block_motion(result)[1], [0.0, -1.0, 0.0], atol=1e-12)
+    np.testing.assert_allclose(mfp.block_motion(result)[1], [0.0, -1.0, 0.0], atol=1e-12)
     dead_reaction = float(model.dead_load.values[1, 1])
     assert float(result.moving_support_reaction) == pytest.approx(
         (1.0 - expected) * dead_reaction, abs=1e-5 * dead_reaction

@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 import masonryfw as mf
+import masonryfw.plugin_api as mfp
 from masonryfw.datasets.drawings import generate
 
 #: LACT3's solver test (LACT3_SolverTest.m): collapse angle of the tilting table [deg], c = 0.
@@ -33,7 +34,7 @@ def _model(tmp_path, merged: bool, glue: bool = False):
         inside = _inner_joints(model, generate.stepped_wall(True)[0])
         for name in ("interface_cohesion", "interface_tensile_strength"):
             model[name].values[inside] = 1e7  # Pa: 5e4 N on a 0.005 m2 half joint, 60 times the wall weight
-        model = mf.checked_model(model.drop_vars(mf.DERIVED_GEOMETRY_VARIABLES))
+        model = mf.checked_model(model.drop_vars(mfp.DERIVED_GEOMETRY_VARIABLES))
     return model
 
 
@@ -70,5 +71,5 @@ def test_an_arch_on_a_settling_pier_has_a_mechanism_through_its_voussoirs(walls)
     model = mf.open_model("arch-settlement")
     result = walls.solve(model)
     assert float(result.collapse_multiplier) == pytest.approx(walls.static_alpha(model), abs=1e-7)
-    masonry = mf.masonry_blocks(model.block_role.values)
+    masonry = mfp.masonry_blocks(model.block_role.values)
     assert np.unique(result.macro_block.values[masonry]).size >= 3

@@ -10,9 +10,10 @@ import numpy as np
 import pytest
 
 import masonryfw as mf
+import masonryfw.plugin_api as mfp
 
 BACKENDS = ("highs", "clarabel", "osqp")
-ROLE = mf.flags("block_role")
+ROLE = mfp.flags("block_role")
 TOL = 1e-6  # relative to the total dead load (forces) and dead load x model size (moments)
 
 
@@ -49,7 +50,7 @@ def model_for(walls, case):
         return walls.ferris_tin_loi_wall()
     if case == "cohesive":
         return cohesive_wall(walls)
-    return mf.derive_geometry(mf.open_model(case))
+    return mfp.derive_geometry(mf.open_model(case))
 
 
 @pytest.mark.parametrize("backend", BACKENDS)
@@ -59,13 +60,13 @@ def test_la_static_and_kinematic_solutions_agree(walls, case, backend):
     result = walls.solve(model, solver=backend)
     alpha = float(result.collapse_multiplier)
     weight = np.hypot(*model.dead_load.values[:, :2].T).sum()
-    size = mf.model_scale(model.node_x.values, model.node_y.values)
+    size = mfp.model_scale(model.node_x.values, model.node_y.values)
 
     # primal (mechanism) alpha = dual (static) alpha
     assert result.attrs["la_alpha_dual"] == pytest.approx(alpha, abs=1e-7)
 
     # every free block (and the moving supports along their direction) is in equilibrium
-    residual = mf.block_loads(model, "dead") + alpha * mf.block_loads(model, "live") + contact_resultants(result)
+    residual = mfp.block_loads(model, "dead") + alpha * mfp.block_loads(model, "live") + contact_resultants(result)
     residual /= np.array([weight, weight, weight * size])
     moving = model.block_role.values == ROLE["moving_support"]
     free = (model.block_fixed.values == 0) & ~moving[:, None]
@@ -94,10 +95,10 @@ def test_la_static_and_kinematic_solutions_agree(walls, case, backend):
     a_t, a_c = (tension * half_area)[:, None], (cohesion * half_area)[:, None]
     dissipation = np.where(ground[:, None], 0.0, a_t * opening + (a_c - mu[:, None] * a_t) * np.abs(slip))
     work = normal * opening + shear * slip
-    scale = weight * np.abs(mf.block_motion(result)[:, :2]).max()
+    scale = weight * np.abs(mfp.block_motion(result)[:, :2]).max()
     assert np.abs(work + dissipation).max() < TOL * scale
-    u = mf.block_motion(result).ravel()
-    external = (mf.block_loads(model, "dead").ravel() + alpha * mf.block_loads(model, "live").ravel()) @ u
+    u = mfp.block_motion(result).ravel()
+    external = (mfp.block_loads(model, "dead").ravel() + alpha * mfp.block_loads(model, "live").ravel()) @ u
     assert external == pytest.approx(dissipation.sum(), abs=TOL * scale)
 
     # settlement cases: the moving support carries (1 - alpha) x its dead reaction at collapse

@@ -5,9 +5,10 @@ import numpy as np
 import pytest
 
 import masonryfw as mf
+import masonryfw.plugin_api as mfp
 
 BACKENDS = ("highs", "clarabel", "osqp")
-ROLE = mf.flags("block_role")
+ROLE = mfp.flags("block_role")
 
 
 def unit_on_base(walls, **kw):
@@ -91,7 +92,7 @@ def test_la_through_the_core(walls):
     assert result.attrs["solver"] == "la" and result.attrs["la_backend"] == "highs"
     assert mf.check(result) == []
     assert str(result.lp_status.values) == "optimal" and int(result.lp_iterations) > 0
-    assert set(np.unique(result.interface_state.values)) <= set(mf.flags("interface_state").values())
+    assert set(np.unique(result.interface_state.values)) <= set(mfp.flags("interface_state").values())
     assert 0.0 <= result.crack_indicator.min() and result.crack_indicator.max() == 1.0
     with pytest.raises(mf.PluginError, match="gurobi"):
         mf.solve(model, "la", {"solver": "gurobi"})

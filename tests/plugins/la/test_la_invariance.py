@@ -4,9 +4,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-import masonryfw as mf
+import masonryfw.plugin_api as mfp
 
-ROLE = mf.flags("block_role")
+ROLE = mfp.flags("block_role")
 
 
 def settling_wall(walls, *, mirrored=False, length_unit=1.0):
@@ -28,7 +28,7 @@ def test_la_same_wall_in_mm_and_in_m(walls, backend):
     assert float(in_mm.collapse_multiplier) == pytest.approx(float(in_m.collapse_multiplier), rel=1e-9)
     # the mechanism: the support moves by 1 model unit, so translations match and rotations scale by 1/1000
     np.testing.assert_allclose(
-        mf.block_motion(in_mm) * [1, 1, 1000], mf.block_motion(in_m), atol=1e-6
+        mfp.block_motion(in_mm) * [1, 1, 1000], mfp.block_motion(in_m), atol=1e-6
     )
 
 
@@ -61,8 +61,8 @@ def test_la_mirrored_wall_mirrored_mechanism(walls):
     res_left = walls.solve(left, solver="clarabel")
     assert float(res_left.collapse_multiplier) == pytest.approx(float(res_right.collapse_multiplier), rel=1e-9)
     match = mirror_map(right, left)  # block i of `right` is block match[i] of `left`
-    u_right = mf.block_motion(res_right)
-    u_left = mf.block_motion(res_left)[match]
+    u_right = mfp.block_motion(res_right)
+    u_left = mfp.block_motion(res_left)[match]
     np.testing.assert_allclose(u_left * [-1, 1, -1], u_right, atol=1e-6 * np.abs(u_right).max())
     np.testing.assert_array_equal(
         res_left.macro_block.values[match] == res_left.macro_block.values[match][0],
@@ -85,6 +85,6 @@ def test_la_central_settlement_gives_a_symmetric_mechanism(walls, backend):
     result = walls.solve(model, solver=backend)
     reference = walls.solve(model, solver="highs")
     assert float(result.collapse_multiplier) == pytest.approx(float(reference.collapse_multiplier), abs=1e-7)
-    u = mf.block_motion(result)
+    u = mfp.block_motion(result)
     match = mirror_map(model, model)
     np.testing.assert_allclose(u[match] * [-1, 1, -1], u, atol=1e-5 * np.abs(u).max())

@@ -10,12 +10,13 @@ import numpy as np
 import pytest
 
 import masonryfw as mf
+import masonryfw.plugin_api as mfp
 import masonryfw.testing as mt
 
 from .test_la_closed_forms import single_unit, unit_on_two_supports
 
 NONASSOCIATIVE = {"flow": "nonassociative"}
-STATE = mf.flags("interface_state")
+STATE = mfp.flags("interface_state")
 
 
 def capped_unit(walls, b=0.4, h=0.3, mu=0.5):
@@ -37,7 +38,7 @@ def test_a_capped_unit_slides_at_mu_without_dilatancy(walls, backend, mu):
     assert float(result.collapse_multiplier) == pytest.approx(mu, rel=1e-7)
     assert result.attrs["flow_rule"] == "nonassociative"
     assert np.isnan(result.attrs["la_alpha_associative"])
-    u = mf.block_motion(result)[1]
+    u = mfp.block_motion(result)[1]
     assert u[1] == pytest.approx(0.0, abs=1e-7) and u[2] == pytest.approx(0.0, abs=1e-7)  # slides flat
     assert set(result.interface_state.values.tolist()) == {STATE["slide"]}  # slip without opening
 

@@ -12,9 +12,10 @@ import numpy as np
 import pytest
 
 import masonryfw as mf
+import masonryfw.plugin_api as mfp
 
-ROLE = mf.flags("block_role")
-STATE = mf.flags("interface_state")
+ROLE = mfp.flags("block_role")
+STATE = mfp.flags("interface_state")
 SUPPORTS = [ROLE["fixed_support"], ROLE["moving_support"]]
 FAST_CASES = ["test-12c", "panel-3", "facade-2"]
 MU = np.tan(np.radians(21.8))  # the paper's friction angle (datasets/README.md: mu = 0.4)
@@ -84,11 +85,11 @@ def test_la_12c_paper_mechanism_is_admissible_but_not_optimal(walls):
     u[right] = (mu, -(1 - mu**2), 0.0)
     u[moving] = (0.0, -1.0, 0.0)
 
-    opening, slip = mf.relative_motion(model, u, "small")
+    opening, slip = mfp.relative_motion(model, u, "small")
     ground = np.isin(model.block_role.values[model.interface_blocks.values], SUPPORTS).all(axis=1)
     assert np.all((opening - mu * np.abs(slip))[~ground] >= -1e-12)
 
-    alpha_paper = -(mf.block_loads(model, "dead") * u).sum() / (mf.block_loads(model, "live") * u).sum()
+    alpha_paper = -(mfp.block_loads(model, "dead") * u).sum() / (mfp.block_loads(model, "live") * u).sum()
     weight_right = -model.dead_load.values[right, 1].sum()
     reaction = model.dead_load.values[moving, 1].sum()
     assert alpha_paper == pytest.approx(1 - (1 - mu**2) * weight_right / reaction, rel=1e-12)
@@ -113,10 +114,10 @@ def test_la_facades_left_part_stays_and_right_part_follows_the_support(walls, ca
     left = (role == ROLE["unit"]) & (model.block_centroid_x.values < settling_start - 0.3)
     label = result.macro_block.values
     assert np.all(label[left] == label[fixed[0]])
-    assert np.abs(mf.block_motion(result)[left]).max() < 1e-6
+    assert np.abs(mfp.block_motion(result)[left]).max() < 1e-6
     blocks, sides = model.interface_blocks.values, np.isin(model.interface_blocks.values, moving)
     on_support = blocks[sides[:, 0], 1]
-    assert np.all(mf.block_motion(result)[on_support, 1] < -0.5)
+    assert np.all(mfp.block_motion(result)[on_support, 1] < -0.5)
 
 
 def test_la_12c_with_the_centroid_over_the_fixed_support_gives_the_papers_two_blocks(walls):
@@ -134,7 +135,7 @@ def test_la_12c_with_the_centroid_over_the_fixed_support_gives_the_papers_two_bl
     assert groups.size == 2
     fixed_group = label[model.block_role.values == ROLE["fixed_support"]][0]
     falling = unit & (label != fixed_group)
-    u = mf.block_motion(result)
+    u = mfp.block_motion(result)
     assert np.abs(u[unit & ~falling]).max() < 1e-6
     assert np.ptp(u[falling], axis=0) == pytest.approx([0, 0, 0], abs=1e-6)  # one rigid translation
     assert u[falling][0, 1] < -0.5 and u[falling][0, 2] == pytest.approx(0, abs=1e-6)

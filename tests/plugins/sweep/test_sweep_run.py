@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 
 import masonryfw as mf
+import masonryfw.plugin_api as mfp
 from masonryfw_sweep import failed_points, plan_sweep, run_sweep
 
 STARTS = (0.5, 0.8, 1.2)  # 1.2 lies beyond the settling support's end (1.1): a SpecError at build
@@ -55,7 +56,7 @@ def test_values_equal_single_solves_in_process(grid_run, reference_solve):
             assert int(point.status) == 0
             for name, variable in (("alpha", "collapse_multiplier"), ("collapse_reaction", "moving_support_reaction")):
                 assert float(point[name]) == pytest.approx(float(reference[variable]), rel=1e-12, abs=1e-12), name
-            masonry = mf.masonry_blocks(reference.block_role.values)
+            masonry = mfp.masonry_blocks(reference.block_role.values)
             assert float(point.macro_blocks) == np.unique(reference.macro_block.values[masonry]).size
             stored = mf.open_dataset(folder / str(point.result_path.values))
             assert float(stored.collapse_multiplier) == float(point.alpha)

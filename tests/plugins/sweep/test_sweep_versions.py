@@ -17,16 +17,17 @@ SOLVER = '''
 import xarray as xr
 
 import masonryfw as mf
+import masonryfw.plugin_api as mfp
 
 
 def solve(model, options, progress):
     alpha = 0.5
-    return xr.Dataset({"collapse_multiplier": ((), alpha, mf.variable_attrs("collapse_multiplier"))})
+    return xr.Dataset({"collapse_multiplier": ((), alpha, mfp.variable_attrs("collapse_multiplier"))})
 
 
-@mf.hookimpl
+@mfp.hookimpl
 def masonryfw_solvers():
-    return [mf.Solver("half", "alpha = one half", solve, "1.0")]
+    return [mfp.Solver("half", "alpha = one half", solve, "1.0")]
 '''
 
 
