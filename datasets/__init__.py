@@ -21,7 +21,7 @@ CASE_NAMES = (
 
 
 #: Drawn example walls (``datasets/drawings``, see its ``generate.py``): a spec with ``[geometry]`` each.
-DRAWN_NAMES = ("lact3-wall", "lact3-portal", "lact3-arch", "arch-settlement", "stepped-units")
+DRAWN_NAMES = ("lact3-wall", "lact3-portal", "lact3-arch", "arch-settlement", "stepped-units", "gable-house")
 #: Walls over a settlement profile (``[settlement]``, docs/settlements.md and docs/tunnels.md).
 PROFILE_NAMES = ("facade-1-trough", "tunnel-facade")
 #: Every name :func:`bundled_spec_path` knows.

@@ -297,11 +297,13 @@ def render(
     kind: str | None = None,
     options: Mapping[str, Any] | None = None,
     ax=None,
+    size: tuple[float, float] | None = None,
 ):
     """Draw ``datasets`` with the plotter called ``kind`` (default: the only one installed).
 
     Draws into ``ax`` when given, else into a new :class:`matplotlib.figure.Figure`
-    (no pyplot, no GUI backend), one panel-width wider per dataset for a ``side_by_side`` kind.
+    (no pyplot, no GUI backend) of ``size`` (width, height) inches, by default
+    :data:`FIGURE_SIZE`, one panel-width wider per dataset for a ``side_by_side`` kind.
     Returns the figure.
     """
     record: Plotter = lookup("plotter", kind).record
@@ -311,9 +313,47 @@ def render(
         from matplotlib.figure import Figure
 
         width = max(FIGURE_SIZE[0], PANEL_WIDTH * len(datasets)) if record.side_by_side else FIGURE_SIZE[0]
-        ax = Figure(figsize=(width, FIGURE_SIZE[1]), layout="constrained").add_subplot()
+        ax = Figure(figsize=size or (width, FIGURE_SIZE[1]), layout="constrained").add_subplot()
     _call_plugin("plotter", record.name, record.plot, datasets, ax, resolved)
+    if size is not None:  # asked for: it wins over a size the kind chose for itself
+        ax.figure.set_size_inches(*size)
+        _fit_text(ax.figure)
     return ax.figure
+
+
+#: The smallest share of its size a figure's text is scaled to, to fit a page asked for.
+SMALLEST_TEXT = 0.5
+
+
+def _fit_text(figure) -> None:
+    """Scale the text of ``figure`` down until what is drawn fits its page (titles and legends beside the axes
+    stick out of a small one), at most to :data:`SMALLEST_TEXT` of its size; a page still too small is warned
+    of."""
+    import warnings
+
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.text import Text
+
+    canvas = FigureCanvasAgg(figure)
+    width, height = figure.get_size_inches()
+    scale = 1.0
+    for _ in range(6):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", UserWarning)  # constrained layout on a page too small: handled here
+            canvas.draw()
+            box = figure.get_tightbbox(canvas.get_renderer())
+        margin = 0.01  # inches
+        if box.x0 >= -margin and box.y0 >= -margin and box.x1 <= width + margin and box.y1 <= height + margin:
+            return
+        spill = max(box.width / width, box.height / height, 1.03)  # at least a step when it is only off-centre
+        factor = max(SMALLEST_TEXT / scale, 0.97 / spill)
+        if scale <= SMALLEST_TEXT + 1e-9:
+            break
+        scale *= factor
+        for text in figure.findobj(Text):
+            text.set_fontsize(text.get_fontsize() * factor)
+    warnings.warn(f"a figure of {width:.3g} x {height:.3g} in is too small for what it shows, even with its text at "
+                  f"{SMALLEST_TEXT:.0%} of its size: ask for a larger --size", UserWarning, stacklevel=3)
 
 
 def plot_table(

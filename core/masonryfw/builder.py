@@ -46,18 +46,18 @@ from .imported import build_drawn, is_drawn, parse_drawn_spec, resolved_drawing
 from .inputs import fits_in_memory
 from .material import Material
 from .model import checked_model
+from .outlined import build_outlined, is_outlined
 from .plausibility import warn_implausible
-from .profiles import SETTLEMENT_KEYS, Profile, profile_segments, read_profile, with_profile
+from .profiles import SETTLEMENT_KEYS, Profile, read_profile, with_profile
 from .roles import ROLE
 from .spec import (
     LENGTH_UNITS,
     SpecTable,
-    check_pivot,
     read_loading,
     read_material,
-    read_motion,
     read_spec,
 )
+from .supports import Support, profile_supports, read_supports, support_blocks
 
 if TYPE_CHECKING:  # annotations only
     import xarray as xr
@@ -126,20 +126,6 @@ class Opening:
 
 
 @dataclass(frozen=True)
-class Support:
-    """A support range along the base, in SI."""
-
-    name: str
-    kind: str
-    start: float
-    end: float
-    motion: str
-    pivot: tuple[float, float] | None
-    rate: float = 1.0
-    ground: blocks.GroundEdge | None = None
-
-
-@dataclass(frozen=True)
 class Wall:
     """A validated spec, every length in metres."""
 
@@ -199,7 +185,7 @@ def parse_spec(spec: dict) -> Wall:
     material = read_material(top)
     if top.has("settlement") and top.has("supports"):
         raise SpecError("spec tables 'settlement' and 'supports': give one of them (the profile makes the supports)")
-    supports = () if top.has("settlement") else _supports(top, width)
+    supports = () if top.has("settlement") else read_supports(top, 0.0, width)
     kind, direction = read_loading(top, top.has("settlement") or any(s.kind == "moving" for s in supports))
 
     result = Wall(
@@ -227,22 +213,11 @@ def parse_spec(spec: dict) -> Wall:
                        f"{sized} over {segments:,} ground segments of {table.key('segment')} = "
                        f"{result.profile.segment:.3g} m (about {blocks_expected + segments:.3g} blocks)",
                        "a longer segment")
-        result = replace(result, supports=_profile_supports(result))
+        mx0, mx1, my0, _, _ = masonry_blocks(result)
+        bottom = my0 <= result.tol
+        result = replace(result, supports=profile_supports(result.profile, 0.0, result.width,
+                                                           np.c_[mx0[bottom], mx1[bottom]]))
     return result
-
-
-def _profile_supports(wall: Wall) -> tuple[Support, ...]:
-    """The support segments of the ``[settlement]`` profile under the wall's bottom course (a continuous
-    ground: :mod:`masonryfw.profiles`)."""
-    x0, x1, y0, _, _ = masonry_blocks(wall)
-    bottom = y0 <= wall.tol
-    segments = profile_segments(wall.profile, 0.0, wall.width, np.c_[x0[bottom], x1[bottom]])
-    return tuple(
-        Support(f"segment {k} [{s.start:.6g}, {s.end:.6g}] m", "moving", s.start, s.end, "ground", None,
-                ground=blocks.GroundEdge((s.start, s.end), 0.0, s.down, s.horizontal))
-        if s.moving else Support(f"segment {k} [{s.start:.6g}, {s.end:.6g}] m", "fixed", s.start, s.end, "none", None)
-        for k, s in enumerate(segments)
-    )
 
 
 def _whole_courses(value: float, unit_height: float, key: str, shown) -> int:
@@ -253,31 +228,6 @@ def _whole_courses(value: float, unit_height: float, key: str, shown) -> int:
         raise SpecError(f"spec key {key!r} = {shown!r}: must be a whole number of courses "
                         f"({ratio:.4g} times unit.height)")
     return int(count)
-
-
-def _supports(top: SpecTable, width: float) -> tuple[Support, ...]:
-    table = top.raw("supports")
-    if not isinstance(table, dict) or not table:
-        raise SpecError(f"spec key 'supports' = {table!r}: must hold at least one [supports.<name>] table")
-    tol = POSITION_TOLERANCE * width
-    supports = []
-    for name in table:
-        entry = SpecTable(table[name], f"supports.{name}", _SUPPORT_KEYS, top.scale)
-        kind = entry.choice("kind", ("fixed", "moving"))
-        start = entry.number("start", length=True, minimum=0.0)
-        end = entry.number("end", length=True)
-        if end > width + tol:
-            raise SpecError(f"spec key {entry.key('end')!r} = {entry.raw('end')!r}: beyond the wall's right end")
-        if end <= start + tol:
-            raise SpecError(f"spec key {entry.key('end')!r} = {entry.raw('end')!r}: must exceed start")
-        motion, pivot, rate = read_motion(entry, kind)
-        check_pivot(entry, pivot, 0.5 * (start + end), tol)
-        supports.append(Support(name, kind, min(start, width), min(end, width), motion, pivot, rate))
-    ordered = sorted(supports, key=lambda s: s.start)
-    for left, right in zip(ordered, ordered[1:]):
-        if right.start < left.end - tol:
-            raise SpecError(f"spec keys 'supports.{left.name}' and 'supports.{right.name}': the ranges overlap")
-    return tuple(supports)
 
 
 def _openings(top: SpecTable, wall: Wall) -> tuple[Opening, ...]:
@@ -439,16 +389,13 @@ def masonry_blocks(wall: Wall):
 # --------------------------------------------------------------------------- the dataset
 
 
-def _support_label(name: str) -> str:
-    """How errors name a support: its spec key, or the profile segment."""
-    return f"settlement {name}" if name.startswith("segment ") else f"spec key 'supports.{name}'"
-
-
 def build(spec, *, validate: bool = True) -> xr.Dataset:
     """Build the model dataset of a wall spec (a dict, a path, a Traversable or TOML text).
 
     A spec with a ``[geometry]`` table is a drawn wall (:mod:`masonryfw.imported`;
-    its drawing's path is relative to the spec file, else to the working folder).
+    its drawing's path is relative to the spec file, else to the working folder); a wall given by its outline
+    (a drawing's ``outline_layer``, a gable, shaped openings, an English or Flemish bond, a height that is not
+    whole courses) gets its bond laid (:mod:`masonryfw.outlined`).
 
     Blocks come course by course, left to right (units and lintels), then the
     supports in spec order; interfaces, kinds and loads as every model gets them
@@ -458,8 +405,12 @@ def build(spec, *, validate: bool = True) -> xr.Dataset:
     :class:`masonryfw.PlausibilityWarning` each (:mod:`masonryfw.plausibility`).
     """
     spec_dict, text, base_dir = read_spec(spec)
-    model = build_drawn(spec_dict, text, base_dir, validate) if is_drawn(spec_dict) \
-        else _build_parametric(spec_dict, text, validate)
+    if is_outlined(spec_dict):
+        model = build_outlined(spec_dict, text, base_dir, validate)
+    elif is_drawn(spec_dict):
+        model = build_drawn(spec_dict, text, base_dir, validate)
+    else:
+        model = _build_parametric(spec_dict, text, validate)
     warn_implausible(model)
     return model
 
@@ -467,21 +418,14 @@ def build(spec, *, validate: bool = True) -> xr.Dataset:
 def _build_parametric(spec_dict: dict, text: str, validate: bool) -> xr.Dataset:
     wall = parse_spec(spec_dict)
     mx0, mx1, my0, my1, m_role = masonry_blocks(wall)
-    s_x0 = np.array([s.start for s in wall.supports])
-    s_x1 = np.array([s.end for s in wall.supports])
+    s_x0, s_x1, s_y0, s_y1, supports = support_blocks(wall.supports, 0.0, wall.unit_height)
     x0, x1 = np.concatenate((mx0, s_x0)), np.concatenate((mx1, s_x1))
-    y0 = np.concatenate((my0, np.full(s_x0.size, -wall.unit_height)))
-    y1 = np.concatenate((my1, np.zeros(s_x0.size)))
+    y0, y1 = np.concatenate((my0, s_y0)), np.concatenate((my1, s_y1))
     role = np.concatenate((m_role, np.full(s_x0.size, ROLE["fixed_support"], dtype=np.int8)))
-    supports = [blocks.Support(_support_label(s.name), s.kind, s.motion, s.pivot, s.rate, s.ground)
-                for s in wall.supports]
-    material = wall.material
     attrs = {"title": wall.title, "source_spec": text}
     if wall.description:
         attrs["comment"] = wall.description
-    ds = blocks.model_from_blocks(*blocks.rectangle_nodes(x0, x1, y0, y1), role, wall.thickness, material, supports,
-                                  wall.loading, wall.tilt_direction, attrs)
+    ds = blocks.model_from_blocks(*blocks.rectangle_nodes(x0, x1, y0, y1), role, wall.thickness, wall.material,
+                                  supports, wall.loading, wall.tilt_direction, attrs)
     ds = with_profile(ds, wall.profile)
     return checked_model(ds, repr(wall.title)) if validate else ds
-
-

@@ -11,6 +11,7 @@ import json
 import shlex
 import signal
 import sys
+import textwrap
 import warnings
 from pathlib import Path
 from typing import Any
@@ -21,7 +22,7 @@ import numpy as np
 import masonryfw as mf
 import masonryfw.plugin_api as mfp
 from masonryfw import inputs, signals
-from masonryfw.command_kit import OPTIONS, PROGRESS, command_line
+from masonryfw.command_kit import FIGURE, OPTIONS, PROGRESS, command_line
 from masonryfw.locks import release_all
 from masonryfw.registry import command_plugin, installed_plugins, plugin_commands
 
@@ -109,6 +110,8 @@ def build(spec: str, output: str | None) -> None:
     model = mf.build(spec_path)
     mf.save(model, out, command=command_line(), protect=inputs)
     click.echo(f"wrote {out}: {model.sizes['block']} blocks, {model.sizes.get('interface', 0)} interfaces")
+    for note in filter(None, str(model.attrs.get("laying_notes", "")).splitlines()):
+        click.echo(f"  laid: {note}")
 
 
 @cli.command(name="check")
@@ -245,6 +248,9 @@ def solve(model: str, solver: str, output: str | None, options: dict[str, str], 
         result, [name for name in result.data_vars if name not in plan.model.variables])
     stop = f"; {result.attrs['stop_reason']}" if result.attrs.get("stop_reason") else ""
     click.echo(f"result: {out}")
+    headline = mf.headline_text(result)
+    if headline:
+        click.echo(f"in short: {headline}")
     click.echo(f"{solver}: {numbers + stop + '; ' if numbers else ''}wall time {result.attrs['wall_time_s']:.3g} s")
     stages = mf.stages_text(result)
     if stages:
@@ -291,6 +297,9 @@ def compare(
         click.echo(f"{letter}: {path} ({mf.result_label(ds)})")
     click.echo("")
     click.echo(mfp.text_table(["", *letters], mfp.headline_rows(datasets)))
+    r0 = mfp.r0_text(datasets, letters)
+    if r0:
+        click.echo(textwrap.fill(r0, 100))
     click.echo("")
     rows = mfp.score_rows(comparisons)
     header = [f"{comparisons[0].attrs['comparator']} score", *(f"{letters[i]}-{letters[j]}" for i, j in pairs)]
@@ -317,9 +326,10 @@ def _comparison_json(results, pairs, comparisons) -> dict:
               help="Image file (png, svg, pdf), or a .csv file of the curves' numbers.")
 @click.option("--format", "file_format", type=click.Choice(["png", "svg", "pdf", "csv"]), default=None,
               help="[default: from the output's suffix] csv: the numbers behind the curves (history).")
+@FIGURE
 @OPTIONS
 def plot(results: tuple[str, ...], kind: str | None, output: str, file_format: str | None,
-         options: dict[str, str]) -> None:
+         size: tuple[float, float] | None, dpi: int, options: dict[str, str]) -> None:
     """Plot one or more RESULTS (result or model files, spec files, bundled case names) with a plotter plugin.
 
     Kinds that overlay (history) or set side by side (compare) take several results.
@@ -335,9 +345,10 @@ def plot(results: tuple[str, ...], kind: str | None, output: str, file_format: s
         click.echo(f"table: {output} ({len(rows)} rows)")
         return
     mfp.check_output_path(output, inputs, mfp.FIGURE_FORMATS)
-    figure = mf.render([_open_input(r, validate=kind != "model") for r in results], kind, options)
-    mf.save_figure(figure, output, protect=inputs)
-    click.echo(f"plot: {output}")
+    figure = mf.render([_open_input(r, validate=kind != "model") for r in results], kind, options, size=size)
+    mf.save_figure(figure, output, protect=inputs, dpi=dpi, cropped=size is None)
+    width, height = figure.get_size_inches()
+    click.echo(f"plot: {output} ({width:.3g} x {height:.3g} in at {dpi} dpi)")
 
 
 def _show_warning(message, category, filename, lineno, file=None, line=None) -> None:

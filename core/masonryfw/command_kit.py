@@ -42,6 +42,36 @@ class Length(click.ParamType):
 #: ``type=LENGTH``: a positive, finite length in metres.
 LENGTH = Length()
 
+#: Inches per unit a figure's ``--size`` may be given in.
+SIZE_UNITS = {"in": 1.0, "cm": 1 / 2.54, "mm": 1 / 25.4}
+
+
+class FigureSize(click.ParamType):
+    """A figure's ``WIDTHxHEIGHT`` in inches, or with ``in``, ``cm`` or ``mm`` after it (``180x120mm``): each side
+    positive, at most 100 inches."""
+
+    name = "WxH[in|cm|mm]"
+
+    def convert(self, value, param, ctx) -> tuple[float, float]:
+        text = str(value).strip().lower()
+        unit = next((u for u in SIZE_UNITS if text.endswith(u)), "in")
+        sides = text.removesuffix(unit).split("x")
+        try:
+            width, height = (float(side) * SIZE_UNITS[unit] for side in sides)
+        except (TypeError, ValueError):
+            self.fail(f"{value!r} is not WIDTHxHEIGHT (inches, or with cm or mm after it: 180x120mm)", param, ctx)
+        if not all(math.isfinite(side) and 0.5 <= side <= 100 for side in (width, height)):
+            self.fail(f"{value!r}: each side between 0.5 and 100 inches (1.3 and 254 cm)", param, ctx)
+        return width, height
+
+
+#: ``@FIGURE``: ``--dpi`` and ``--size`` of a figure file.
+def FIGURE(command):  # noqa: N802 - a decorator named as the other option sets
+    command = click.option("--size", type=FigureSize(), default=None,
+                           help="Figure size WIDTHxHEIGHT in inches, or 180x120mm / 18x12cm [default: the kind's].")(command)
+    return click.option("--dpi", type=click.IntRange(50, 1200), default=200, show_default=True,
+                        help="Resolution of a PNG (dots per inch of --size).")(command)
+
 #: ``@PROGRESS``: ``--progress/--no-progress`` (``progress_bar`` draws what it asks for).
 PROGRESS = click.option("--progress/--no-progress", default=None,
                         help="Progress on stderr [default: a bar on a terminal, a line a stage or 10 % elsewhere].")

@@ -29,13 +29,20 @@ def describe_model(model: xr.Dataset) -> list[str]:
     profile = model_profile(model)
     if profile is not None:
         lines.append(f"settlement profile: {profile_text(profile)}")
-    return lines + ["supports:", *_support_lines(model), "loads:", *_load_lines(model)]
+    notes = [f"  {note}" for note in str(model.attrs.get("laying_notes", "")).splitlines() if note]
+    return lines + (["laid in its outline:", *notes] if notes else []) + ["supports:", *_support_lines(model), "loads:",
+                                                                          *_load_lines(model)]
+
+
+#: Flags a count names only where some block has them (few walls have arches).
+SAID_WHEN_PRESENT = ("voussoir",)
 
 
 def _counts(values: np.ndarray, flag_variable: str) -> str:
     meanings = flags(flag_variable)
     counts = np.bincount(np.asarray(values, dtype=np.int64), minlength=max(meanings.values()) + 1)
-    return ", ".join(f"{meaning.replace('_', ' ')} {counts[value]}" for meaning, value in meanings.items())
+    return ", ".join(f"{meaning.replace('_', ' ')} {counts[value]}" for meaning, value in meanings.items()
+                     if counts[value] or meaning not in SAID_WHEN_PRESENT)
 
 
 def _span(values: np.ndarray) -> str:

@@ -109,6 +109,56 @@ def read_drawing(path: str | Path, drawing_unit: str | None = None, chord_tolera
     return clean(rings, snap, ignored)
 
 
+#: An elevation's arcs (an arched window's head) become chords within this [m] unless the spec says otherwise.
+ELEVATION_CHORD = 1e-3
+
+
+@dataclass(frozen=True)
+class Elevation:
+    """An architect's elevation in metres: the wall's outline and its openings (each with what it was in the
+    drawing, for messages)."""
+
+    outline: np.ndarray  # (n, 2)
+    outline_source: str
+    openings: tuple[np.ndarray, ...]
+    opening_sources: tuple[str, ...]
+
+
+def read_elevation(path: str | Path, drawing_unit: str | None, outline_layer: str, openings_layer: str | None,
+                   chord_tolerance: float | None = None) -> Elevation:
+    """The outline (the one closed polyline, or polygon, on ``outline_layer``) and the openings of an elevation
+    drawing: those on ``openings_layer``, else every other closed one inside the outline, and the holes of a
+    GeoJSON outline. Units as :func:`read_drawing`; arcs become chords within ``chord_tolerance`` (drawing units,
+    default :data:`ELEVATION_CHORD`); a SpecError names the layer or the entity at fault."""
+    path = drawing_file(path)
+    kind = SUFFIXES.get(path.suffix.lower())
+    if kind is None:
+        raise SpecError(f"drawing {str(path)!r}: unknown file type {path.suffix!r}; use {', '.join(sorted(SUFFIXES))}")
+    if kind == "dxf":
+        rings, unit, _ = _read_dxf(path, drawing_unit, chord_tolerance, ELEVATION_CHORD)
+    else:
+        if drawing_unit is None:
+            raise SpecError(f"drawing {str(path)!r}: a {kind.upper()} file carries no unit; "
+                            "give geometry.drawing_unit (m, cm or mm)")
+        rings, unit = (_read_csv(path) if kind == "csv" else _read_geojson(path, holes=True)), drawing_unit
+    outlines = [r for r in rings if r.layer == outline_layer]
+    if len(outlines) != 1:
+        layers = ", ".join(sorted({r.layer for r in rings})) or "none"
+        raise SpecError(f"drawing {path.name!r}: {len(outlines)} closed polyline(s) on outline_layer "
+                        f"{outline_layer!r}; an elevation has one outline (the drawing's layers: {layers})")
+    scale = DRAWING_UNITS[unit]
+    outline = np.c_[outlines[0].x, outlines[0].y] * scale
+    if openings_layer is not None:
+        chosen = [r for r in rings if r.layer in (openings_layer, f"{outline_layer}/hole")]
+    else:
+        import shapely
+
+        shape = shapely.Polygon(outline / scale)
+        chosen = [r for r in rings if r is not outlines[0] and shapely.Polygon(np.c_[r.x, r.y]).within(shape)]
+    return Elevation(outline, outlines[0].source, tuple(np.c_[r.x, r.y] * scale for r in chosen),
+                     tuple(r.source for r in chosen))
+
+
 def _counted(ignored: dict[str, int]) -> str:
     return ", ".join(f"{n} {kind}" for kind, n in sorted(ignored.items()))
 
@@ -182,7 +232,9 @@ def read_dxf_lines(path: str | Path, layer: str | None = None) -> DxfLines:
     return DxfLines(tuple(lines), tuple(sources), int(doc.header.get("$INSUNITS", 0)))
 
 
-def _read_dxf(path: Path, drawing_unit: str | None, chord_tolerance: float | None):
+def _read_dxf(path: Path, drawing_unit: str | None, chord_tolerance: float | None, default_chord: float | None = None):
+    """The closed polylines of a DXF drawing, its unit and the entities left out. An arc needs a chord
+    tolerance (drawing units): ``chord_tolerance``, else ``default_chord`` metres, else an error."""
     doc = _open_dxf(path)
     unit = drawing_unit
     if unit is None:
@@ -191,6 +243,8 @@ def _read_dxf(path: Path, drawing_unit: str | None, chord_tolerance: float | Non
         if unit is None:
             raise SpecError(f"drawing {str(path)!r}: its $INSUNITS = {code} is not m, cm or mm "
                             "(1 = inches is common in drawings made in mm); give geometry.drawing_unit")
+    if chord_tolerance is None and default_chord is not None:
+        chord_tolerance = default_chord / DRAWING_UNITS[unit]
     rings: list[_Ring] = []
     ignored: Counter = Counter()
     for entity in _flat_entities(doc.modelspace()):
@@ -277,7 +331,9 @@ def _found_columns(columns: list[str]) -> str:
     return " (its first row is not a row of column names: is it a CSV drawing?)"
 
 
-def _read_geojson(path: Path) -> list[_Ring]:
+def _read_geojson(path: Path, holes: bool = False) -> list[_Ring]:
+    """One ring per Polygon feature; with ``holes``, a polygon's holes too (rings on the layer ``<layer>/hole``:
+    an outline's openings), else a hole is refused."""
     try:
         data = json.loads(read_text(path, "drawing"))
     except ValueError as exc:  # JSONDecodeError says where (line, column), not what is there
@@ -295,9 +351,12 @@ def _read_geojson(path: Path) -> list[_Ring]:
         if not isinstance(geometry, dict) or geometry.get("type") != "Polygon":
             kind = geometry.get("type") if isinstance(geometry, dict) else f"JSON {_json_kind(geometry)}"
             raise SpecError(f"{where}: a {kind}, not a Polygon; one Polygon per block")
-        ring = _polygon_ring(geometry.get("coordinates"), where)
+        outline, *inner = _polygon_rings(geometry.get("coordinates"), where, holes)
         name = properties.get("name", properties.get("id", index))
-        rings.append(_Ring(ring[:, 0], ring[:, 1], str(properties.get("layer", "0")), f"feature {name}"))
+        layer = str(properties.get("layer", "0"))
+        rings.append(_Ring(outline[:, 0], outline[:, 1], layer, f"feature {name}"))
+        rings += [_Ring(hole[:, 0], hole[:, 1], f"{layer}/hole", f"feature {name} hole {k}")
+                  for k, hole in enumerate(inner)]
     return rings
 
 
@@ -311,18 +370,22 @@ def _is_position(value) -> bool:
         isinstance(v, (int, float)) and not isinstance(v, bool) for v in value)
 
 
-def _polygon_ring(coordinates, where: str) -> np.ndarray:
-    """The outline of a GeoJSON Polygon's ``coordinates`` (a list of rings, the first the outline) as an
-    ``(n, 2)`` array, or a SpecError saying what is wrong where (never quoting more than a position)."""
+def _polygon_rings(coordinates, where: str, holes: bool) -> list[np.ndarray]:
+    """The rings of a GeoJSON Polygon's ``coordinates`` (the outline first, then its holes when ``holes``) as
+    ``(n, 2)`` arrays, or a SpecError saying what is wrong where (never quoting more than a position)."""
     if not isinstance(coordinates, list) or not coordinates:
         raise SpecError(f"{where}: its coordinates are a JSON {_json_kind(coordinates)}"
                         f"{' (empty)' if coordinates == [] else ''}, not a list of rings")
     if _is_position(coordinates[0]):
         raise SpecError(f"{where}: its coordinates are one ring of [x, y] positions, not a list of rings; "
                         "wrap the ring in one more [ ]")
-    if len(coordinates) != 1:
-        raise SpecError(f"{where}: a polygon with {len(coordinates) - 1} hole(s); a block is one outline without holes")
-    ring = coordinates[0]
+    if len(coordinates) != 1 and not holes:
+        raise SpecError(f"{where}: a polygon with {len(coordinates) - 1} hole(s); a block is one outline without holes"
+                        " (an elevation's outline with openings is laid by geometry.outline_layer)")
+    return [_ring_positions(ring, where if k == 0 else f"{where} hole {k - 1}") for k, ring in enumerate(coordinates)]
+
+
+def _ring_positions(ring, where: str) -> np.ndarray:
     if isinstance(ring, list) and ring and isinstance(ring[0], list) and ring[0] and isinstance(ring[0][0], list):
         raise SpecError(f"{where}: its coordinates are nested one level too deep (a Polygon's are [[[x, y], ...]]; "
                         "a MultiPolygon's are not read)")

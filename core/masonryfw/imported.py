@@ -61,8 +61,9 @@ GROUND_KEYS = ("ground_layer", "ground_select")
 _GEOMETRY_KEYS = ("dxf", "polygons", "drawing_unit", "chord_tolerance", "snap_tolerance", "layers")
 _SUPPORT_KEYS = ("kind", "select", "layer", "at", "motion", "pivot", "rate")
 _PARAMETRIC = {
-    "unit": "the drawing gives the blocks",
-    "bond": "the drawing gives the blocks",
+    "unit": "the drawing gives the blocks; to lay a bond in an outline, name its layer: geometry.outline_layer",
+    "bond": "the drawing gives the blocks; to lay a bond in an outline, name its layer: geometry.outline_layer",
+    "heads": "the drawing gives the blocks; to lay a bond in an outline, name its layer: geometry.outline_layer",
     "openings": "openings are drawn (left empty) in the drawing",
 }
 
@@ -209,6 +210,7 @@ def build_drawn(spec_dict: dict, text: str, base_dir: Path | None, validate: boo
         raise SpecError(f"spec key {spec.drawing_key!r} = {spec.drawing!r}: no such file ({path})")
     drawing = read_drawing(path, spec.drawing_unit, spec.chord_tolerance, spec.snap_tolerance)
     kept = np.array([spec.layers.get(layer, "unit") != "ignore" for layer in drawing.layers])
+    _refuse_an_elevation(drawing, kept, path)
     attrs = {
         "title": spec.title,
         "source_spec": text,
@@ -229,6 +231,34 @@ def build_drawn(spec_dict: dict, text: str, base_dir: Path | None, validate: boo
         raise ModelError(f"model {spec.title!r} from drawing {path.name!r} is invalid "
                          f"({len(exc.problems)} problem(s))",
                          [_labelled(p, labels) for p in exc.problems]) from None
+
+
+def _refuse_an_elevation(drawing: Drawing, kept: np.ndarray, path: Path) -> None:
+    """A drawing of an outline and its openings (blocks inside a block), or of one block the size of the wall,
+    is not a drawing of blocks: refused, saying how to lay a bond in it (an architect's elevation took every
+    closed polyline for a brick, or built one block 6.5 m x 10.5 m)."""
+    import shapely
+
+    shapes = polygons(drawing.node_x, drawing.node_y, drawing.block_node_count)
+    chosen = np.flatnonzero(kept)
+    inner, outer = shapely.STRtree(shapes[chosen]).query(shapely.point_on_surface(shapes[chosen]), "within")
+    nested = inner != outer
+    howto = ("lay a bond in it: [geometry] outline_layer = {outline!r}{openings}, with [unit] (length, course "
+             "height) and, if you like, [bond] and [heads] (docs/import.md)")
+    if nested.any():
+        container = chosen[np.bincount(outer[nested], minlength=chosen.size).argmax()]
+        held = chosen[inner[nested][outer[nested] == np.flatnonzero(chosen == container)[0]]]
+        layers = sorted({drawing.layers[b] for b in held})
+        x0, y0, x1, y1 = shapes[container].bounds
+        raise SpecError(f"drawing {path.name!r}: {drawing.label(container)} ({x1 - x0:.4g} x {y1 - y0:.4g} m) holds "
+                        f"{held.size} other closed polyline(s) (on layer {', '.join(layers)}): an elevation's outline "
+                        "and its openings, not one polyline per block; " + howto.format(
+                            outline=drawing.layers[container], openings=f", openings_layer = {layers[0]!r}"))
+    if chosen.size == 1:
+        x0, y0, x1, y1 = shapes[chosen[0]].bounds
+        raise SpecError(f"drawing {path.name!r}: its masonry would be one block, {drawing.label(chosen[0])} "
+                        f"({x1 - x0:.4g} x {y1 - y0:.4g} m); a wall of one block is no masonry: if it is the wall's "
+                        "outline, " + howto.format(outline=drawing.layers[chosen[0]], openings=""))
 
 
 def _masonry_roles(spec: DrawnSpec, drawing: Drawing, masonry: np.ndarray) -> list[int]:

@@ -426,14 +426,17 @@ def save(
 FIGURE_FORMATS = (".png", ".svg", ".pdf")
 
 
-def save_figure(figure, path: str | os.PathLike, *, protect=(), dpi: float | None = None) -> Path:
-    """Write a matplotlib ``figure`` to ``path`` (.png, .svg or .pdf) atomically, cropped to what is drawn
-    (no empty margins); never onto ``protect``."""
+def save_figure(figure, path: str | os.PathLike, *, protect=(), dpi: float | None = None, cropped: bool = True
+                ) -> Path:
+    """Write a matplotlib ``figure`` to ``path`` (.png, .svg or .pdf) atomically, cropped to what is drawn (no
+    empty margins), or at exactly the figure's size (``cropped=False``: a size asked for); never onto
+    ``protect``."""
     target = check_output_path(path, protect, FIGURE_FORMATS)
     suffix = target.suffix.lower()
     return write_atomically({
         target: lambda temporary: figure.savefig(temporary, format=suffix[1:], dpi=dpi or "figure",
-                                                 bbox_inches="tight", pad_inches=0.04)}, path)[0]
+                                                 bbox_inches="tight" if cropped else None, pad_inches=0.04)},
+        path)[0]
 
 
 def save_text(text: str, path: str | os.PathLike, *, protect=(), suffixes: tuple[str, ...] = ()) -> Path:

@@ -1,14 +1,16 @@
-"""What a block is, by its ``block_role`` (the format's flags): masonry (units and lintels) or ground (fixed and
-moving supports). The one place the role codes are read; every other part of the house asks here."""
+"""What a block is, by its ``block_role`` (the format's flags): masonry (units, voussoirs and lintels) or ground
+(fixed and moving supports). The one place the role codes are read; every other part of the house asks here."""
 from __future__ import annotations
 
 import numpy as np
 
 from .schema import flags
 
-#: The role codes of the format: ``{"unit": 0, "lintel": 1, "fixed_support": 2, "moving_support": 3}``.
+#: The role codes of the format: ``{"unit": 0, "lintel": 1, "fixed_support": 2, "moving_support": 3, "voussoir": 4}``.
 ROLE = flags("block_role")
-MASONRY_ROLES = (ROLE["unit"], ROLE["lintel"])
+#: Masonry laid in joints: units, and voussoirs (the units of an arch, whose beds are the joints between them).
+JOINTED_ROLES = (ROLE["unit"], ROLE["voussoir"])
+MASONRY_ROLES = (*JOINTED_ROLES, ROLE["lintel"])
 SUPPORT_ROLES = (ROLE["fixed_support"], ROLE["moving_support"])
 
 
@@ -18,8 +20,13 @@ def support_blocks(role: np.ndarray) -> np.ndarray:
 
 
 def masonry_blocks(role: np.ndarray) -> np.ndarray:
-    """Units and lintels."""
+    """Units, voussoirs and lintels."""
     return np.isin(role, MASONRY_ROLES)
+
+
+def jointed_blocks(role: np.ndarray) -> np.ndarray:
+    """Units and voussoirs: the masonry of joints (not a lintel, one elastic piece)."""
+    return np.isin(role, JOINTED_ROLES)
 
 
 def moving_blocks(role: np.ndarray) -> np.ndarray:

@@ -27,6 +27,10 @@ if TYPE_CHECKING:  # annotations only
 #: The reaction history is at its plateau from the first settlement after which it stays within
 #: this share of the dead reaction of its final value.
 PLATEAU_SHARE = 0.01
+#: A history whose settlement records have a median unbalanced force ratio above this is dynamic, not
+#: quasi-static (the gable house's fdem run at the default loading rate: 0.18, its reaction swinging 92..146 kN;
+#: at a fifth of the rate 0.021 and 128..138 kN; Test 12C 0.0017; docs/fdem.md).
+QUASI_STATIC_RATIO = 0.05
 MISSING = "-"
 #: Scores a comparison table shows first, in this order; then any other scalar score of the comparator ...
 SHOWN_SCORES = ("crack_f1", "crack_jaccard", "crack_overlap", "crack_spearman", "macro_block_ari",
@@ -175,6 +179,12 @@ def key_numbers(result: xr.Dataset) -> list[KeyNumber]:
             numbers.append(KeyNumber(name, float(result[f"step_{name}"].values[-1]), "1" if "ratio" in name else "rad",
                                      what))
     numbers += _assessment_numbers(result)
+    if "unbalanced_ratio" in result.attrs:
+        numbers += [KeyNumber("unbalanced_ratio", float(result.attrs["unbalanced_ratio"]), "1",
+                              "median unbalanced force ratio of the settlement records (quasi-static under "
+                              f"{QUASI_STATIC_RATIO:g})"),
+                    KeyNumber("kinetic_energy_ratio", float(result.attrs.get("kinetic_energy_ratio", np.nan)), "1",
+                              "median kinetic over stored elastic energy of the settlement records")]
     derived = at_threshold(result)
     if "crack_indicator" in derived:
         numbers.append(KeyNumber("cracked_joints", float(np.count_nonzero(derived.crack_indicator.values)), "1",
@@ -200,6 +210,11 @@ class Row:
 
 def _mm(metres: float) -> str:
     return f"{1e3 * metres:.3g} mm"
+
+
+def force_text(newtons: float) -> str:
+    """A force as an engineer writes it: ``133.9 kN`` from a thousand newtons up, else ``985.2 N``."""
+    return f"{newtons / 1000:.4g} kN" if abs(newtons) >= 1000 else f"{newtons:.4g} N"
 
 
 def _crack_text(numbers: dict) -> str:
@@ -234,7 +249,7 @@ def stages_text(result: xr.Dataset) -> str:
     if "damage_category" in numbers:
         own = f"{_damage_name(numbers['damage_category'])}, widest crack {_crack_text(numbers)}"
     else:
-        own = f"alpha {numbers['alpha']:.4f}, collapse reaction {numbers.get('collapse_reaction', float('nan')):.4g} N"
+        own = f"alpha {numbers['alpha']:.4f}, collapse reaction {force_text(numbers.get('collapse_reaction', float('nan')))}"
     return (f"at S = {_mm(numbers['assessed_settlement'])}{_short_of_target(result)}: stage 1 {_stage_1(numbers)}; "
             f"stage 2 (LTSM) {_stage_2(numbers)}; stage 3 ({result_label(result)}) {own}")
 
@@ -274,14 +289,14 @@ def _damage_name(category: float) -> str:
 _HEADLINES = (
     ("alpha", "alpha", lambda n: f"{n['alpha']:.4f}",
      "collapse multiplier (limit analysis): the share of R0 the settling supports shed at collapse"),
-    ("collapse_reaction", "collapse reaction", lambda n: f"{n['collapse_reaction']:.4g} N",
+    ("collapse_reaction", "collapse reaction", lambda n: force_text(n['collapse_reaction']),
      "reaction on the settling supports when the mechanism forms, (1 - alpha) R0"),
-    ("dead_reaction", "dead reaction R0", lambda n: f"{n['dead_reaction']:.4g} N",
+    ("dead_reaction", "dead reaction R0", lambda n: force_text(n['dead_reaction']),
      "reaction of the settling ground under the weight alone (over a profile the settlement reaction: each "
      "part weighted by its settlement per unit of the settlement parameter, S_max for a trough)"),
-    ("minimum_reaction", "minimum reaction", lambda n: f"{n['minimum_reaction']:.4g} N at "
+    ("minimum_reaction", "minimum reaction", lambda n: f"{force_text(n['minimum_reaction'])} at "
      f"{_mm(n['minimum_reaction_settlement'])}", "smallest reaction of the history, and the settlement there"),
-    ("plateau_reaction", "plateau reaction", lambda n: f"{n['plateau_reaction']:.4g} N from "
+    ("plateau_reaction", "plateau reaction", lambda n: f"{force_text(n['plateau_reaction'])} from "
      f"{_mm(n['plateau_settlement'])}", "the reaction once it stops changing (within 1 % of R0)"),
     ("final_settlement", "final settlement", lambda n: _mm(n["final_settlement"]), "settlement of the last record"),
     ("crack_width", "widest crack", lambda n: _crack_text(n),
@@ -301,6 +316,10 @@ _HEADLINES = (
      "(sagging positive)"),
     ("angular_distortion", "angular distortion", lambda n: _slope(n["angular_distortion"]),
      "of the imposed ground at the last record: its largest slope less the chord's tilt"),
+    ("unbalanced_ratio", "quasi-static check", lambda n: quasi_static_text(n),
+     "medians over the settlement records of the unbalanced force over the applied load and of the kinetic over "
+     "the stored elastic energy: a reaction history is quasi-static, so its minimum meaningful, when the first is "
+     f"under {QUASI_STATIC_RATIO:g}"),
     ("cracked_joints", "cracked joints", lambda n: f"{int(n['cracked_joints'])}",
      "joints moving more than a tenth of the largest joint motion (the one crack threshold of every plot, "
      "comparison and diagnosis)"),
@@ -327,16 +346,55 @@ def result_label(result: xr.Dataset) -> str:
 
 
 def headline_text(result: xr.Dataset) -> str:
-    """A result's headline in a few words (a figure's title): alpha and the collapse reaction (limit
-    analysis), else R0 and the smallest and plateau reactions (incremental solvers); empty for a model."""
+    """A result's headline in a few words (a figure's title): alpha, what it means, and the collapse reaction
+    (limit analysis), else R0 and the smallest and plateau reactions (incremental solvers); empty for a model."""
     numbers = {n.name: n.value for n in key_numbers(result)} if "solver" in result.attrs else {}
     if "alpha" in numbers:
-        reaction = f", collapse reaction {numbers['collapse_reaction']:.4g} N" if "collapse_reaction" in numbers else ""
-        return f"alpha = {numbers['alpha']:.4f}{reaction}"
+        if "dead_reaction" not in numbers:
+            return f"alpha = {numbers['alpha']:.4f} (the live load's multiplier at collapse)"
+        reaction = f", collapse reaction {force_text(numbers['collapse_reaction'])}" \
+            if "collapse_reaction" in numbers else ""
+        return (f"alpha = {numbers['alpha']:.4f} (the share of R0 = {force_text(numbers['dead_reaction'])} the "
+                f"settling ground sheds before collapse){reaction}")
     if "minimum_reaction" in numbers:
-        return (f"R0 {numbers['dead_reaction']:.4g} N, min {numbers['minimum_reaction']:.4g} N at "
-                f"{_mm(numbers['minimum_reaction_settlement'])}, plateau {numbers['plateau_reaction']:.4g} N")
+        dynamic = numbers.get("unbalanced_ratio", 0.0) > QUASI_STATIC_RATIO
+        return (f"R0 {force_text(numbers['dead_reaction'])}, min {force_text(numbers['minimum_reaction'])} at "
+                f"{_mm(numbers['minimum_reaction_settlement'])}, plateau {force_text(numbers['plateau_reaction'])}"
+                + (f" (DYNAMIC: unbalanced force ratio {numbers['unbalanced_ratio']:.2g})" if dynamic else ""))
     return ""
+
+
+def quasi_static_text(numbers: dict) -> str:
+    """``quasi-static (unbalanced 0.021, kinetic/stored 0.0034)``, or the warning that the history is dynamic."""
+    ratios = f"unbalanced {numbers['unbalanced_ratio']:.2g}, kinetic/stored {numbers['kinetic_energy_ratio']:.2g}"
+    if numbers["unbalanced_ratio"] <= QUASI_STATIC_RATIO:
+        return f"quasi-static ({ratios})"
+    return f"DYNAMIC ({ratios}): the reactions depend on the loading; rerun with a smaller loading_rate"
+
+
+#: Results whose R0 differ by more than this share get :func:`r0_text`'s explanation.
+R0_SPREAD = 0.005
+
+
+def r0_text(results: Sequence[xr.Dataset], labels: Sequence[str]) -> str:
+    """Why results of one model report different R0 (empty when they agree within :data:`R0_SPREAD`): which R0
+    each reports, and that over ground partly fixed and partly settling the split of the weight is statically
+    indeterminate."""
+    r0 = {label: n.value for label, result in zip(labels, results) for n in key_numbers(result)
+          if n.name == "dead_reaction"}
+    if len(r0) < 2 or max(r0.values()) - min(r0.values()) <= R0_SPREAD * max(abs(v) for v in r0.values()):
+        return ""
+    numbers = {label: {n.name for n in key_numbers(result)} for label, result in zip(labels, results)}
+    said = [f"{label} reports {force_text(value)}, "
+            + ("W L_s / L_total, the weight shared between the ground's parts by their contact lengths (the "
+               "convention of limit analysis: alpha is a share of it)" if "alpha" in numbers[label] else
+               "the reaction it computes at rest under the weight, before the ground settles")
+            for label, value in r0.items()]
+    return ("R0 is not one number here: " + "; ".join(said) + ". A wall on ground that is partly fixed and partly "
+            "settling is statically indeterminate: equilibrium alone does not fix how its weight divides between "
+            "the parts; the stiffness of the contacts and the openings over each part do (a pier over a part "
+            "carries more than its length's share). A computed R0 is that split at rest, the convention is the "
+            "same for every wall; compare collapse or minimum reactions in kN, or each as a share of its own R0.")
 
 
 def headline_rows(results: Sequence[xr.Dataset]) -> list[Row]:

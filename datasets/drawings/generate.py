@@ -20,6 +20,10 @@ rewrites every ``<name>.dxf``/``.geojson`` and ``<name>.toml`` in this folder.
 - ``arch-settlement``: a semicircular arch ring of 17 voussoirs (intrados and
   extrados drawn as arcs, DXF bulges) on two masonry piers; the right pier's
   base settles.
+- ``gable-house``: an architect's elevation, not a drawing of blocks: the outline of a three-storey
+  gable-fronted terraced house (6.5 m wide, eaves 8.5 m, ridge 10.5 m, on layer OUTLINE) and its door and
+  five windows (layer OPENINGS; the top one has a semicircular head, drawn as an arc), in mm, as
+  architects draw them. The spec lays an English bond in it (``geometry.outline_layer``).
 - ``stepped-units``: a running-bond wall whose units are partly merged in pairs
   into stepped (non-convex) blocks, as a GeoJSON polygon file; the right part of
   its base settles. ``stepped_wall(merged=False)`` is the same wall in rectangles.
@@ -238,6 +242,32 @@ def stepped_wall(merged: bool = True) -> tuple[list[Polygon], list[str]]:
     return polygons, ["UNITS"] * (len(polygons) - 2) + ["BASE", "SETTLE"]
 
 
+# ---------------------------------------------------------------- an architect's elevation
+
+#: The gable house [mm]: width, eaves and ridge; openings (x, sill, width, height); the arched window's
+#: (x, sill, width, springing height above the sill).
+GABLE_HOUSE = {"width": 6500.0, "eaves": 8500.0, "ridge": 10500.0,
+               # as an architect dimensions them (not on the 75 mm courses): the laying moves them
+               "openings": [(2750.0, 0.0, 1000.0, 2200.0),  # the door
+                            (750.0, 850.0, 1200.0, 1500.0), (4550.0, 850.0, 1200.0, 1500.0),
+                            (750.0, 3800.0, 1200.0, 1650.0), (4550.0, 3800.0, 1200.0, 1650.0)],
+               "arched": (2800.0, 6500.0, 900.0, 1200.0)}
+
+
+def gable_house() -> tuple[list[list], list[str]]:
+    """The outline (one closed polyline) and the openings (rectangles, and one window whose head is a
+    semicircle: a bulge of 1 on its top edge)."""
+    g = GABLE_HOUSE
+    w = g["width"]
+    polygons = [[(0.0, 0.0, 0.0), (w, 0.0, 0.0), (w, g["eaves"], 0.0), (0.5 * w, g["ridge"], 0.0),
+                 (0.0, g["eaves"], 0.0)]]
+    for x, y, width, height in g["openings"]:
+        polygons.append([(x, y, 0.0), (x + width, y, 0.0), (x + width, y + height, 0.0), (x, y + height, 0.0)])
+    x, y, width, springing = g["arched"]
+    polygons.append([(x, y, 0.0), (x + width, y, 0.0), (x + width, y + springing, 1.0), (x, y + springing, 0.0)])
+    return polygons, ["OUTLINE"] + ["OPENINGS"] * (len(polygons) - 1)
+
+
 # ---------------------------------------------------------------- writing
 
 def write_dxf(path: Path, polygons: list, layers: list[str], insunits: int = 4, points: bool = False) -> None:
@@ -275,6 +305,7 @@ def write_all(folder: Path = HERE) -> None:
     write_dxf(folder / "lact3-arch.dxf", *lact3_arch(), points=True)
     write_dxf(folder / "arch-settlement.dxf", *settling_arch())
     write_geojson(folder / "stepped-units.geojson", *stepped_wall())
+    write_dxf(folder / "gable-house.dxf", *gable_house())
 
 
 if __name__ == "__main__":

@@ -33,6 +33,7 @@ from .figure_parts import (
     single_result,
     supports_of,
 )
+from .records import MODEL_INTERFACES_UP_TO
 from .shapes import deformed_nodes, deformed_points, largest_vertex_motion
 
 # Default amplification: the largest vertex displacement drawn as this share of the model size.
@@ -40,6 +41,8 @@ DRAWN_MOTION_SHARE = 0.10
 STATE_COLOURS = {"open": "tab:red", "slide": "tab:blue", "open_slide": "tab:purple"}
 FAILURE_COLOURS = {"tensile": "tab:blue", "shear": "0.55", "tensile_shear": "navy"}
 SMALL_PIECE_COLOUR = "0.82"
+WIDEST_COLOUR = "#d00000"
+WIDEST_LINE = 6.0  # pt: the widest opening's line when the cracks plot draws widths
 FRICTION_MAP = "plasma_r"  # dark: sliding; light: far from it
 DOMINANT_SHARE = 0.02  # a macro-block holding this share of the masonry area is numbered ...
 MOST_NUMBERED = 10  # ... up to this many
@@ -99,6 +102,47 @@ def _number_pieces(ax, geo: xr.Dataset, pieces: Pieces, x: np.ndarray, y: np.nda
                 bbox={"boxstyle": "round,pad=0.15", "facecolor": "white", "edgecolor": "none", "alpha": 0.8})
 
 
+@dataclass(frozen=True)
+class WidestCrack:
+    """The widest crack at a result's last record: its joint, width [m] and damage category (-1: none given)."""
+
+    interface: int
+    width: float
+    category: int
+
+    def label(self) -> str:
+        names = {value: name.replace("_", " ") for name, value in mfp.flags("step_damage_category").items()}
+        category = f": damage category {self.category} {names.get(self.category, '')}" if self.category >= 0 else ""
+        return f"widest crack {self.width * 1000:.3g} mm{category}".rstrip().replace(": damage", ":\ndamage")
+
+
+def widest_crack(ds: xr.Dataset) -> WidestCrack | None:
+    """The widest crack at the last record (the state the plots draw), None where the result has no crack widths
+    (limit analysis: a mechanism's shape, not its size) or nothing opens."""
+    if not {"step_crack_width_max", "step_crack_interface"} <= set(ds.variables) or not ds.step_crack_width_max.size:
+        return None
+    interface, width = int(ds.step_crack_interface.values[-1]), float(ds.step_crack_width_max.values[-1])
+    if interface < 0 or not width > 0:
+        return None
+    category = int(ds.step_damage_category.values[-1]) if "step_damage_category" in ds else -1
+    return WidestCrack(interface, width, category)
+
+
+def _mark_widest(ax, ds: xr.Dataset, point: tuple[float, float] | None, handles: list) -> None:
+    """A ring round the widest crack at ``point`` and its legend entry; for a result without widths, a legend line
+    saying why there is none."""
+    widest = widest_crack(ds)
+    if widest is None or point is None:
+        if "collapse_multiplier" in ds:
+            handles.append(Line2D([], [], color="none", label="no crack widths: limit analysis gives the\n"
+                                                              "mechanism's shape, not its size"))
+        return
+    ax.plot(*point, marker="o", markersize=16, markerfacecolor="none", markeredgecolor=WIDEST_COLOUR,
+            markeredgewidth=2.2, zorder=6)
+    handles.append(Line2D([], [], marker="o", markersize=10, markerfacecolor="none", markeredgecolor=WIDEST_COLOUR,
+                          markeredgewidth=2.0, linestyle="none", label=widest.label()))
+
+
 def _deformed_crack_faces(geo: xr.Dataset, u, amplification: float, cracked: np.ndarray) -> np.ndarray:
     """The cracked joints as drawn on the deformed blocks: each joint once on either side's face
     (the two faces of a crack part as the blocks move apart), shape (2 * cracked, 2, 2)."""
@@ -116,7 +160,8 @@ def default_amplification(geo: xr.Dataset, displacement) -> float:
 
 
 
-ROLE_COLOURS = {"unit": "#f3e3c8", "lintel": "#8c6d46", "fixed_support": SUPPORT_COLOUR, "moving_support": "#e0a020"}
+ROLE_COLOURS = {"unit": "#f3e3c8", "voussoir": "#d9bf94", "lintel": "#8c6d46", "fixed_support": SUPPORT_COLOUR,
+                "moving_support": "#e0a020"}
 KIND_COLOURS = {"bed": "tab:blue", "head": "tab:green", "other": "tab:purple", "support": "tab:red"}
 
 
@@ -131,14 +176,16 @@ def draw_model(datasets: Sequence[xr.Dataset], ax, options: Mapping[str, Any]) -
     support = supports_of(geo)
     fill = np.array([ROLE_COLOURS[r] for r in roles], dtype=object)
     ax.add_collection(PolyCollection(list(verts[~support]), facecolors=list(fill[~support]), edgecolors="0.35",
-                                     linewidths=0.4, zorder=1))
+                                     linewidths=0.4 * line_scale(geo), zorder=1))
     if support.any():
         ax.add_collection(PolyCollection(list(verts[support]), facecolors=list(fill[support]), edgecolors="0.2",
                                          linewidths=0.4, hatch="////", zorder=1))
     kinds = {value: name for name, value in mfp.flags("interface_kind").items()}
     kind = np.array([kinds[int(k)] for k in geo.interface_kind.values]) if "interface_kind" in geo else np.array([])
     handles = []
-    for name, colour in KIND_COLOURS.items():
+    drawn = options["interfaces"] == "yes" or (options["interfaces"] == "auto"
+                                               and geo.sizes["block"] <= MODEL_INTERFACES_UP_TO)
+    for name, colour in KIND_COLOURS.items() if drawn else ():
         chosen = kind == name
         if chosen.any():
             segments = segment_array(geo.interface_x.values[chosen], geo.interface_y.values[chosen])
@@ -205,6 +252,15 @@ def draw_mechanism(datasets: Sequence[xr.Dataset], ax, options: Mapping[str, Any
                                          linewidths=1.6 * scale + 0.4, zorder=3, capstyle="round"))
         handles.append(Line2D([], [], color="k", lw=2.0, label=f"cracked joints ({int(cracked.sum())})"))
     _number_pieces(ax, geo, pieces, x, y)
+    widest = widest_crack(ds)
+    point = None
+    if widest is not None:
+        k = widest.interface
+        px, py = deformed_points(geo, u, amplification, np.array([geo.interface_x.values[k].mean()]),
+                                 np.array([geo.interface_y.values[k].mean()]),
+                                 np.array([int(geo.interface_blocks.values[k, 0])]))
+        point = (float(px[0]), float(py[0]))
+    _mark_widest(ax, ds, point, handles)
     ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize="small", frameon=False,
               title=f"displacements x {amplification:.3g}", title_fontsize="small")
     finish_axes(ax, ds)
@@ -225,10 +281,23 @@ def draw_cracks(datasets: Sequence[xr.Dataset], ax, options: Mapping[str, Any]) 
     segments = segment_array(geo.interface_x.values, geo.interface_y.values)
     flag = mfp.flags("interface_state")
     handles = []
+    opening = np.maximum(ds.interface_opening.values, 0.0).mean(axis=1)
+    in_masonry = ~mfp.support_blocks(geo.block_role.values)[geo.interface_blocks.values.astype(np.int64)].any(axis=1)
+    widest_opening = float(opening[(state > 0) & in_masonry].max(initial=0.0))  # a base gap is no crack
+    drawn_widths = options["widths"] and widest_opening > 0
+    widths = (0.8 + (WIDEST_LINE - 0.8) * np.minimum(opening / widest_opening, 1.0) if drawn_widths
+              else np.full(opening.size, 2.2))
     for meaning, colour in STATE_COLOURS.items():
         chosen = state == flag[meaning]
-        ax.add_collection(LineCollection(segments[chosen], colors=colour, linewidths=2.2, zorder=3))
+        ax.add_collection(LineCollection(segments[chosen], colors=colour, linewidths=widths[chosen], zorder=3))
         handles.append(Line2D([], [], color=colour, lw=2.2, label=f"{meaning.replace('_', ' + ')} ({chosen.sum()})"))
+    if drawn_widths:
+        handles.append(Line2D([], [], color="0.3", lw=WIDEST_LINE, label=f"line width: the opening,\nup to "
+                                                                       f"{widest_opening * 1000:.3g} mm in the masonry"))
+    widest = widest_crack(ds)
+    point = None if widest is None else (float(geo.interface_x.values[widest.interface].mean()),
+                                         float(geo.interface_y.values[widest.interface].mean()))
+    _mark_widest(ax, ds, point, handles)
     ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize="small", frameon=False)
     finish_axes(ax, ds)
 

@@ -7,6 +7,7 @@ smallest and plateau reactions). A kind that needs a variable the result lacks r
 """
 from __future__ import annotations
 
+import textwrap
 from collections.abc import Sequence
 
 import numpy as np
@@ -19,6 +20,7 @@ import masonryfw.plugin_api as mfp
 from .shapes import padded_block_nodes
 
 SUPPORT_COLOUR = "0.45"
+TITLE_WIDTH = 75  # characters of a title line (a 7 in figure's width at the medium size)
 # damage categories 0..5: green to dark red
 DAMAGE_COLOURS = ("#1a9850", "#91cf60", "#fee08b", "#fc8d59", "#d73027", "#7f0000")
 
@@ -48,7 +50,7 @@ def finish_axes(ax, ds: xr.Dataset) -> None:
     ax.autoscale_view()
     ax.set_xlabel("x [m]")
     ax.set_ylabel("y [m]")
-    headline = mf.headline_text(ds)
+    headline = textwrap.fill(mf.headline_text(ds), TITLE_WIDTH)
     ax.set_title(title_of(ds) + (f"\n{headline}" if headline else ""), fontsize="medium")
 
 

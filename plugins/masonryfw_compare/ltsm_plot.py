@@ -1,9 +1,9 @@
 """The ``ltsm`` plot: the engineers' stage 2 of a result over a settlement profile.
 
 Above, the greenfield trough under the wall with its sagging and hogging parts; below, the classic
-interaction chart (Burland 1995; Boscardin & Cording 1989): the deflection ratio against the horizontal
-strain, the zones of the LTSM categories for the governing part's length over height and neutral axis, and
-every part of the wall as a point at the assessed settlement. The numbers are :mod:`masonryfw.assessment`'s.
+interaction chart (Burland 1995; Boscardin & Cording 1989) for every part of the wall: the deflection ratio
+against the horizontal strain, the zones of the LTSM categories for that part's length over height and kind
+(sagging, hogging), and the part as a point at the assessed settlement. The numbers are :mod:`masonryfw.assessment`'s.
 """
 from __future__ import annotations
 
@@ -57,9 +57,10 @@ def draw_ltsm(datasets: Sequence[xr.Dataset], ax, options: Mapping[str, Any]) ->
     x_a, x_b, height = mfp.wall_extent(ds)
     figure, spec = ax.figure, ax.get_subplotspec()
     ax.set_axis_off()
-    trough, chart = (figure.add_subplot(g) for g in spec.subgridspec(2, 1, height_ratios=(1, 2), hspace=0.08))
+    rows = spec.subgridspec(2, 1, height_ratios=(1, 2), hspace=0.08)
+    trough = figure.add_subplot(rows[0])
     _draw_trough(trough, profile, stages, settlement, x_a, x_b, height)
-    _draw_chart(chart, stages, settlement, height)
+    _draw_charts(figure, rows[1], stages, settlement, height)
     trough.set_title(f"{title_of(ds)}: stage 2 (LTSM) at S_max = {1e3 * settlement:.3g} mm\n"
                      f"LTSM strain {100 * stages.strain:.3g} %, category {ZONE_NAMES[stages.category]}; stage 1: slope "
                      f"1/{1 / max(stages.slope, 1e-12):.0f}, settlement {1e3 * stages.greenfield_settlement:.3g} mm"
@@ -67,10 +68,20 @@ def draw_ltsm(datasets: Sequence[xr.Dataset], ax, options: Mapping[str, Any]) ->
 
 
 def _draw_trough(ax, profile, stages, settlement: float, x_a: float, x_b: float, height: float) -> None:
-    """The greenfield settlement below the wall, drawn as a box, its parts shaded by kind."""
+    """The greenfield settlement below the wall, drawn as a box, its parts shaded by kind; a trough's axis (a
+    tunnel's) marked, the view widened to it where it is off the wall."""
     margin = 0.5 * (x_b - x_a)
-    x = np.linspace(x_a - margin, x_b + margin, 400)
+    low, high = x_a - margin, x_b + margin
+    axis = profile.center if profile.kind in ("gaussian", "tunnel") else None
+    if axis is not None:
+        low, high = min(low, axis - 0.25 * margin), max(high, axis + 0.25 * margin)
+    x = np.linspace(low, high, 600)
     ax.plot(x, -1e3 * settlement * profile.rate(x), color="0.2", lw=1.4, label="greenfield settlement")
+    if axis is not None:
+        ax.axvline(axis, color="0.35", lw=1.0, ls="--")
+        ax.annotate(f"{'tunnel' if profile.kind == 'tunnel' else 'trough'} axis, x = {axis:.3g} m", (axis, 0.0),
+                    xytext=(-4, -4), textcoords="offset points", ha="right", va="top", fontsize="small",
+                    color="0.25")
     depth = 1e3 * settlement
     for part in stages.parts:
         colour = "#4575b4" if part.sagging else "#d73027"
@@ -79,41 +90,47 @@ def _draw_trough(ax, profile, stages, settlement: float, x_a: float, x_b: float,
         ax.text(0.5 * (part.start + part.end), 0.4 * depth, "sagging" if part.sagging else "hogging", ha="center",
                 va="center", fontsize="small")
     ax.axhline(0.0, color="0.6", lw=0.6)
-    ax.set_xlim(x[0], x[-1])
+    ax.set_xlim(low, high)
     ax.set_ylim(-1.15 * depth, 0.8 * depth)
     ax.set_ylabel("settlement [mm]")
     ax.set_xlabel(f"x [m]; the wall from {x_a:.3g} to {x_b:.3g} m, {height:.3g} m high (boxes: its parts)")
     ax.grid(alpha=0.3)
 
 
-def _draw_chart(ax, stages, settlement: float, height: float) -> None:
-    """Deflection ratio against horizontal strain [%]: the zones for the governing part up to one category above
-    the worst part's (so the parts are not lost in the corner of a chart of every zone), the parts as points."""
-    governing = max(stages.parts, key=lambda p: p.strain)
-    points = [(100 * settlement * p.horizontal_strain, 100 * settlement * p.deflection_ratio) for p in stages.parts]
-    shown = min(stages.category, len(mfp.LTSM_LIMITS) - 1)  # the limit above the worst category (the last: itself)
-    top_strain = max(1.15 * 100 * mfp.LTSM_LIMITS[shown], 1.3 * max(s for s, _ in points))
-    low_strain = min(0.0, 1.3 * min(s for s, _ in points))
+def _draw_charts(figure, spec, stages, settlement: float, height: float) -> None:
+    """One interaction chart per part of the wall, each with the zones of its own length over height and kind
+    (a sagging part's zones are not a hogging one's), side by side; the zones' legend beside the last."""
+    parts = list(stages.parts)
+    grid = spec.subgridspec(1, len(parts), wspace=0.3)
+    axes = [figure.add_subplot(grid[0, k]) for k in range(len(parts))]
+    for ax, part in zip(axes, parts):
+        _draw_chart(ax, part, stages.category, settlement, height)
+    axes[0].set_ylabel("deflection ratio [%]")
+    axes[-1].legend(*axes[-1].get_legend_handles_labels(), loc="upper left", bbox_to_anchor=(1.02, 1.0),
+                    fontsize="small", title="LTSM category", title_fontsize="small", frameon=False)
+
+
+def _draw_chart(ax, part, worst: int, settlement: float, height: float) -> None:
+    """Deflection ratio against horizontal strain [%] for ``part``: its zones up to one category above the worst
+    part's (so the point is not lost in the corner of a chart of every zone), the part as a point."""
+    x, y = 100 * settlement * part.horizontal_strain, 100 * settlement * part.deflection_ratio
+    shown = min(worst, len(mfp.LTSM_LIMITS) - 1)  # the limit above the worst category (the last: itself)
+    top_strain = max(1.15 * 100 * mfp.LTSM_LIMITS[shown], 1.3 * x)
+    low_strain = min(0.0, 1.3 * x)
     strain = np.linspace(low_strain, top_strain, 600)
-    boundaries = [100 * zone_boundary(limit, strain / 100, governing, height) for limit in mfp.LTSM_LIMITS]
-    ceiling = max(1.15 * float(np.nanmax(boundaries[shown])), 1.3 * max(r for _, r in points))
+    boundaries = [100 * zone_boundary(limit, strain / 100, part, height) for limit in mfp.LTSM_LIMITS]
+    ceiling = max(1.15 * float(np.nanmax(boundaries[shown])), 1.3 * y)
     lower = np.zeros_like(strain)
     for category, upper in enumerate([*boundaries, np.full_like(strain, ceiling)]):
         upper = np.where(np.isnan(upper), 0.0, np.minimum(upper, ceiling))
         ax.fill_between(strain, lower, np.maximum(upper, lower), color=DAMAGE_COLOURS[category], alpha=0.35, lw=0,
                         label=ZONE_NAMES[category])
         lower = np.maximum(upper, lower)
-    zones = ax.legend(loc="upper right", fontsize="small", title_fontsize="small",
-                      title=f"zones for the governing part: {'sagging' if governing.sagging else 'hogging'}, "
-                            f"L/H = {(governing.end - governing.start) / height:.2g}")
-    parts = [ax.plot(x, y, "o" if part.sagging else "s", ms=7, color="k", mfc="#4575b4" if part.sagging else "#d73027",
-                     label=f"{'sagging' if part.sagging else 'hogging'} {part.start:.3g}..{part.end:.3g} m (L/H "
-                           f"{(part.end - part.start) / height:.2g}): strain {100 * settlement * part.strain:.3g} %")[0]
-             for part, (x, y) in zip(stages.parts, points)]
-    ax.add_artist(zones)
-    ax.legend(handles=parts, loc="upper center", bbox_to_anchor=(0.5, -0.2), ncol=2, fontsize="small", frameon=False)
+    kind = "sagging" if part.sagging else "hogging"
+    ax.plot(x, y, "o" if part.sagging else "s", ms=8, color="k", mfc="#4575b4" if part.sagging else "#d73027")
+    ax.set_title(f"{kind} {part.start:.3g}..{part.end:.3g} m, L/H {(part.end - part.start) / height:.2g}:\n"
+                 f"strain {100 * settlement * part.strain:.3g} %", fontsize="small")
     ax.set_xlim(low_strain, top_strain)
     ax.set_ylim(0.0, ceiling)
-    ax.set_xlabel("horizontal strain [%] (tension positive)")
-    ax.set_ylabel("deflection ratio [%]")
+    ax.set_xlabel("horizontal strain [%]\n(tension positive)")
     ax.grid(alpha=0.3)

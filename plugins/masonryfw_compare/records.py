@@ -22,6 +22,8 @@ AMPLIFICATION_OPTION = mfp.Option(
     above=0.0,
 )
 COMPARE_OPTIONS = (THRESHOLD_OPTION,)
+#: The model plot draws interfaces by default up to this many blocks (beyond, their lines hide the blocks).
+MODEL_INTERFACES_UP_TO = 400
 
 COMPARATOR = mfp.Comparator(
     name="crack",
@@ -44,11 +46,16 @@ PLOTTERS = {
     for plotter in (
         _plotter("model", "the model as built or imported: blocks by role, interfaces by kind, block numbers",
                  (mfp.Option("numbers", bool, False, "write every block's number at its centroid"),
-                  mfp.Option("font_size", float, 5.0, "size of the block numbers [pt]", above=0.0))),
+                  mfp.Option("font_size", float, 5.0, "size of the block numbers [pt]", above=0.0),
+                  mfp.Option("interfaces", str, "auto", "draw the interfaces coloured by kind: yes, no, or auto (a "
+                             f"model of at most {MODEL_INTERFACES_UP_TO} blocks)", ("auto", "yes", "no")))),
         _plotter("mechanism", "amplified deformed wall, alpha and the reaction in the title, the dominant "
-                 "macro-blocks numbered, cracks on the blocks' faces",
+                 "macro-blocks numbered, cracks on the blocks' faces, the widest crack marked with the damage category",
                  (AMPLIFICATION_OPTION, THRESHOLD_OPTION)),
-        _plotter("cracks", "joints that open, slide or both, in colours", (THRESHOLD_OPTION,)),
+        _plotter("cracks", "joints that open, slide or both, in colours; the widest crack marked with the damage "
+                 "category", (THRESHOLD_OPTION,
+                              mfp.Option("widths", bool, False, "draw each cracked joint as wide as its opening "
+                                         "(amplified; its width in mm in the legend)"))),
         _plotter("forces", "contact forces (at collapse, or at the last record) as thrust segments",
                  (mfp.Option("scale", float, 1.0, "largest segment, in median interface lengths", above=0.0),)),
         _plotter("plastic", "plastic quadrature points over the mesh (continuum results)",

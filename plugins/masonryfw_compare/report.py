@@ -215,7 +215,11 @@ def _diagnosis_section(path: str, ds: xr.Dataset) -> list[str]:
              f"({source}); a surveyed line follows a joint within {_number(ds.attrs.get('tolerance'), '.3g')} m. "
              f"The plausible set: every candidate within {_number(ds.attrs.get('plausible_margin'), 'g')} of the "
              f"best score. File sha256 {mfp.sha256_file(path)}; made by: <code>{html.escape(made_by)}</code>")
-    return [f"<h2>Diagnosis: {html.escape(path)}</h2>",
+    partial = (f'<p class="partial"><strong>Partial: the search was interrupted after '
+               f"{ds.sizes['candidate'] + int(ds.attrs.get('failed_candidates', 0))} of "
+               f"{int(ds.attrs.get('scenarios_planned', 0))} scenarios; the ranking is of those tried.</strong></p>"
+               if int(ds.attrs.get("interrupted", 0)) else "")
+    return [f"<h2>Diagnosis: {html.escape(path)}</h2>", partial,
             f"<p><strong>{html.escape(str(ds.attrs.get('verdict', '')))}</strong></p>", f"<p>{facts}</p>",
             _table(["rank", *columns], mfp.diagnosis_rows(ds, 10), "diagnosis", columns),
             _figure([ds], "diagnosis", "The surveyed cracks (red) over the wall, the best candidates' mechanisms "
@@ -249,6 +253,8 @@ def report_html(paths: Sequence[str], command: str, progress: Callable[[float, s
              _model_section(first)]
     if datasets:
         parts += ["<h2>Key numbers</h2>", _table(["", *letters], mfp.headline_rows(datasets), "key-numbers", letters)]
+        r0 = mfp.r0_text(datasets, labels)
+        parts += [f'<p class="note" id="r0-note">{html.escape(r0)}</p>'] if r0 else []
     step(0.2, "figures")
     parts += _history_section(datasets)
     for i, (label, ds) in enumerate(zip(labels, datasets)):

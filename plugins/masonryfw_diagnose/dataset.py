@@ -110,6 +110,9 @@ def to_dataset(diagnosis: Diagnosis, source_wall: str = "") -> xr.Dataset:
         attrs["source_levelling"] = survey.sources["levelling"]
     if diagnosis.verified_with:
         attrs["verify_solver"] = diagnosis.verified_with
+    if diagnosis.interrupted:  # a partial search: its figures and reports say so
+        attrs["interrupted"] = 1
+        attrs["scenarios_planned"] = len(diagnosis.tables)
     return xr.Dataset({**{n: model[n] for n in names}, **_candidate_variables(diagnosis),
                        **_kept_variables(diagnosis), **_survey_variables(diagnosis)},
                       coords={c: model.coords[c] for c in model.coords}, attrs=attrs)

@@ -189,4 +189,9 @@ def draw_diagnosis(datasets, ax, options) -> None:
     bottom = grid[1, :].subgridspec(1, len(panels), wspace=0.25)
     for k, draw in enumerate(panels):
         draw(figure.add_subplot(bottom[0, k]), ds)
-    figure.suptitle(str(ds.attrs.get("verdict", "")), fontsize=9)
+    verdict = str(ds.attrs.get("verdict", ""))
+    if int(ds.attrs.get("interrupted", 0)):
+        tried = ds.sizes.get("candidate", 0) + int(ds.attrs.get("failed_candidates", 0))
+        verdict = (f"PARTIAL: the search was interrupted after {tried} of {int(ds.attrs.get('scenarios_planned', 0))} "
+                   f"scenarios; the ranking is of those tried\n{verdict}")
+    figure.suptitle(verdict, fontsize=9, color="#b00000" if int(ds.attrs.get("interrupted", 0)) else "black")

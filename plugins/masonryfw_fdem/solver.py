@@ -20,7 +20,7 @@ from . import estimate, postprocess
 from .compilation import Compilations
 from .controls import make_controls
 from .scene import Scene, build_scene
-from .simulation import History, State, initial_state, run
+from .simulation import SETTLEMENT_PHASE, History, State, initial_state, run
 
 LOG = logging.getLogger("masonryfw.fdem")
 #: Load-factor search (scaled time, sqrt(length / g)): the ramp to a trial multiplier, the longest hold.
@@ -82,6 +82,12 @@ def _solve(model: xr.Dataset, options: Mapping[str, Any], progress) -> xr.Datase
         fdem_asleep_blocks=int((~scene.driven & (state.active == 0)).sum()),
         fdem_target_settlement=controls.target * scene.scales.length,
     )
+    result.attrs.update(quasi_static_ratios(result))
+    if result.attrs.get("unbalanced_ratio", 0.0) > mfp.QUASI_STATIC_RATIO:
+        LOG.warning("fdem: the reaction history is dynamic, not quasi-static: the median unbalanced force ratio of "
+                    "the settlement records is %.3g (over %g) and the kinetic energy %.3g of the stored; its minimum "
+                    "depends on the loading; rerun with a smaller --option loading_rate (docs/fdem.md)",
+                    result.attrs["unbalanced_ratio"], mfp.QUASI_STATIC_RATIO, result.attrs["kinetic_energy_ratio"])
     if state.trials:
         result.attrs["fdem_unstable_load_factor"] = state.collapse_bracket[1] if state.collapse_bracket[1] is not None \
             else np.nan
@@ -96,6 +102,18 @@ def opening_meter(scene: Scene):
     def widest(pos: np.ndarray) -> mf.Cracks:
         return mf.widest_crack(scene.model, postprocess.block_displacement(scene, pos), "finite")
     return widest
+
+
+def quasi_static_ratios(result: xr.Dataset) -> dict[str, float]:
+    """How far the settlement records are from rest (docs/format.md): the medians of the unbalanced force ratio and
+    of the kinetic over the stored elastic energy; none without settlement records."""
+    settling = result.step_phase.values == SETTLEMENT_PHASE if "step_phase" in result else np.zeros(0, bool)
+    if not settling.any():
+        return {}
+    stored = result.step_stored.values[settling]
+    kinetic = result.step_kinetic_energy.values[settling] / np.where(stored > 0, stored, np.inf)
+    return {"unbalanced_ratio": float(np.median(result.step_unbalanced_ratio.values[settling])),
+            "kinetic_energy_ratio": float(np.median(kinetic))}
 
 
 def history_variables(scene: Scene, history: History) -> dict:

@@ -11,7 +11,12 @@ directions are axial, so the mean is taken on doubled angles:
 tall, gets the direction of its beds (its head joints weigh nothing); a voussoir's two
 radial joints give the radial direction between them, the keystone's nearly vertical
 ones included. A block whose joints are all vertical weighs them by length alone; one
-without joints, or whose joints cancel out, keeps the horizontal.
+without joints, or whose joints cancel out, keeps the horizontal. A **voussoir** (the
+``voussoir`` role: a unit of an arch or flat arch laid in a wall) takes the mean of its
+joints with the voussoirs beside it alone, weighted by length: embedded in a wall, its
+extrados joint with the courses above would otherwise outweigh its radial joints, and a
+ring whose beds run along it carries no thrust (a gable house's arched and flat-arched
+heads did not stand under their own weight, measured).
 
 A joint of a block is a **head joint** of it when it runs more than 45 deg off the
 block's bed direction. A block without head joints (a voussoir of a one-ring arch, a
@@ -22,6 +27,8 @@ from __future__ import annotations
 
 import numpy as np
 import xarray as xr
+
+import masonryfw.plugin_api as mfp
 
 
 def bed_angles(model: xr.Dataset) -> np.ndarray:
@@ -41,7 +48,10 @@ def bed_angles(model: xr.Dataset) -> np.ndarray:
 
     carrying, by_carrying = mean_direction(np.abs(dx))  # L |n_y| = |dx|
     any_joint, by_length = mean_direction(length)
+    voussoir = model.block_role.values == mfp.ROLE["voussoir"]
+    radial, by_radial = mean_direction(length * voussoir[sides].all(axis=1))  # the joints between voussoirs
     angle = np.where(by_carrying, carrying, np.where(by_length, any_joint, 0.0))
+    angle = np.where(voussoir & by_radial, radial, angle)
     angle[np.abs(angle) < 1e-12] = 0.0  # level beds are exactly level: no rotation at all (problem.bed_rotations)
     return np.where(angle <= -np.pi / 2 + 1e-12, angle + np.pi, angle)
 

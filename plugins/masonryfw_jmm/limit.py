@@ -374,7 +374,7 @@ def wall_lp(domain: Domain, model: xr.Dataset, A: np.ndarray, b: np.ndarray, nam
     field = StaticField(mesh.p, mesh.t, model.block_thickness.values[blocks] / H)
     unit_weight = model.block_unit_weight.values[blocks] / domain.unit_weight
     fixed, moving = support_edges(domain, field, model)
-    strong = np.nonzero(model.block_role.values[blocks] == ROLE["unit"])[0]
+    strong = np.nonzero(mfp.jointed_blocks(model.block_role.values[blocks]))[0]
     angle = domain.angles[blocks]
     to_bed = stress_rotation(angle) if np.any(angle) else None
     head = np.array([name.startswith("head") for name in names])

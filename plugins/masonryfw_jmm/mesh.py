@@ -9,7 +9,8 @@ Two meshers, one result (:class:`WallMesh`: every triangle belongs to one block)
   alternating diagonals (no preferred direction). Cells follow the courses exactly.
 - **gmsh** otherwise (drawn walls: stones of any shape, arches): every block a plane
   surface of OpenCASCADE, fragmented together so that blocks meeting along part of an
-  edge (T-junctions) share their nodes, meshed by gmsh's Delaunay mesher with elements
+  edge (T-junctions) share their nodes, and with the supports' ends (a base edge across
+  two supports would be held by neither), meshed by gmsh's Delaunay mesher with elements
   no larger than the mesh size.
 
 Supports are the model's support interfaces (masonry on a support block): the boundary
@@ -132,7 +133,11 @@ def gmsh_mesh(model: xr.Dataset, size: float) -> tuple[np.ndarray, np.ndarray, n
             corners = [occ.addPoint(x[k], y[k], 0.0) for k in range(start[b], start[b + 1])]
             lines = [occ.addLine(p, q) for p, q in zip(corners, corners[1:] + corners[:1])]
             surfaces.append(occ.addPlaneSurface([occ.addCurveLoop(lines)]))
-        _, pieces = occ.fragment([(2, s) for s in surfaces], [])
+        ends = np.unique(support_segments(model)[0].reshape(-1, 2), axis=0)
+        corners = [(0, occ.addPoint(px, py, 0.0)) for px, py in ends]
+        # the supports' ends split the blocks' edges: every mesh edge on the base lies on one support (an edge
+        # across two is held by neither, and the no-tension masonry over that gap cannot take the weight)
+        _, pieces = occ.fragment([(2, s) for s in surfaces], corners)
         occ.synchronize()
         for name, value in (("Mesh.MeshSizeMax", size), ("Mesh.MeshSizeMin", 0.0), ("Mesh.MeshSizeFromPoints", 0),
                             ("Mesh.MeshSizeExtendFromBoundary", 0), ("Mesh.MeshSizeFromCurvature", 0),

@@ -84,7 +84,7 @@ def _modal(values: np.ndarray, tol: float) -> float:
 
 def unit_size(model: xr.Dataset, angles: np.ndarray) -> tuple[float, float]:
     """``(b, a)``: length and height of the commonest unit, measured along and across its bed direction."""
-    units = model.block_role.values == ROLE["unit"]
+    units = mfp.jointed_blocks(model.block_role.values)
     if not units.any():
         raise mf.ModelError("jmm: no unit blocks to take the unit size b x a from; give options beta and mesh_size")
     length, height = extents_along(model, angles)
@@ -95,7 +95,7 @@ def unit_size(model: xr.Dataset, angles: np.ndarray) -> tuple[float, float]:
 def median_unit_height(model: xr.Dataset, angles: np.ndarray) -> float:
     """The median extent of the units across their beds: half of it is the automatic mesh size (the
     commonest unit's height in a wall of courses; the voussoirs' widths in an arch on piers of fewer units)."""
-    units = model.block_role.values == ROLE["unit"]
+    units = mfp.jointed_blocks(model.block_role.values)
     return float(np.median(extents_along(model, angles)[1][units]))
 
 
@@ -268,7 +268,7 @@ def masonry_height(model: xr.Dataset) -> float:
 def auto_mesh_size(model: xr.Dataset) -> float:
     """The ``mesh_size`` option's automatic value: half the median unit height (a tenth of the masonry height
     without units)."""
-    if (model.block_role.values == ROLE["unit"]).any():
+    if mfp.jointed_blocks(model.block_role.values).any():
         return median_unit_height(model, bed_angles(model)) / 2
     return masonry_height(model) / 20
 
@@ -333,7 +333,7 @@ def build_problem(model: xr.Dataset, options) -> Problem:
     else:  # the model's E, else the paper's G = 511 MPa
         E = _block_constant(model, "block_young_modulus", blocks, None, 0.0)
         E = np.where(E > 0, E, 2.0 * 511e6 * (1.0 + nu))
-    is_unit = role[blocks] == ROLE["unit"]
+    is_unit = mfp.jointed_blocks(role[blocks])
     ref = is_unit if is_unit.any() else np.ones_like(is_unit)
     young, poisson = float(E[ref].mean()), float(nu[ref].mean())
     G = young / (2.0 * (1.0 + poisson))
@@ -342,7 +342,7 @@ def build_problem(model: xr.Dataset, options) -> Problem:
     thickness = model.block_thickness.values[blocks] / H
     disc = Discretisation(MeshTri(mesh.points / H, mesh.triangles), options["element"], thickness)
     D_points = np.repeat(_elastic_matrices(E / G, nu, options["hypothesis"]), disc.nqp, axis=0)
-    masonry_points = np.repeat(role[blocks] == ROLE["unit"], disc.nqp)
+    masonry_points = np.repeat(mfp.jointed_blocks(role[blocks]), disc.nqp)
     rmap = ReturnMap(domain.scaled_strength(options["apex_shift"]),
                      elastic_matrix(young / G, poisson, options["hypothesis"]))
     body = np.stack([np.zeros(blocks.size), -gamma / domain.unit_weight], axis=1)

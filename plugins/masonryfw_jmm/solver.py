@@ -115,9 +115,21 @@ def _gravity_stage(newton: NewtonSolver, state: State, history: History) -> tupl
             continue
         increment /= 2
         if increment < 1e-3:
-            return state, f"gravity stage did not converge at gravity factor {factor:.4f}"
+            x, y = _least_balanced(newton.problem, trial)
+            return state, (f"gravity stage did not converge at gravity factor {factor:.4f} (the weight's share "
+                           f"carried; least in balance near x {x:.3f} m, y {y:.3f} m)")
     history.add(newton, state, 0.0, 0.0, iterations)
     return state, ""
+
+
+def _least_balanced(problem: Problem, trial: State) -> tuple[float, float]:
+    """Where ``trial`` (a step that did not converge) is farthest from equilibrium: the mesh vertex of the largest
+    free residual [m]."""
+    vertex = problem.disc.vertex_dofs()
+    residual = np.hypot(trial.residual[2 * vertex], trial.residual[2 * vertex + 1])
+    residual[np.isin(2 * vertex + 1, problem.support_uy)] = 0.0  # a held vertex carries what it is given
+    k = int(np.argmax(residual))
+    return float(problem.disc.mesh.p[0, k] * problem.length), float(problem.disc.mesh.p[1, k] * problem.length)
 
 
 def elastic_unloading_settlement(newton: NewtonSolver, state: State) -> tuple[float, float]:
@@ -407,6 +419,9 @@ def solve(model: xr.Dataset, options, progress) -> xr.Dataset:
     state, history, info = (run_load_factor if problem.searches_load else run)(problem, options, progress)
     if info["interrupted"] and len(history.iterations) == 0:
         raise KeyboardInterrupt  # interrupted before the gravity stage converged: nothing to keep
+    if len(history.iterations) == 0:
+        raise mf.SolveError(f"jmm: the wall does not stand under its own weight in the jointed continuum: "
+                            f"{info['stop_reason']}; a finer mesh_size, or la or fdem on the blocks themselves")
     if not info["interrupted"]:  # an interrupted run leaves the bar where it stopped
         progress(1.0, info["stop_reason"])
     flow = "associative" if options["dilatancy"] is None else "nonassociative"  # the continuum's flow rule

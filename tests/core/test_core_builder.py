@@ -316,9 +316,9 @@ SECOND_OPENING = {"x": 0.3, "y": 0.1, "width": 0.1, "height": 0.05, "lintel_bear
         (_set("wall.width", "0.6"), "wall.width"),
         (_set("unit.length", -0.2), "unit.length"),
         (_set("wall.thickness", 0.0), "wall.thickness"),
-        (_set("wall.height", 0.23), "wall.height"),
+        (_set("wall.height", -0.3), "wall.height"),  # 0.23 (not whole courses) is laid, a cut course on top
         (_set("length_unit", "km"), "length_unit"),
-        (_set("bond", {"pattern": "flemish"}), "bond.pattern"),
+        (_set("bond", {"pattern": "herringbone"}), "bond.pattern"),  # flemish is laid (masonryfw.bond)
         (_set("material.friction", 0.4), "material.friction"),
         (_set("material.friction_angle", DELETE), "material.friction_angle"),
         (_set("material.poisson_ratio", 0.5), "material.poisson_ratio"),

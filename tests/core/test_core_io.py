@@ -280,8 +280,8 @@ def test_save_fills_cf_attributes_from_the_format(tmp_path):
         assert nc["node_x"].units == "m" and nc["dead_load"].units == "N"
         role = nc["block_role"]
         assert role.dtype == np.int8 and role.flag_values.dtype == np.int8
-        assert list(role.flag_values) == [0, 1, 2, 3]
-        assert role.flag_meanings == "unit lintel fixed_support moving_support"
+        assert list(role.flag_values) == [0, 1, 2, 3, 4]
+        assert role.flag_meanings == "unit lintel fixed_support moving_support voussoir"
         assert nc["block_geometry"].geometry_type == "polygon"
         assert nc["extra"].long_name == "plugin data"  # a plugin's own attributes are kept
         for name in ("node_x", "block_role", "dead_load", "extra"):

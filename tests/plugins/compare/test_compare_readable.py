@@ -146,8 +146,10 @@ def test_the_mechanism_numbers_the_pieces_holding_two_percent_of_the_masonry(ope
     assert f"cracked joints ({cracked})" in legend
     faces = [c for c in ax.collections if c.get_linewidths()[0] > 1.0]
     assert len(faces[0].get_segments()) == 2 * cracked  # each crack on both blocks' faces
-    assert ax.get_title().endswith(f"alpha = {float(ds.collapse_multiplier):.4f}, collapse reaction "
-                                   f"{(1 - float(ds.collapse_multiplier)) * R0:.4g} N")
+    title = ax.get_title().replace("\n", " ")
+    assert f"alpha = {float(ds.collapse_multiplier):.4f} (the share of R0 = {R0:.4g} N the settling ground sheds " \
+        "before collapse)" in title
+    assert title.endswith(f"collapse reaction {(1 - float(ds.collapse_multiplier)) * R0:.4g} N")
 
 
 def test_a_sweep_s_points_go_on_the_history_at_their_settlements(opened):

@@ -54,7 +54,9 @@ def test_the_discrete_plot_kinds_draw_a_real_result(la_12c, kind):
     figure, ax = plot(la_12c, kind)
     # R0 = 792 N * 0.6 / 1.1 = 432 N (datasets/README.md); the collapse reaction is (1 - alpha) R0
     alpha = float(la_12c.collapse_multiplier)
-    assert ax.get_title() == f"Test 12C - la (highs)\nalpha = {alpha:.4f}, collapse reaction {(1 - alpha) * 432:.4g} N"
+    assert ax.get_title().replace("\n", " ") == (f"Test 12C - la (highs) alpha = {alpha:.4f} (the share of R0 = 432 N "
+                                                f"the settling ground sheds before collapse), collapse reaction "
+                                                f"{(1 - alpha) * 432:.4g} N")
     assert len(ax.collections) >= 2
 
 
