@@ -181,18 +181,21 @@ def draw_history(datasets: Sequence[xr.Dataset], ax, options: Mapping[str, Any])
             if first > 0 and not log:  # the reactions of the gravity stage, at zero settlement
                 low, high = float(r[:first + 1].min()), float(r[:first + 1].max())
                 handles.append(ax.vlines(0.0, low, high, color=colour, lw=4, alpha=0.35,
-                                         label=f"{label}: gravity stage, {first + 1} records, {low:.4g}..{high:.4g} N"))
+                                         label=f"{label}: gravity stage, {first + 1} records, "
+                                               f"{mfp.force_text(low)}..{mfp.force_text(high)}"))
         handles += _draw_sweeps(ax, sweeps, len(incremental))
         references = [*incremental, *limits]
         r0 = mf.dead_reaction(references[0]) if references else 0.0
         if r0 > 0:
-            handles.append(ax.axhline(r0, ls="--", lw=0.9, color="0.35", label=f"dead reaction R0 = {r0:.4g} N"))
+            handles.append(ax.axhline(r0, ls="--", lw=0.9, color="0.35", label=f"dead reaction R0 = {mfp.force_text(r0)}"))
         for ds, style in zip(limits, (":", "-.", (0, (1, 3)), (0, (5, 2)))):
             collapse = (1 - float(ds.collapse_multiplier.values)) * mf.dead_reaction(ds)
             handles.append(ax.axhline(collapse, ls=style, lw=1.2, color="k",
-                                      label=f"{mf.result_label(ds)}: (1 - alpha) R0 = {collapse:.4g} N"))
+                                      label=f"{mf.result_label(ds)}: (1 - alpha) R0 = {mfp.force_text(collapse)}"))
         strips, rows = _damage_strips(ax, incremental)
-        ax.set_ylabel("settlement reaction [N]" if _profiled(references) else "reaction on the moving support [N]")
+        unit = _force_axis(ax, r0)
+        ax.set_ylabel(f"settlement reaction [{unit}]" if _profiled(references) else
+                      f"reaction on the moving support [{unit}]")
         ax.set_ylim(bottom=min(0.0, ax.get_ylim()[0]))
         ax.legend(handles=handles + strips, loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=2,
                   fontsize="small", frameon=False)
@@ -206,6 +209,18 @@ def draw_history(datasets: Sequence[xr.Dataset], ax, options: Mapping[str, Any])
         ax.set_title(f"{title_of(incremental[0])}\n{mf.headline_text(incremental[0])}", fontsize="medium")
     else:
         ax.set_title(str(datasets[0].attrs.get("title", "")), fontsize="medium")
+
+
+def _force_axis(ax, reference: float) -> str:
+    """The force axis in kN where the forces are kN-sized (R0, else the largest drawn, from 1 kN), else N; the
+    unit its label gives. The curves keep newtons: only the ticks are written in kN."""
+    from matplotlib.ticker import FuncFormatter
+
+    largest = max(abs(reference), *(abs(v) for v in ax.get_ylim()))
+    if largest < 1000:
+        return "N"
+    ax.yaxis.set_major_formatter(FuncFormatter(lambda value, _: f"{value / 1000:g}"))
+    return "kN"
 
 
 def _fit_y_to_shown(ax, curves: Sequence[tuple[np.ndarray, np.ndarray]]) -> None:

@@ -168,7 +168,8 @@ def test_the_readme_takes_the_bundled_gable_house_from_its_drawing_to_a_report(t
         "180x120mm", "--dpi", "300")
     run("report", "gable.la.nc", "gable.fdem.nc", "gable.jmm.nc", "-o", "gable-house.html")
     page = (tmp_path / "gable-house.html").read_text()
-    assert page.count("<figure") >= 6 and 'id="r0-note"' in page
+    # over the trough every part of the ground settles: la's and fdem's R0 agree (0.1 %), so no R0 note
+    assert page.count("<figure") >= 6 and "quasi-static check" in page and 'id="r0-note"' not in page
 
 
 @pytest.mark.parametrize("name", mf.CASE_NAMES + ("tunnel-facade", "facade-1-trough"))

@@ -192,3 +192,18 @@ def test_what_a_figure_shows_fits_the_page_asked_for(test_12c_files, size):
         assert tuple(figure.get_size_inches()) == pytest.approx(size)
         assert box.x0 >= -0.011 and box.y0 >= -0.011, kind
         assert box.x1 <= size[0] + 0.011 and box.y1 <= size[1] + 0.011, kind
+
+
+def test_the_history_axis_is_in_kn_where_the_forces_are_kn_sized(test_12c_files):
+    fdem = mf.open_dataset(test_12c_files["fdem"])
+    ax = mf.render([fdem], "history").axes[0]
+    assert ax.get_ylabel().endswith("[N]")  # Test 12C: R0 = 432 N
+    heavy = fdem.assign(step_reaction=fdem.step_reaction * 300.0)  # the same history, 300 times heavier
+    heavy["dead_load"] = fdem.dead_load * 300.0
+    ax = mf.render([heavy], "history").axes[0]
+    assert ax.get_ylabel().endswith("[kN]")
+    ax.figure.canvas.draw()
+    ticks = {t.get_position()[1]: t.get_text() for t in ax.get_yticklabels()}
+    assert all(text == f"{value / 1000:g}" for value, text in ticks.items())  # the curves keep newtons
+    legend = [t.get_text() for t in ax.get_legend().get_texts()]
+    assert f"dead reaction R0 = {mfp.force_text(300 * R0_12C)}" in legend
