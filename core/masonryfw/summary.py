@@ -380,11 +380,10 @@ def r0_text(results: Sequence[xr.Dataset], labels: Sequence[str]) -> str:
     """Why results of one model report different R0 (empty when they agree within :data:`R0_SPREAD`): which R0
     each reports, and that over ground partly fixed and partly settling the split of the weight is statically
     indeterminate."""
-    r0 = {label: n.value for label, result in zip(labels, results) for n in key_numbers(result)
-          if n.name == "dead_reaction"}
+    numbers = {label: {n.name: n.value for n in key_numbers(result)} for label, result in zip(labels, results)}
+    r0 = {label: n["dead_reaction"] for label, n in numbers.items() if "dead_reaction" in n}
     if len(r0) < 2 or max(r0.values()) - min(r0.values()) <= R0_SPREAD * max(abs(v) for v in r0.values()):
         return ""
-    numbers = {label: {n.name for n in key_numbers(result)} for label, result in zip(labels, results)}
     said = [f"{label} reports {force_text(value)}, "
             + ("W L_s / L_total, the weight shared between the ground's parts by their contact lengths (the "
                "convention of limit analysis: alpha is a share of it)" if "alpha" in numbers[label] else

@@ -112,8 +112,8 @@ class WidestCrack:
 
     def label(self) -> str:
         names = {value: name.replace("_", " ") for name, value in mfp.flags("step_damage_category").items()}
-        category = f": damage category {self.category} {names.get(self.category, '')}" if self.category >= 0 else ""
-        return f"widest crack {self.width * 1000:.3g} mm{category}".rstrip().replace(": damage", ":\ndamage")
+        category = f":\ndamage category {self.category} {names.get(self.category, '')}" if self.category >= 0 else ""
+        return f"widest crack {self.width * 1000:.3g} mm{category}".rstrip()
 
 
 def widest_crack(ds: xr.Dataset) -> WidestCrack | None:
@@ -128,10 +128,10 @@ def widest_crack(ds: xr.Dataset) -> WidestCrack | None:
     return WidestCrack(interface, width, category)
 
 
-def _mark_widest(ax, ds: xr.Dataset, point: tuple[float, float] | None, handles: list) -> None:
-    """A ring round the widest crack at ``point`` and its legend entry; for a result without widths, a legend line
-    saying why there is none."""
-    widest = widest_crack(ds)
+def _mark_widest(ax, ds: xr.Dataset, widest: WidestCrack | None, point: tuple[float, float] | None,
+                 handles: list) -> None:
+    """A ring round the ``widest`` crack at ``point`` and its legend entry; for a result without widths, a legend
+    line saying why there is none."""
     if widest is None or point is None:
         if "collapse_multiplier" in ds:
             handles.append(Line2D([], [], color="none", label="no crack widths: limit analysis gives the\n"
@@ -260,7 +260,7 @@ def draw_mechanism(datasets: Sequence[xr.Dataset], ax, options: Mapping[str, Any
                                  np.array([geo.interface_y.values[k].mean()]),
                                  np.array([int(geo.interface_blocks.values[k, 0])]))
         point = (float(px[0]), float(py[0]))
-    _mark_widest(ax, ds, point, handles)
+    _mark_widest(ax, ds, widest, point, handles)
     ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize="small", frameon=False,
               title=f"displacements x {amplification:.3g}", title_fontsize="small")
     finish_axes(ax, ds)
@@ -297,7 +297,7 @@ def draw_cracks(datasets: Sequence[xr.Dataset], ax, options: Mapping[str, Any]) 
     widest = widest_crack(ds)
     point = None if widest is None else (float(geo.interface_x.values[widest.interface].mean()),
                                          float(geo.interface_y.values[widest.interface].mean()))
-    _mark_widest(ax, ds, point, handles)
+    _mark_widest(ax, ds, widest, point, handles)
     ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize="small", frameon=False)
     finish_axes(ax, ds)
 
