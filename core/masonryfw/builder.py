@@ -36,6 +36,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, replace
+from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -101,6 +102,11 @@ def load_wall(path_or_text) -> dict:
 
 
 def _validated(spec: dict, base_dir) -> dict:
+    if is_outlined(spec):  # checked as it is laid (masonryfw.outlined); its drawing found from the spec's folder
+        geometry = spec.get("geometry", {})
+        drawings = {k: str(Path(base_dir or ".", Path(geometry[k]).expanduser()).resolve())
+                    for k in ("dxf", "polygons") if isinstance(geometry.get(k), str)}
+        return {**spec, "geometry": {**geometry, **drawings}} if drawings else spec
     if is_drawn(spec):
         drawn = parse_drawn_spec(spec)
         key = drawn.drawing_key.split(".")[1]

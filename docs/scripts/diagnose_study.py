@@ -1,44 +1,41 @@
-"""The studies of docs/diagnose.md: forward then inverse, on walls the method was not tuned to.
+"""The studies of docs/diagnose.md: forward then inverse, on walls and surveys the method was not tuned to.
 
-1. ``generator``: random walls (size, unit, bond, openings; ``masonryfw_diagnose.synthetic``) over a random
-   known scenario (a step at one end, a Gaussian trough, a tilt), solved forward by fdem (to 2 % of the wall
-   height) and by la; the cracked joints (fdem: open or slipping over 0.1 mm at the end; la: crack
-   indicator over 0.1) drawn as a surveyor would (lines offset 0.2 h, 10 % of the joints left out, cracks
-   shorter than h missed, one spurious hairline), widths from fdem's openings; diagnosed with la. Success:
-   the family right, a step's or tilt's ends within two segments, a trough's centre within 10 % of the wall,
-   sagging/hogging right, the truth in the plausible set; the magnitude against fdem's settlement.
-2. ``noise``: the la cases again, one surveyor error at a time (offset, missing cracks, spurious lines).
+1. ``cases``: the held-out surveys of datasets/surveys/study (docs/scripts/diagnose_cases.py: facades with
+   openings cracked by fdem, drawn by four surveyors, levelled with 0.3 mm noise), each diagnosed from its
+   cracks and from its cracks and its levelling, judged against its truth by ``synthetic.judged`` (what the
+   answer determined: side, edge within two segments, sagging/hogging; the family where it claims one; the
+   truth in the plausible set; the differential settlement against fdem's), before and after the default
+   re-ranking by fdem. ``--half tuning`` or ``--half held-back`` runs one half (cases-<half>.json).
+2. ``table``: the doc's table from the halves' numbers.
 3. ``walls``: the paper's ten walls, the cracks of their own la and fdem results as the survey.
-
 4. ``survey``: the bundled survey of the README tour (datasets/surveys/).
 
-    python docs/scripts/diagnose_study.py [generator|noise|walls|survey ...] [--cases 30] [--cache DIR]
+    python docs/scripts/diagnose_study.py [cases|table|walls|survey ...] [--half tuning] [--cache DIR]
 
-Forward results are kept in the cache (default /tmp/masonryfw-diagnose-study): a re-run only diagnoses.
-Prints the tables of the doc and writes docs/img/diagnose/*.json (the numbers) and the example figure.
+Forward results of ``walls`` and the rows of ``cases`` are kept in the cache (default
+/tmp/masonryfw-diagnose-study): a re-run only does what is missing. Prints the tables of the doc and writes docs/img/diagnose/*.json (the numbers) and the figures.
 """
 from __future__ import annotations
 
 import argparse
 import json
 import time
-from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 
 import masonryfw as mf
 import masonryfw.plugin_api as mfp
-from masonryfw_diagnose import Survey, describe, diagnose, to_dataset
+from masonryfw_diagnose import Survey, describe, diagnose, read_cracks, read_levelling, to_dataset, wall_model
 from masonryfw_diagnose import synthetic as sy
+from masonryfw_diagnose.rerank import DEFAULT_BUDGET, affordable, rerank
 
 ROOT = Path(__file__).resolve().parents[2]
 IMAGES = ROOT / "docs" / "img" / "diagnose"
-SURVEYOR = sy.Surveyor(offset=0.2, gaps=0.1, missing=1.0, spurious=1)
+CASES = ROOT / "datasets" / "surveys" / "study"
 FDEM_WIDTH = 1e-4  # m: a joint open or slipping more is a crack the surveyor sees
 TEN_WALLS = ("test-8c", "test-12c", "panel-1", "panel-2", "panel-3", "panel-4", "panel-5", "facade-1", "facade-2",
              "facade-3")
-NOISE = {"offset": (0.0, 0.25, 0.5, 1.0), "missing": (0.0, 2.0, 4.0), "spurious": (0, 3, 6)}
 
 
 def survey_of(collection: dict) -> Survey:
@@ -64,78 +61,98 @@ def forward(cache: Path, key: str, model, solver: str):
     return result
 
 
-def case(seed: int):
-    rng = np.random.default_rng(seed)
-    spec = sy.random_wall(rng)
-    truth = sy.random_truth(spec, rng)
-    return spec, truth
+def study_cases() -> list[Path]:
+    return sorted(p for p in CASES.iterdir() if (p / "truth.json").is_file())
 
 
-def run_case(spec: dict, truth: dict, result, joints, surveyor: sy.Surveyor, seed: int, widths=None) -> dict:
-    collection = sy.draw(result, joints, surveyor, np.random.default_rng(1000 + seed), widths)
-    if not collection["features"]:
-        return {"seed": seed, "skipped": "no crack drawn"}
+def diagnose_case(folder: Path, levelled: bool) -> dict:
+    """One case of the held-out set (docs/scripts/diagnose_cases.py) diagnosed from its cracks, or its cracks and
+    its levelling, and judged against its truth."""
+    about = json.loads((folder / "truth.json").read_text())
+    survey = read_cracks(folder / "cracks.geojson")
+    if levelled:
+        survey = survey.with_levelling(read_levelling(folder / "levelling.csv", "m"), "levelling.csv")
     started = time.perf_counter()
-    diagnosis = diagnose(mf.build({**spec, **mf.STAND_IN_GROUND}), survey_of(collection))
+    diagnosis = diagnose(wall_model(str(folder / "wall.toml")), survey)
     seconds = time.perf_counter() - started
-    judged = sy.judged([c.table for c in diagnosis.candidates], [c.table for c in diagnosis.plausible], truth,
-                       diagnosis.extent, diagnosis.segment)
-    return {"seed": seed, "wall": spec["title"], "openings": len(spec.get("openings", [])), "truth": truth,
-            "best": diagnosis.best.table, "score": diagnosis.best.score.total, "plausible": len(diagnosis.plausible),
-            "candidates": len(diagnosis.candidates), "seconds": seconds, "magnitude": diagnosis.best.score.magnitude,
-            "lines": len(collection["features"]), **judged}
+    truth = {k: v for k, v in about["truth"].items() if k != "target"}
+    by_la = sy.judged(diagnosis, truth, about["settlement"])
+    started = time.perf_counter()
+    rerank(diagnosis, affordable(diagnosis, DEFAULT_BUDGET))  # as the command does by default
+    return {"case": folder.name, "half": about["half"], "levelled": levelled, "truth": truth,
+            "settlement": about["settlement"], "best": describe(diagnosis.best.table),
+            "score": diagnosis.best.score.total, "candidates": len(diagnosis.candidates), "seconds": seconds,
+            "rerank_seconds": time.perf_counter() - started, "reranked": diagnosis.reranked,
+            "family_probability": diagnosis.family_probability, "by_la": by_la,
+            **sy.judged(diagnosis, truth, about["settlement"])}
 
 
-def rates(rows: list[dict]) -> dict:
-    done = [r for r in rows if "family" in r]
-    troughs = [r for r in done if r["truth"]["profile"] == "gaussian"]
-    return {"cases": len(done), "family": np.mean([r["family"] for r in done]),
-            "place": np.mean([r["place"] for r in done]), "in_plausible": np.mean([r["in_plausible"] for r in done]),
-            "shape": np.mean([r["shape"] for r in troughs]) if troughs else float("nan"),
-            "troughs": len(troughs), "median_plausible": float(np.median([r["plausible"] for r in done])),
-            "median_seconds": float(np.median([r["seconds"] for r in done]))}
+def summary(rows: list[dict]) -> dict:
+    """The shares of docs/diagnose.md's table for ``rows``."""
+    ratios = [r["magnitude_ratio"] for r in rows if r["magnitude_ratio"] is not None]
+    claimed = [r for r in rows if r["claims"]]
+    determined = [r for r in rows if r["found_side"] is not None]
+    return {"cases": len(rows), "side_determined": len(determined), "side": sum(r["side"] for r in rows),
+            "edge": sum(r["edge"] for r in rows),
+            "side_and_edge": sum(r["side_and_edge"] for r in rows), "mode": sum(r["mode"] for r in rows),
+            "family": sum(r["family"] for r in rows), "place": sum(r["place"] for r in rows),
+            "claims": len(claimed), "claimed_right": sum(r["family"] for r in claimed),
+            "in_plausible": sum(r["in_plausible"] for r in rows),
+            "median_plausible": float(np.median([r["plausible"] for r in rows])),
+            "magnitude_within_25": sum(abs(q - 1) <= 0.25 for q in ratios), "magnitudes": len(ratios),
+            "magnitude_quartiles": [float(v) for v in np.percentile(ratios, [25, 50, 75])] if ratios else None,
+            "median_seconds": float(np.median([r["seconds"] for r in rows])),
+            "median_rerank_seconds": float(np.median([r.get("rerank_seconds", 0.0) for r in rows]))}
 
 
-def generator(cases: int, cache: Path) -> dict:
-    out = {}
-    for solver in ("la", "fdem"):
-        rows = []
-        for seed in range(cases):
-            spec, truth = case(seed)
-            model = mf.build({**spec, "settlement": truth, "loading": {"type": "settlement"}})
-            try:
-                result = forward(cache, f"case{seed}", model, solver)
-            except mf.MasonryError as exc:
-                rows.append({"seed": seed, "skipped": str(exc).splitlines()[0]})
-                continue
-            if solver == "la":
-                row = run_case(spec, truth, result, sy.visible_cracks(result), SURVEYOR, seed)
+def cases(cache: Path, halves: tuple[str, ...] = ("tuning", "held-back")) -> dict:
+    """Every case of ``halves`` diagnosed (its row kept in ``cache``: a re-run reuses it); a case whose surveyor
+    drew no crack is counted as skipped."""
+    out: dict = {"rows": [], "skipped": []}
+    for folder in study_cases():
+        if json.loads((folder / "truth.json").read_text())["half"] not in halves:
+            continue
+        if not json.loads((folder / "cracks.geojson").read_text())["features"]:
+            out["skipped"].append({"case": folder.name, "why": "no crack drawn (none over 0.1 mm, or all missed)"})
+            continue
+        for levelled in (False, True):
+            kept = cache / "rows" / f"{folder.name}-{'levelling' if levelled else 'cracks'}.json"
+            if kept.is_file():
+                row = json.loads(kept.read_text())
             else:
-                joints = sy.visible_cracks(result, width=FDEM_WIDTH)
-                opening = np.maximum(result.interface_opening.values, 0.0).max(axis=1)
-                row = run_case(spec, truth, result, joints, SURVEYOR, seed,
-                               {int(j): 1e3 * float(opening[j]) for j in joints})
-                row["settlement"] = float(result.step_settlement.values[-1])
-            rows.append(row)
-            print(solver, json.dumps(row, default=float), flush=True)
-        out[solver] = {"rows": rows, "rates": rates(rows)}
-        print(solver, out[solver]["rates"], flush=True)
+                row = diagnose_case(folder, levelled)
+                kept.parent.mkdir(parents=True, exist_ok=True)
+                kept.write_text(json.dumps(row, default=float))
+            out["rows"].append(row)
+            print(json.dumps(row, default=float), flush=True)
+    for half in halves:
+        for levelled in (False, True):
+            rows = [r for r in out["rows"] if r["half"] == half and r["levelled"] == levelled]
+            out[f"{half}/{'levelling' if levelled else 'cracks'}"] = summary(rows)
+            out[f"{half}/{'levelling' if levelled else 'cracks'}/la"] = summary([{**r, **r["by_la"]} for r in rows])
+            print(half, levelled, summary(rows), flush=True)
     return out
 
 
-def noise(cases: int, cache: Path) -> dict:
+def table() -> dict:
+    """docs/diagnose.md's table of the held-out study, from the halves' numbers (docs/img/diagnose/cases-*.json)."""
+    lines = ["| half | survey | ranked by | cases | side determined (right) | side and edge right | mode right | "
+             "family right (claimed, right) | family and place right | truth plausible | median plausible | "
+             "magnitude within 25 % | magnitude ratio quartiles |",
+             "|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|"]
     out = {}
-    for factor, levels in NOISE.items():
-        for level in levels:
-            surveyor = replace(sy.Surveyor(), **{factor: level})
-            rows = []
-            for seed in range(cases):
-                spec, truth = case(seed)
-                model = mf.build({**spec, "settlement": truth, "loading": {"type": "settlement"}})
-                result = forward(cache, f"case{seed}", model, "la")
-                rows.append(run_case(spec, truth, result, sy.visible_cracks(result), surveyor, seed))
-            out[f"{factor}={level}"] = rates(rows)
-            print(factor, level, out[f"{factor}={level}"], flush=True)
+    for half in ("tuning", "held-back"):
+        numbers = json.loads((IMAGES / f"cases-{half}.json").read_text())
+        for survey in ("cracks", "levelling"):
+            for ranked, key in (("la", f"{half}/{survey}/la"), ("la + fdem", f"{half}/{survey}")):
+                n = numbers[key]
+                quartiles = ", ".join(f"{q:.2f}" for q in n["magnitude_quartiles"]) if n["magnitude_quartiles"] else "-"
+                lines.append(f"| {half} | {survey} | {ranked} | {n['cases']} | {n['side_determined']} "
+                             f"({n['side']}) | {n['side_and_edge']} | {n['mode']} | {n['family']} ({n['claims']}, "
+                             f"{n['claimed_right']}) | {n['place']} | {n['in_plausible']} | {n['median_plausible']:g} | "
+                             f"{n['magnitude_within_25']} of {n['magnitudes']} | {quartiles} |")
+                out[key] = n
+    print("\n".join(lines))
     return out
 
 
@@ -160,7 +177,7 @@ def walls(cache: Path) -> dict:
                    "score": diagnosis.best.score.total, "plausible": len(diagnosis.plausible),
                    "candidates": len(diagnosis.candidates), "joints": int(joints.size), "segment": diagnosis.segment,
                    "edge_found": bool(found), "seconds": time.perf_counter() - started,
-                   "either_end": diagnosis.either_end()}
+                   "side": diagnosis.determined().side}
             out[f"{name}/{solver}"] = row
             print(json.dumps(row, default=float), flush=True)
             if name == "facade-1" and solver == "fdem":
@@ -191,16 +208,21 @@ def survey(cache: Path) -> dict:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("studies", nargs="*", default=["generator", "noise", "walls"])
-    parser.add_argument("--cases", type=int, default=30)
+    parser.add_argument("studies", nargs="*", default=["cases", "walls"])
+    parser.add_argument("--half", action="append", choices=("tuning", "held-back"),
+                        help="the halves of the held-out set the cases study runs [default: both]")
     parser.add_argument("--cache", type=Path, default=Path("/tmp/masonryfw-diagnose-study"))
     args = parser.parse_args()
+    args.half = args.half or ["tuning", "held-back"]
     args.cache.mkdir(parents=True, exist_ok=True)
     IMAGES.mkdir(parents=True, exist_ok=True)
     for study in args.studies:
-        numbers = {"generator": lambda: generator(args.cases, args.cache), "noise": lambda: noise(args.cases, args.cache),
-                   "walls": lambda: walls(args.cache), "survey": lambda: survey(args.cache)}[study]()
-        (IMAGES / f"{study}.json").write_text(json.dumps(numbers, indent=1, default=float) + "\n")
+        numbers = {"cases": lambda: cases(args.cache, tuple(args.half)), "table": table, "walls": lambda: walls(args.cache),
+                   "survey": lambda: survey(args.cache)}[study]()
+        if study == "table":  # printed for the doc, from the numbers written
+            continue
+        name = f"cases-{args.half[0]}" if study == "cases" and len(args.half) == 1 else study
+        (IMAGES / f"{name}.json").write_text(json.dumps(numbers, indent=1, default=float) + "\n")
 
 
 if __name__ == "__main__":

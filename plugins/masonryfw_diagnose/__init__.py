@@ -2,7 +2,9 @@
 
 Registration only (cheap to import); the work lives in :mod:`.survey` (reading crack maps and levellings),
 :mod:`.scenarios` (the ``[settlement]`` tables tried), :mod:`.scoring` (how well a mechanism explains a
-survey), :mod:`.diagnosis` (the search and the ranking), :mod:`.dataset` (the ``diagnosis`` dataset and the
+survey's cracks), :mod:`.levelling` (the levelling as evidence, the free profile), :mod:`.diagnosis` (the
+search and the ranking), :mod:`.parallel` (where the scenarios are solved), :mod:`.rerank` (the second
+physics), :mod:`.features` (what a survey determines), :mod:`.dataset` (the ``diagnosis`` dataset and the
 ``--json`` contract), :mod:`.plotting` (the ``diagnosis`` plot) and :mod:`.commands` (the CLI command).
 docs/diagnose.md says what the scores mean and where the method stops.
 

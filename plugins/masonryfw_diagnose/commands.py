@@ -1,6 +1,7 @@
 """The ``diagnose`` command this plugin adds to the ``masonryfw`` CLI."""
 from __future__ import annotations
 
+import contextlib
 import json
 import time
 from pathlib import Path
@@ -35,20 +36,38 @@ def _ranking_lines(diagnosis, top: int) -> list[str]:
 
     x_a, x_b = diagnosis.extent
     levelled = diagnosis.survey.levelling is not None
-    header = f"{'rank':>4}  {'score':>5}  {'cracks':>6}  {'level':>5}  {'t [mm]':>7}  {'':1}  scenario"
+    forward = f"  {diagnosis.ranked_by:>5}" if diagnosis.reranked else ""
+    header = f"{'rank':>4}{forward}  {'score':>5}  {'cracks':>6}  {'level':>5}  {'t [mm]':>7}  {'':1}  scenario"
     lines = [header]
     shown = max(top, 1)
     for c in diagnosis.candidates[:shown]:
         level = f"{c.score.levelling:5.2f}" if levelled and c.score.levelling is not None else f"{'-':>5}"
         magnitude = f"{1e3 * c.score.magnitude:7.3g}" if c.score.magnitude is not None else f"{'-':>7}"
         shape = scenarios.shape(c.table, x_a, x_b)
-        lines.append(f"{c.rank:>4}  {c.score.total:5.2f}  {c.score.crack:6.2f}  {level}  {magnitude}  "
+        again = (f"  {c.reranked:5.2f}" if c.reranked is not None else f"  {'-':>5}") if forward else ""
+        lines.append(f"{c.rank:>4}{again}  {c.score.total:5.2f}  {c.score.crack:6.2f}  {level}  {magnitude}  "
                      f"{'*' if c.plausible else ' '}  {scenarios.describe(c.table)}{f' ({shape})' if shape else ''}")
     plausible = len(diagnosis.plausible)
     if plausible > shown:
         lines.append(f"   ... {plausible - shown} more plausible candidate(s) (* marks the plausible set; all in the "
                      "output file)")
     return lines
+
+
+def _levelling_lines(diagnosis) -> list[str]:
+    """The levelling's evidence: its noise, the families' probabilities, the free profile."""
+    import numpy as np
+
+    if diagnosis.free is None:
+        return []
+    free = diagnosis.free
+    probabilities = ", ".join(f"{family} {p:.2f}" for family, p in sorted(diagnosis.family_probability.items(),
+                                                                           key=lambda item: -item[1]))
+    deepest = float(free.x[int(np.argmax(free.settlement))])
+    return [f"levelling: sigma {1e3 * diagnosis.sigma:.2g} mm ({'given' if diagnosis.sigma_given else 'from the data'});"
+            f" the families by its evidence: {probabilities}",
+            f"free ground profile (the course following its ground): settles most at {deepest:.3g} m, "
+            f"{1e3 * free.magnitude:.3g} mm over its least settling point"]
 
 
 def _table_lines(table: dict) -> list[str]:
@@ -80,6 +99,19 @@ def _table_lines(table: dict) -> list[str]:
 @click.option("--plugin", "solver", default="la", show_default=True,
               help="The solver whose cracks are matched (la: its collapse mechanism).")
 @click.option("--option", "options", multiple=True, metavar="KEY=VALUE", help="A solver option (repeatable).")
+@click.option("--levelling-sigma", "sigma_mm", type=click.FloatRange(min=0.0, min_open=True), metavar="MM",
+              help="The levelling's noise, its standard deviation [mm] [default: read from the data, the median "
+                   "absolute deviation of its second differences].")
+@click.option("--rerank", type=click.IntRange(min=0), metavar="N",
+              help="Re-rank the best N candidates by forward fdem runs to their settlements, scored on fdem's "
+                   "cracks (0: rank by the search's solver alone) [default: as many of the best 5 as fit in "
+                   "--budget].")
+@click.option("--budget", type=click.FloatRange(min=0.0), default=120.0, show_default=True, metavar="SECONDS",
+              help="The time the default re-ranking may take, by fdem's estimate.")
+@click.option("--workers", type=click.IntRange(min=1), default=1, show_default=True,
+              help="Solve the scenarios on this many local processes.")
+@click.option("--scheduler", metavar="ADDRESS",
+              help="Solve the scenarios on the running dask cluster at ADDRESS (tcp://host:port); left running.")
 @click.option("--verify", "verify_with", metavar="SOLVER",
               help="Run the best candidates (at most 3, at most --top) forward with SOLVER (e.g. fdem) to their "
                    "estimated settlement.")
@@ -90,7 +122,8 @@ def _table_lines(table: dict) -> list[str]:
 @mfp.PROGRESS
 def diagnose_command(wall: str, cracks: str, cracks_layer: str | None, levelling: str | None, unit: str | None,
                      families: tuple[str, ...], segment: float | None, tolerance: float | None, solver: str,
-                     options: tuple[str, ...], verify_with: str | None, top: int, as_json: bool,
+                     options: tuple[str, ...], sigma_mm: float | None, rerank: int | None, budget: float,
+                     workers: int, scheduler: str | None, verify_with: str | None, top: int, as_json: bool,
                      output: str | None, progress: bool | None) -> None:
     """Which settlement of the ground under WALL explains the surveyed cracks?
 
@@ -101,10 +134,14 @@ def diagnose_command(wall: str, cracks: str, cracks_layer: str | None, levelling
     diagnosis dataset (`masonryfw plot OUT --kind diagnosis`, `masonryfw report OUT`). Ctrl-C writes what
     was ranked so far (exit status 130).
     """
-    from . import dataset
+    from . import dataset, parallel
     from .diagnosis import KEPT, prepare, search, verify, wall_model
+    from .rerank import affordable
+    from .rerank import rerank as rerank_by
     from .survey import read_cracks, read_levelling
 
+    if scheduler and workers > 1:
+        raise click.UsageError("--workers sizes the local processes; it cannot be used with --scheduler")
     inputs = mfp.input_files(wall, cracks, levelling)
     out = Path(output) if output else _default_output(wall)
     mfp.check_output_path(out, inputs)
@@ -116,16 +153,26 @@ def diagnose_command(wall: str, cracks: str, cracks_layer: str | None, levelling
     if verify_with:
         mf.get_solver(verify_with)
     model = wall_model(wall)
-    diagnosis = prepare(model, survey, families, segment, solver, solver_options, tolerance)
-    expected = f"; expect about {mfp.duration_text(diagnosis.expected.seconds)}" if diagnosis.expected else ""
+    sigma = None if sigma_mm is None else 1e-3 * sigma_mm
+    diagnosis = prepare(model, survey, families, segment, solver, solver_options, tolerance, sigma)
+    share = 1 if scheduler else workers  # a cluster's size is its own
+    expected = (f"; expect about {mfp.duration_text(diagnosis.expected.seconds / share)}"
+                f"{f' on {workers} processes' if workers > 1 else ''}" if diagnosis.expected else "")
     click.echo(f"diagnose: {len(diagnosis.tables):,} scenarios ({', '.join(families)}) with {solver} on "
                f"{len(diagnosis.model.block) - int(mfp.masonry_blocks(diagnosis.model.block_role.values).sum())} "
                f"ground pieces{expected}; Ctrl-C keeps the ranking of those tried", err=True)
     bar = mfp.progress_bar(progress)
     started = time.perf_counter()
     try:
-        search(diagnosis, solver_options, progress=bar or mfp.no_progress)
-        if verify_with and not diagnosis.interrupted:
+        where = (parallel.dask_cluster(scheduler) if scheduler else parallel.local_processes(workers)
+                 if workers > 1 else contextlib.nullcontext(parallel.serial))
+        with where as runner:
+            search(diagnosis, solver_options, progress=bar or mfp.no_progress, runner=runner)
+        count = (rerank if rerank is not None else affordable(diagnosis, budget)) if not diagnosis.interrupted else 0
+        if count:
+            click.echo(f"diagnose: re-ranking the best {count} by forward fdem runs to their settlements", err=True)
+            rerank_by(diagnosis, count, progress=bar or mfp.no_progress)
+        if verify_with and not (diagnosis.interrupted or diagnosis.rerank_interrupted):
             verify(diagnosis, verify_with, min(top, KEPT), progress=bar or mfp.no_progress)
     finally:
         if bar is not None:
@@ -133,6 +180,9 @@ def diagnose_command(wall: str, cracks: str, cracks_layer: str | None, levelling
     seconds = time.perf_counter() - started
     mf.save(dataset.to_dataset(diagnosis, wall), out, command=mfp.command_line(), protect=inputs)
     _report(diagnosis, wall, top, as_json, seconds, out)
+    if diagnosis.rerank_interrupted:
+        raise mf.Interrupted(f"the re-ranking was interrupted after {diagnosis.reranked} forward run(s): the ranking "
+                             f"with those is written to {out}")
     if diagnosis.interrupted:
         raise mf.Interrupted(f"interrupted after {len(diagnosis.candidates) + len(diagnosis.failed)} scenario(s): "
                              f"the ranking of those is written to {out}")
@@ -160,6 +210,8 @@ def _report(diagnosis, wall: str, top: int, as_json: bool, seconds: float, out: 
     for line in _ranking_lines(diagnosis, top):
         _echo(line, as_json)
     _echo(diagnosis.verdict(), as_json)
+    for line in _levelling_lines(diagnosis):
+        _echo(line, as_json)
     best = diagnosis.best
     if best.score.unexplained:
         names = ", ".join(repr(survey.names[k]) for k in best.score.unexplained[:8])

@@ -45,6 +45,10 @@ def _candidate_variables(diagnosis: Diagnosis) -> dict:
     }
     if diagnosis.survey.levelling is not None:
         columns["candidate_levelling_score"] = np.array([_nan(c.score.levelling) for c in candidates])
+        columns["candidate_magnitude_spread"] = np.array([c.score.fit.spread for c in candidates])
+        columns["candidate_ground_share"] = np.array([c.score.fit.share_ground for c in candidates])
+    if diagnosis.reranked:
+        columns["candidate_reranked_score"] = np.array([_nan(c.reranked) for c in candidates])
     if any(verified):
         columns["candidate_verified_crack_width"] = np.array([_nan(v.get("crack_width")) for v in verified])
         columns["candidate_verified_damage_category"] = np.array(
@@ -63,6 +67,8 @@ def _kept_variables(diagnosis: Diagnosis) -> dict:
         "kept_crack_indicator": (("kept", "interface"), np.stack(
             [mfp.indicator_at(c.result, SURVEY_THRESHOLD) for c in kept])),
     }
+    if diagnosis.survey.levelling is not None:
+        columns["kept_levelling_fit"] = (("kept", "levelling_point"), np.stack([c.score.fit.fitted for c in kept]))
     return {name: (dims, values, mfp.variable_attrs(name, "diagnosis")) for name, (dims, values) in columns.items()}
 
 
@@ -86,6 +92,8 @@ def _survey_variables(diagnosis: Diagnosis) -> dict:
     if survey.levelling is not None:
         for k, name in enumerate(("levelling_x", "levelling_y", "levelling_dy")):
             columns[name] = (("levelling_point",), survey.levelling[:, k])
+        columns["free_profile_x"] = (("free_node",), diagnosis.free.x)
+        columns["free_profile_settlement"] = (("free_node",), diagnosis.free.settlement)
     return {name: (dims, values, mfp.variable_attrs(name, "diagnosis")) for name, (dims, values) in columns.items()}
 
 
@@ -103,6 +111,7 @@ def to_dataset(diagnosis: Diagnosis, source_wall: str = "") -> xr.Dataset:
         "plausible_margin": PLAUSIBLE_MARGIN, "explained_threshold": EXPLAINED, "verdict": diagnosis.verdict(),
         "families": ",".join(diagnosis.families), "failed_candidates": len(diagnosis.failed),
         "source_cracks": survey.sources.get("cracks", ""), "survey_unit": survey.sources.get("unit", "m"),
+        "ranked_by": diagnosis.ranked_by or diagnosis.solver,
     }
     if source_wall:
         attrs["source_wall"] = source_wall
@@ -110,12 +119,30 @@ def to_dataset(diagnosis: Diagnosis, source_wall: str = "") -> xr.Dataset:
         attrs["source_levelling"] = survey.sources["levelling"]
     if diagnosis.verified_with:
         attrs["verify_solver"] = diagnosis.verified_with
+    attrs.update(_determined_attrs(diagnosis))
+    if survey.levelling is not None:
+        attrs["levelling_sigma"] = diagnosis.sigma
+        attrs["levelling_sigma_given"] = int(diagnosis.sigma_given)
+        attrs.update({f"levelling_probability_{f}": p for f, p in diagnosis.family_probability.items()})
+    if diagnosis.reranked:
+        attrs["reranked"] = diagnosis.reranked
     if diagnosis.interrupted:  # a partial search: its figures and reports say so
         attrs["interrupted"] = 1
         attrs["scenarios_planned"] = len(diagnosis.tables)
     return xr.Dataset({**{n: model[n] for n in names}, **_candidate_variables(diagnosis),
                        **_kept_variables(diagnosis), **_survey_variables(diagnosis)},
                       coords={c: model.coords[c] for c in model.coords}, attrs=attrs)
+
+
+def _determined_attrs(diagnosis: Diagnosis) -> dict:
+    determined = diagnosis.determined()
+    attrs = {"determined_side": determined.side or "undetermined", "determined_edge": determined.edge_best,
+             "determined_edge_low": determined.edge[0], "determined_edge_high": determined.edge[1],
+             "determined_mode": determined.mode or "undetermined", "determined_families": ",".join(determined.families)}
+    if determined.magnitude is not None:
+        attrs.update(determined_magnitude=determined.magnitude_best, determined_magnitude_low=determined.magnitude[0],
+                     determined_magnitude_high=determined.magnitude[1])
+    return attrs
 
 
 def settlement_table(table: dict) -> dict:
@@ -139,6 +166,11 @@ def candidate_json(diagnosis: Diagnosis, candidate) -> dict:
              "levelling_score": None if candidate.score.levelling is None else round(candidate.score.levelling, 6),
              "unexplained_cracks": [diagnosis.survey.names[k] for k in candidate.score.unexplained],
              "unobserved_joints": candidate.score.unobserved}
+    if candidate.score.fit is not None:
+        entry["magnitude_spread"] = _finite(candidate.score.fit.spread)
+        entry["ground_share"] = round(candidate.score.fit.share_ground, 6)
+    if candidate.reranked is not None:
+        entry["reranked_score"] = round(candidate.reranked, 6)
     if candidate.verified:
         entry["verified"] = {k: _finite(v) if isinstance(v, float) else v for k, v in candidate.verified.items()}
     return entry
@@ -154,7 +186,20 @@ def to_json(diagnosis: Diagnosis, top: int) -> dict:
             "verdict": diagnosis.verdict(), "explained": diagnosis.explained,
             "plausible": sum(c.plausible for c in diagnosis.candidates), "tried": len(diagnosis.candidates),
             "failed": len(diagnosis.failed), "segment": diagnosis.segment, "tolerance": diagnosis.wall.tolerance,
-            "solver": diagnosis.solver, "families": list(diagnosis.families), "kept": KEPT}
+            "solver": diagnosis.solver, "families": list(diagnosis.families), "kept": KEPT,
+            "determined": diagnosis.determined().as_json(), "levelling": _levelling_json(diagnosis),
+            "ranked_by": diagnosis.ranked_by or diagnosis.solver, "reranked": diagnosis.reranked}
+
+
+def _levelling_json(diagnosis: Diagnosis) -> dict | None:
+    """The ``levelling`` object: the noise, the families' probabilities, the free profile (null without one)."""
+    if diagnosis.free is None:
+        return None
+    free = diagnosis.free
+    return {"sigma": diagnosis.sigma, "sigma_given": diagnosis.sigma_given,
+            "family_probability": {f: round(p, 6) for f, p in diagnosis.family_probability.items()},
+            "free_profile": {"points": [[round(float(x), 6), round(float(s), 7)] for x, s in zip(free.x, free.settlement)],
+                             "magnitude": free.magnitude, "sigma": free.sigma, "settlement": free.table()}}
 
 
 def json_text(diagnosis: Diagnosis, top: int) -> str:

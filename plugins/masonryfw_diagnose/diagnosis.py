@@ -22,11 +22,18 @@ import xarray as xr
 import masonryfw as mf
 import masonryfw.plugin_api as mfp
 
-from . import scenarios, scoring
+from . import features, levelling, parallel, scenarios, scoring
 from .survey import UNITS, Survey
 
-#: A candidate within this score of the best is plausible.
+#: A candidate within this score of the best of its family is plausible, if its family is.
 PLAUSIBLE_MARGIN = 0.05
+#: A family is plausible, from cracks alone, when its best candidate is within this score of the best; the
+#: held-out survey's tuning half (docs/diagnose.md): at the 0.05 of a candidate the truth's family was in the
+#: plausible set in 18 of 28, at 0.1 in 22 (0.15 and 0.25 add none and name every family).
+FAMILY_MARGIN = 0.1
+#: A family is plausible, with a levelling, when its probability by the levelling's evidence is at least this
+#: (a Bayes factor of 1 to 19 against the others).
+FAMILY_EVIDENCE = 0.05
 #: A best score under this explains the survey poorly: the diagnosis says so.
 EXPLAINED = 0.5
 #: The best candidates whose mechanisms are kept (and drawn, and verified).
@@ -44,6 +51,7 @@ class Candidate:
     plausible: bool = False
     result: xr.Dataset | None = None  # kept for the best few
     verified: dict | None = None  # the forward run of --verify: its numbers
+    reranked: float | None = None  # its score from a forward run by the re-ranking's physics
 
 
 @dataclass
@@ -65,6 +73,13 @@ class Diagnosis:
     tables: list[dict] = field(default_factory=list)  # the scenarios to try
     expected: mfp.Estimate | None = None  # the search's time, before it starts
     verify_interrupted: bool = False  # Ctrl-C stopped the verification: the verified are those finished before
+    sigma: float = 0.0  # the levelling's noise [m]: given, or read from the data (levelling.noise)
+    sigma_given: bool = False
+    free: levelling.FreeProfile | None = None  # the free ground profile fitted to the levelling
+    family_probability: dict[str, float] = field(default_factory=dict)  # from the levelling's evidence
+    ranked_by: str = ""  # the physics whose cracks ranked the best candidates (the search's solver, or fdem)
+    reranked: int = 0  # how many of the best were re-ranked by a forward run
+    rerank_interrupted: bool = False  # Ctrl-C stopped the re-ranking: the re-ranked are those finished before
 
     @property
     def best(self) -> Candidate:
@@ -78,32 +93,29 @@ class Diagnosis:
     def explained(self) -> bool:
         return self.best.score.total >= EXPLAINED
 
-    def either_end(self) -> bool:
-        """Whether the plausible candidates disagree on which end of the wall settles most (cracks alone
-        cannot tell a part that went down from the rest going up: a levelling can)."""
-        middle = 0.5 * sum(self.extent)
-        sides = {np.sign(settled_middle(c.table, self.extent) - middle) for c in self.plausible}
-        return {-1.0, 1.0} <= sides
+    def determined(self) -> features.Determined:
+        """What the plausible set agrees on: the settled side, the edge, sagging or hogging, the magnitude
+        (:mod:`.features`; with a levelling, the magnitude of the plausible candidate that fits it best: the
+        levelling measures it, the cracks do not)."""
+        plausible = self.plausible
+        if self.survey.levelling is not None:
+            fitting = max(plausible, key=lambda c: c.score.levelling or 0.0)
+            plausible = [fitting] + [c for c in plausible if c is not fitting]
+        spreads = [c.score.fit.spread if c.score.fit is not None else 0.0 for c in plausible]
+        determined = features.determine([c.table for c in plausible], [c.score.magnitude for c in plausible],
+                                        self.extent, spreads)
+        best = features.feature(self.best.table, self.extent)
+        return dataclasses.replace(determined, edge_best=best.edge,
+                                   families=tuple(dict.fromkeys(c.table["profile"] for c in self.plausible)))
 
     def verdict(self) -> str:
         count = len(self.plausible)
         if not self.explained:
             return (f"nothing tried explains these cracks well: the best score is {self.best.score.total:.2f} "
-                    f"(under {EXPLAINED}), and {count} candidates are within {PLAUSIBLE_MARGIN} of it")
-        text = (f"best: {scenarios.describe(self.best.table)} (score {self.best.score.total:.2f}); {count} "
-                f"candidate(s) within {PLAUSIBLE_MARGIN} of it")
-        if self.either_end() and self.survey.levelling is None:
-            text += ("; they settle either end of the wall: the cracks alone do not say which part went down, "
-                     "a levelling would (--levelling)")
-        return text
-
-
-def settled_middle(table: dict, extent: tuple[float, float]) -> float:
-    """The rate-weighted mean x of the ground a ``[settlement]`` table moves under the wall."""
-    x = np.linspace(extent[0], extent[1], 201)
-    profile = mf.settlement_profile(table, extent[0], extent[1], 1.0)
-    rate = profile.rate(x)
-    return float(np.average(x, weights=rate)) if rate.sum() > 0 else 0.5 * sum(extent)
+                    f"(under {EXPLAINED}), and {count} candidates are plausible")
+        return (f"{features.sentence(self.determined(), self.survey.levelling is not None)} "
+                f"[best: {scenarios.describe(self.best.table)}, score {self.best.score.total:.2f}; {count} plausible "
+                f"candidate(s); ranked by {self.ranked_by or self.solver}]")
 
 
 def wall_model(source: str) -> xr.Dataset:
@@ -179,19 +191,22 @@ def ground_pieces(model: xr.Dataset) -> np.ndarray:
 
 def diagnose(model: xr.Dataset, survey: Survey, families=scenarios.FAMILIES, segment: float | None = None,
              solver: str = "la", options: dict | None = None, tolerance: float | None = None,
-             progress=mfp.no_progress) -> Diagnosis:
+             progress=mfp.no_progress, sigma: float | None = None) -> Diagnosis:
     """Try every scenario of ``families`` on ``model``'s wall and rank them against ``survey`` (module docstring):
     :func:`search` of :func:`prepare`."""
-    return search(prepare(model, survey, families, segment, solver, options, tolerance), options, progress)
+    return search(prepare(model, survey, families, segment, solver, options, tolerance, sigma), options, progress)
 
 
 def prepare(model: xr.Dataset, survey: Survey, families=scenarios.FAMILIES, segment: float | None = None,
-            solver: str = "la", options: dict | None = None, tolerance: float | None = None) -> Diagnosis:
-    """The wall on its ground, the survey matched to its joints, the scenarios to try and the search's estimated
-    time: nothing solved yet. Refused beyond :data:`MAX_SCENARIOS` scenarios, saying which ``--segment`` fits.
+            solver: str = "la", options: dict | None = None, tolerance: float | None = None,
+            sigma: float | None = None) -> Diagnosis:
+    """The wall on its ground, the survey matched to its joints, the free profile of its levelling, the scenarios
+    to try and the search's estimated time: nothing solved yet. Refused beyond :data:`MAX_SCENARIOS`
+    scenarios, saying which ``--segment`` fits.
 
     ``segment`` defaults to the median masonry block length (about a unit length); ``tolerance`` (how far a
-    surveyed line may lie from the joint it follows) to half the median block height.
+    surveyed line may lie from the joint it follows) to half the median block height; ``sigma`` (the
+    levelling's noise [m]) to what the data say (:func:`.levelling.noise`).
     """
     masonry = mfp.masonry_blocks(model.block_role.values)
     xmin, xmax, _, _ = mfp.block_bounds(model.node_x.values, model.node_y.values, model.block_node_count.values)
@@ -206,6 +221,10 @@ def prepare(model: xr.Dataset, survey: Survey, families=scenarios.FAMILIES, segm
     observed = scoring.observe(wall, survey.cracks)
     diagnosis = Diagnosis(ground, survey, wall, observed, [], solver, segment, tuple(families),
                           (float(pieces.min()), float(pieces.max())), unit_length, segment_given)
+    if survey.levelling is not None:
+        x, dy = survey.levelling[:, 0], survey.levelling[:, 2]
+        diagnosis.sigma, diagnosis.sigma_given = (levelling.noise(x, dy), False) if sigma is None else (sigma, True)
+        diagnosis.free = levelling.free_profile(x, dy, np.unique(pieces), diagnosis.sigma)
     diagnosis.tables = scenarios.candidates(pieces, diagnosis.families, segment)
     one = mf.estimate(mf.over_profile(ground, profile_of(diagnosis, diagnosis.tables[0])), solver, options or {})
     if one is not None:
@@ -228,41 +247,91 @@ def _refuse_too_many(count: int, pieces: np.ndarray, segment: float, families) -
                        f"{fitting:.3g} m, or fewer --profiles")
 
 
-def search(diagnosis: Diagnosis, options: dict | None = None, progress=mfp.no_progress) -> Diagnosis:
-    """Solve and score every scenario of a prepared ``diagnosis``, then rank them; Ctrl-C ends the search with
-    those tried (``interrupted``), or propagates when none was."""
+def search(diagnosis: Diagnosis, options: dict | None = None, progress=mfp.no_progress,
+           runner: parallel.Runner = parallel.serial) -> Diagnosis:
+    """Solve and score every scenario of a prepared ``diagnosis`` (here, or by ``runner``: on local processes or a
+    dask cluster, :mod:`.parallel`), then rank them; Ctrl-C ends the search with those tried (``interrupted``), or
+    propagates when none was."""
     tables = diagnosis.tables
+    done = 0
     try:
-        for k, table in enumerate(tables):
-            progress(k / len(tables), f"diagnose: {scenarios.describe(table)} ({k + 1} of {len(tables)})")
-            try:
-                result = solved(diagnosis, table, options)
-            except mf.MasonryError as exc:
-                diagnosis.failed.append((table, str(exc).splitlines()[0]))
-                continue
-            diagnosis.candidates.append(Candidate(table, scoring.score(
-                diagnosis.wall, diagnosis.observed, result, diagnosis.survey.widths_mm, diagnosis.survey.levelling)))
+        for outcomes in runner(parallel.work(tried, diagnosis, options), parallel.chunks(tables, runner)):
+            for table, score, failure in outcomes:
+                done += 1
+                progress(done / len(tables), f"diagnose: {scenarios.describe(table)} ({done} of {len(tables)})")
+                if score is None:
+                    diagnosis.failed.append((table, failure))
+                else:
+                    diagnosis.candidates.append(Candidate(table, score))
     except KeyboardInterrupt:
         if not diagnosis.candidates:
             raise
         diagnosis.interrupted = True
     if not diagnosis.candidates:
         raise mf.SolveError(f"diagnose: no scenario could be solved ({diagnosis.failed[0][1]})")
-    rank(diagnosis.candidates)
+    rank(diagnosis)
     for candidate in diagnosis.candidates[:KEPT]:
         candidate.result = solved(diagnosis, candidate.table, options)
     progress(1.0, "diagnose: ranked")
     return diagnosis
 
 
-def rank(candidates: list[Candidate]) -> None:
-    """Sort best first (ties: step before gaussian before linear, then as tried) and mark the plausible set."""
-    order = {family: i for i, family in enumerate(scenarios.FAMILIES)}
-    candidates.sort(key=lambda c: (-round(c.score.total, 12), order[c.table["profile"]]))
-    best = candidates[0].score.total
+def tried(diagnosis: Diagnosis, options: dict | None, tables: list[dict]) -> list[tuple[dict, scoring.Score | None,
+                                                                                       str]]:
+    """``(table, score, "")`` of every scenario of ``tables`` solved and scored, ``(table, None, why)`` of one that
+    could not be solved."""
+    outcomes: list[tuple[dict, scoring.Score | None, str]] = []
+    for table in tables:
+        try:
+            result = solved(diagnosis, table, options)
+        except mf.MasonryError as exc:
+            outcomes.append((table, None, str(exc).splitlines()[0]))
+            continue
+        outcomes.append((table, score_of(diagnosis, table, result), ""))
+    return outcomes
+
+
+def score_of(diagnosis: Diagnosis, table: dict, result: xr.Dataset) -> scoring.Score:
+    """How well a scenario's ``result`` (per unit settlement) explains the survey: its cracks, and its fit to the
+    levelling (the ground's rate under every levelled point from the candidate's profile)."""
+    levelled = diagnosis.survey.levelling
+    rate = None if levelled is None else profile_of(diagnosis, table).rate(levelled[:, 0])
+    return scoring.score(diagnosis.wall, diagnosis.observed, result, diagnosis.survey.widths_mm, levelled, rate,
+                         diagnosis.sigma)
+
+
+def rank(diagnosis: Diagnosis) -> None:
+    """With a levelling, every candidate's levelling score against the best fit and the families' probabilities
+    (:mod:`.levelling`); then :func:`order` the candidates."""
+    candidates, levelled = diagnosis.candidates, diagnosis.survey.levelling
+    if levelled is not None:
+        fits = [c.score.fit for c in candidates]
+        for candidate, value in zip(candidates, levelling.scores(fits, diagnosis.sigma, len(levelled))):
+            candidate.score = dataclasses.replace(candidate.score, levelling=float(value))
+        diagnosis.family_probability = levelling.family_probabilities(
+            fits, [c.table["profile"] for c in candidates], diagnosis.sigma, len(levelled))
+    order(candidates, diagnosis.family_probability)
+
+
+def order(candidates: list[Candidate], family_probability: dict[str, float] | None = None) -> None:
+    """Sort best first (ties: step before gaussian before linear, then as tried) and mark the plausible set: the
+    candidates within :data:`PLAUSIBLE_MARGIN` of the best of their family, in the families the data cannot rule
+    out (with a levelling, a probability of at least :data:`FAMILY_EVIDENCE`; from cracks alone, a best within
+    :data:`FAMILY_MARGIN` of the best)."""
+    precedence = {family: i for i, family in enumerate(scenarios.FAMILIES)}
+    candidates.sort(key=lambda c: (-round(c.score.total, 12), precedence[c.table["profile"]]))
+    best_of: dict[str, float] = {}
+    for candidate in candidates:
+        best_of.setdefault(candidate.table["profile"], candidate.score.total)
+    if family_probability:
+        families = {f for f in best_of if family_probability.get(f, 0.0) >= FAMILY_EVIDENCE}
+    else:
+        families = {f for f, score in best_of.items() if score >= candidates[0].score.total - FAMILY_MARGIN}
     for number, candidate in enumerate(candidates, start=1):
+        family = candidate.table["profile"]
         candidate.rank = number
-        candidate.plausible = candidate.score.total >= best - PLAUSIBLE_MARGIN
+        candidate.plausible = family in families and candidate.score.total >= best_of[family] - PLAUSIBLE_MARGIN
+    candidates[0].plausible = True
 
 
 def profile_of(diagnosis: Diagnosis, table: dict) -> mf.Profile:

@@ -97,6 +97,8 @@ def _candidate_panel(ax, ds: xr.Dataset, kept: int, amplification: float | None)
     _survey_lines(ax, ds, width=0.9)
     magnitude = float(ds.candidate_magnitude.values[k])
     size = f", t {1e3 * magnitude:.3g} mm" if np.isfinite(magnitude) else ""
+    if "candidate_reranked_score" in ds and np.isfinite(ds.candidate_reranked_score.values[k]):
+        size += f", {ds.attrs.get('ranked_by', '')} {float(ds.candidate_reranked_score.values[k]):.2f}"
     ax.set_title(f"{k + 1}: {mfp.candidate_text(ds, k)}\nscore {float(ds.candidate_score.values[k]):.2f}{size}"
                  + (" (plausible)" if ds.candidate_plausible.values[k] else ""), fontsize=8)
 
@@ -105,18 +107,19 @@ def _score_panel(ax, ds: xr.Dataset) -> None:
     score = ds.candidate_score.values
     rank = np.arange(1, score.size + 1)
     families = ds.candidate_profile.values.astype(str)
-    best = float(score[0])
-    margin = float(ds.attrs.get("plausible_margin", 0.05))
-    ax.axhspan(best - margin, best, color="#dcdcdc", zorder=0, label=f"plausible (within {margin:g})")
+    plausible = ds.candidate_plausible.values.astype(bool)
     for family, colour in FAMILY_COLOURS.items():
         mine = families == family
         if mine.any():
             ax.scatter(rank[mine], score[mine], s=9, color=colour, label=family, zorder=2)
+    ax.scatter(rank[plausible], score[plausible], s=40, facecolors="none", edgecolors="k", lw=0.7, zorder=3,
+               label="plausible")
     ax.axhline(float(ds.attrs.get("explained_threshold", 0.5)), color="k", lw=0.6, ls=":",
                label="explained well above")
     ax.set_xscale("log")
     ax.set_ylim(0.0, 1.02)
-    ax.set_xlabel("rank")
+    ax.set_xlabel(f"rank (the first {int(ds.attrs['reranked'])} by {ds.attrs.get('ranked_by', '')})"
+                  if int(ds.attrs.get("reranked", 0)) else "rank")
     ax.set_ylabel("score")
     ax.set_title(f"{score.size} candidates", fontsize=8)
     ax.legend(fontsize=7, loc="upper right", frameon=False)
@@ -145,22 +148,20 @@ def _gaussian_panel(ax, ds: xr.Dataset) -> None:
 
 
 def _levelling_panel(ax, ds: xr.Dataset) -> None:
-    from .scoring import levelling_fit, vertical_motion
-
-    points = np.c_[ds.levelling_x.values, ds.levelling_y.values, ds.levelling_dy.values]
-    order = np.argsort(points[:, 0])
-    ax.plot(points[order, 0], 1e3 * points[order, 2], "o", color=SURVEY_COLOUR, ms=4, label="levelling")
+    order = np.argsort(ds.levelling_x.values)
+    x = ds.levelling_x.values[order]
+    ax.plot(x, 1e3 * ds.levelling_dy.values[order], "o", color=SURVEY_COLOUR, ms=4, label="levelling")
     for kept in range(ds.sizes.get("kept", 0)):
-        mechanism = ds.assign(block_displacement=(("block", "axis"), ds.kept_block_displacement.values[kept]),
-                              block_rotation=("block", ds.kept_block_rotation.values[kept]))
-        t, fit = levelling_fit(mechanism, points)
-        p = vertical_motion(mechanism, points[order, 0], points[order, 1])
-        datum = float(np.mean(points[:, 2] - t * vertical_motion(mechanism, points[:, 0], points[:, 1])))
-        ax.plot(points[order, 0], 1e3 * (datum + t * p), "-", lw=1.0,
-                label=f"{int(ds.kept_candidate.values[kept]) + 1}: t {1e3 * t:.3g} mm, fit {fit:.2f}")
+        candidate = int(ds.kept_candidate.values[kept])
+        ax.plot(x, 1e3 * ds.kept_levelling_fit.values[kept][order], "-", lw=1.0,
+                label=f"{candidate + 1}: {1e3 * float(ds.candidate_magnitude.values[candidate]):.3g} "
+                      f"+/- {2e3 * float(ds.candidate_magnitude_spread.values[candidate]):.2g} mm")
+    if "free_profile_settlement" in ds:
+        ax.plot(ds.free_profile_x.values, -1e3 * ds.free_profile_settlement.values, ":", color="0.4", lw=1.2,
+                label="free profile (ground settlement, its own datum)")
     ax.set_xlabel("x [m]")
     ax.set_ylabel("dy [mm] (negative down)")
-    ax.set_title("levelling and the best candidates' fits", fontsize=8)
+    ax.set_title(f"levelling (sigma {1e3 * float(ds.attrs.get('levelling_sigma', 0.0)):.2g} mm) and the fits", fontsize=8)
     ax.legend(fontsize=7, frameon=False)
 
 

@@ -6,7 +6,7 @@ On the wall's ground pieces (their ends, the *nodes*, from ``x_a`` to ``x_b``):
   but the whole base (which would move the wall as one body), from its first piece's start to its last
   one's end;
 - ``gaussian``: a trough (Peck) with its axis at every node and every other node's distance beyond
-  either end (a quarter of the wall each side), its width ``i`` from an eighth to two wall lengths in steps
+  either end (half the wall each side), its width ``i`` from an eighth to two wall lengths in steps
   of sqrt(2): sagging where the wall lies within ``i`` of the axis, hogging beyond;
 - ``linear``: a tilt rising from a node to either end of the wall.
 """
@@ -18,7 +18,7 @@ FAMILIES = ("step", "gaussian", "linear")
 #: Trough widths i, in wall lengths: an eighth to two, in steps of sqrt(2).
 WIDTHS = tuple(float(w) for w in 0.125 * np.sqrt(2.0) ** np.arange(9))
 #: How far the axis may lie beyond the wall's ends, in wall lengths.
-BEYOND = 0.25
+BEYOND = 0.5
 
 
 def steps(pieces: np.ndarray) -> list[tuple[float, float]]:

@@ -13,11 +13,10 @@ height ``h`` (the median masonry block height):
   of what was seen the scenario explains), **precision** the weighted mean ``w`` of the predicted points
   (how much of what it cracks was seen), the **crack score** their harmonic mean (1: every surveyed crack
   explained, nothing else cracked);
-- with a levelling, the course's measured ``dy`` against the mechanism's vertical motion ``p`` at its
-  points (per unit settlement): ``dy = a + t p`` fitted by least squares (``a`` the levelling's datum),
-  ``t >= 0`` (a settlement: a fit wanting the ground to rise gets ``t = 0``), the **levelling score**
-  ``1 - SS_res / SS_tot`` (at least 0), and the score the geometric mean of both;
-- the **magnitude** t: from the levelling when there is one, else the widest surveyed crack over the
+- with a levelling, the course fitted by the mechanism's motion and the ground's (:mod:`.levelling`); the
+  **levelling score** (set when the candidates are ranked: it compares each fit with the best) and the
+  score the geometric mean of both;
+- the **magnitude**: from the levelling when there is one, else the widest surveyed crack over the
   widest opening the mechanism gives per unit settlement.
 """
 from __future__ import annotations
@@ -28,6 +27,8 @@ import numpy as np
 import xarray as xr
 
 import masonryfw.plugin_api as mfp
+
+from . import levelling
 
 #: The distance scale of the weights, in unit heights (docs/diagnose.md: chosen so that random lines score
 #: under 0.5 while a crack drawn a third of a joint off keeps 0.94 and one a whole joint off about 0.6).
@@ -131,16 +132,27 @@ class Score:
     unexplained: tuple[int, ...]  # surveyed lines whose points the scenario explains less than half
     unobserved: int  # predicted cracked joints whose points were mostly not seen
     magnitude: float | None
-    levelling: float | None  # levelling score, None without a levelling
+    levelling: float | None = None  # levelling score (set when the candidates are ranked), None without a levelling
+    fit: levelling.Fit | None = None  # the fit to the levelling
 
     @property
     def total(self) -> float:
         return self.crack if self.levelling is None else float(np.sqrt(self.crack * self.levelling))
 
 
-def score(wall: Wall, observed: Observed, result: xr.Dataset, widths_mm, levelling: np.ndarray | None) -> Score:
-    """How well ``result`` (a mechanism per unit settlement) explains the survey (module docstring)."""
-    indicator = mfp.indicator_at(result, SURVEY_THRESHOLD)
+@dataclass(frozen=True)
+class Match:
+    """How well a pattern of cracked joints explains the surveyed cracks (module docstring)."""
+
+    crack: float
+    precision: float
+    recall: float
+    unexplained: tuple[int, ...]  # surveyed lines whose points the pattern explains less than half
+    unobserved: int  # predicted cracked joints whose points were mostly not seen
+
+
+def match(wall: Wall, observed: Observed, indicator: np.ndarray) -> Match:
+    """The crack score of joints cracked as ``indicator`` says (``(interface,)`` in [0, 1], 0: uncracked)."""
     predicted = wall.inner[wall.joints.owner] & (indicator[wall.joints.owner] > 0)
     pred_xy = wall.joints.xy[predicted]
     c = indicator[wall.joints.owner][predicted] * wall.joints.length[predicted]
@@ -154,32 +166,25 @@ def score(wall: Wall, observed: Observed, result: xr.Dataset, widths_mm, levelli
     owners = wall.joints.owner[predicted]
     unseen = np.bincount(owners, weights=(found < 0.5) * c, minlength=wall.inner.size) > 0.5 * np.bincount(
         owners, weights=c, minlength=wall.inner.size)
+    return Match(crack, precision, recall, tuple(int(k) for k in np.flatnonzero(per_line < 0.5)), int(unseen.sum()))
+
+
+def score(wall: Wall, observed: Observed, result: xr.Dataset, widths_mm, levelled: np.ndarray | None = None,
+          ground_rate: np.ndarray | None = None, sigma: float = 0.0) -> Score:
+    """How well ``result`` (a mechanism per unit settlement) explains the survey's cracks (module docstring), and
+    its fit to the levelling ``levelled`` (``x, y, dy``; the ground's rate under each point ``ground_rate``, the
+    noise ``sigma``: :mod:`.levelling`) when there is one."""
+    matched = match(wall, observed, mfp.indicator_at(result, SURVEY_THRESHOLD))
     magnitude, fit = None, None
-    if levelling is not None:
-        magnitude, fit = levelling_fit(result, levelling)
+    if levelled is not None:
+        fit = levelling.fit(levelled[:, 2], vertical_motion(result, levelled[:, 0], levelled[:, 1]), -ground_rate, sigma)
+        magnitude = fit.magnitude
     elif any(w is not None for w in widths_mm):
         opening = np.maximum(result.interface_opening.values, 0.0).max(axis=1)[wall.inner]
         widest = float(opening.max(initial=0.0))
         magnitude = 1e-3 * max(w for w in widths_mm if w is not None) / widest if widest > 0 else None
-    return Score(crack, precision, recall, tuple(int(k) for k in np.flatnonzero(per_line < 0.5)), int(unseen.sum()),
-                 magnitude, fit)
-
-
-def levelling_fit(result: xr.Dataset, levelling: np.ndarray) -> tuple[float, float]:
-    """``(t, score)``: the settlement ``t >= 0`` that best scales the mechanism's vertical motion at the levelled
-    points onto the measured ``dy`` (with a free datum), and ``1 - SS_res / SS_tot`` (at least 0). A fit that
-    wants ``t < 0`` says the ground under the scenario rose: it is held at ``t = 0`` (score 0), which is how a
-    levelling tells a part that went down from its mirror image (the same cracks, the rest going up)."""
-    p = vertical_motion(result, levelling[:, 0], levelling[:, 1])
-    dy = levelling[:, 2]
-    design = np.c_[np.ones_like(p), p]
-    (datum, t), *_ = np.linalg.lstsq(design, dy, rcond=None)
-    if not t > 0:
-        datum, t = float(dy.mean()), 0.0
-    residual = dy - datum - t * p
-    total = float(((dy - dy.mean()) ** 2).sum())
-    fit = 1.0 - float((residual**2).sum()) / total if total > 0 else float(np.allclose(residual, 0.0))
-    return float(t), max(fit, 0.0)
+    return Score(matched.crack, matched.precision, matched.recall, matched.unexplained, matched.unobserved,
+                 magnitude, fit=fit)
 
 
 def vertical_motion(result: xr.Dataset, x: np.ndarray, y: np.ndarray) -> np.ndarray:

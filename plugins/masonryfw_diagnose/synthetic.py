@@ -25,6 +25,8 @@ class Surveyor:
     missing: float = 0.0  # cracks shorter than this many h are not drawn
     spurious: int = 0  # hairlines drawn where nothing cracked
     spurious_length: float = 2.0  # their length [h]
+    jitter: float = 0.0  # standard deviation of every vertex's own displacement [h]
+    width_step: float = 0.0  # widths written rounded to this [mm] (0: as measured)
 
 
 def visible_cracks(result: xr.Dataset, threshold: float = mf.CRACK_THRESHOLD, width: float | None = None) -> np.ndarray:
@@ -83,11 +85,16 @@ def draw(result: xr.Dataset, joints: np.ndarray, surveyor: Surveyor, rng: np.ran
         if drawn.size == 0:
             continue
         shift = rng.normal(0.0, surveyor.offset * h, 2) if surveyor.offset else np.zeros(2)
-        lines = [np.clip(np.c_[result.interface_x.values[j], result.interface_y.values[j]] + shift,
-                         [box[0], box[2]], [box[1], box[3]]).tolist() for j in drawn]
+        lines = [np.clip(np.c_[result.interface_x.values[j], result.interface_y.values[j]] + shift
+                         + (rng.normal(0.0, surveyor.jitter * h, (2, 2)) if surveyor.jitter else 0.0),
+                         [box[0], box[2]], [box[1], box[3]]).tolist()
+                 for j in drawn]
         properties = {"name": f"crack {len(features) + 1}"}
         if widths_mm is not None:
-            properties["width_mm"] = float(max(widths_mm.get(int(j), 0.0) for j in chain))
+            width = float(max(widths_mm.get(int(j), 0.0) for j in chain))
+            if surveyor.width_step:  # a surveyor writes 0.5 mm steps, and never 0 for a crack seen
+                width = max(surveyor.width_step, surveyor.width_step * round(width / surveyor.width_step))
+            properties["width_mm"] = width
         features.append({"type": "Feature", "properties": properties,
                          "geometry": {"type": "MultiLineString", "coordinates": lines}})
     for k in range(surveyor.spurious):
@@ -167,40 +174,35 @@ def random_truth(spec: dict, rng: np.random.Generator) -> dict:
         "profile": "linear", "start": edge, "end": width}
 
 
-def judged(best_tables: list[dict], plausible: list[dict], truth: dict, extent: tuple[float, float],
-           segment: float) -> dict:
-    """The success criteria of a diagnosis against the ``truth`` it should find (docs/diagnose.md): ``family``,
-    the best candidate's profile right; ``place``, a step's edges inside the wall (where the ground breaks)
-    within two segments, a tilt's hinge (``start``) within two segments, a trough's centre within 10 % of the
-    wall; ``side``, the same end of the wall settling most (steps and tilts: what cracks alone cannot tell);
-    ``shape``, sagging or hogging right (troughs); ``in_plausible``, a plausible candidate of the truth's
-    family in its place."""
-    from .diagnosis import settled_middle
-    from .scenarios import shape
+def judged(diagnosis, truth: dict, settlement: float | None = None) -> dict:
+    """A diagnosis judged against the ``truth`` (a ``[settlement]`` table) it should find (docs/diagnose.md):
+    what it determined (``side``, ``edge`` within two segments, ``mode``: right only where determined), the
+    ``family`` of its best candidate and whether it ``claims`` one (a single family plausible), the ``place``
+    (the family right and the edge within two segments), the truth ``in_plausible`` (a plausible candidate of
+    its family with its side and mode and its edge within two segments) and the ``magnitude`` ratio, the
+    differential settlement under the wall determined over the truth's at the ``settlement`` reached."""
+    from .features import feature
 
-    length = extent[1] - extent[0]
-    tolerance = 2 * segment + 1e-9 * length
+    extent, segment = diagnosis.extent, diagnosis.segment
+    tolerance = 2 * segment + 1e-9 * (extent[1] - extent[0])
+    true = feature(truth, extent)
+    determined = diagnosis.determined()
+    best = diagnosis.best.table
 
-    def inner_edges(table: dict) -> list[float]:
-        return [e for e in (table["start"], table["end"]) if extent[0] + 1e-9 * length < e < extent[1] - 1e-9 * length]
+    def alike(table: dict) -> bool:
+        mine = feature(table, extent)
+        return (table["profile"] == truth["profile"] and mine.side == true.side and mine.mode == true.mode
+                and abs(mine.edge - true.edge) <= tolerance)
 
-    def placed(table: dict) -> bool:
-        if table["profile"] != truth["profile"]:
-            return False
-        if truth["profile"] == "gaussian":
-            return abs(table["center"] - truth["center"]) <= 0.1 * length
-        if truth["profile"] == "linear":
-            return abs(table["start"] - truth["start"]) <= tolerance
-        found = inner_edges(table)
-        return all(any(abs(e - f) <= tolerance for f in found) for e in inner_edges(truth))
-
-    best = best_tables[0]
-    verdict = {"family": best["profile"] == truth["profile"], "place": placed(best),
-               "in_plausible": any(placed(t) for t in plausible)}
-    middle = 0.5 * (extent[0] + extent[1])
-    if truth["profile"] == "gaussian":
-        verdict["shape"] = shape(best, *extent) == shape(truth, *extent)
-    else:
-        verdict["side"] = bool(np.sign(settled_middle(best, extent) - middle) ==
-                               np.sign(settled_middle(truth, extent) - middle))
-    return verdict
+    edge = abs(determined.edge_best - true.edge) <= tolerance
+    magnitude = determined.magnitude_best
+    settlement = None if settlement is None else settlement * true.differential
+    return {"side": determined.side == true.side, "edge": bool(edge), "mode": determined.mode == true.mode,
+            "side_and_edge": determined.side == true.side and bool(edge),
+            "family": best["profile"] == truth["profile"], "claims": len(determined.families) == 1,
+            "place": best["profile"] == truth["profile"] and bool(edge),
+            "in_plausible": any(alike(c.table) for c in diagnosis.plausible),
+            "magnitude_ratio": None if magnitude is None or not settlement else magnitude / settlement,
+            "true_side": true.side, "true_edge": true.edge, "true_mode": true.mode,
+            "found_side": determined.side, "found_edge": determined.edge_best, "found_mode": determined.mode,
+            "families": list(determined.families), "plausible": len(diagnosis.plausible)}

@@ -138,10 +138,11 @@ def test_the_tunnel_step_of_the_tour_runs_as_written(tmp_path):
     assert (tmp_path / "ltsm.png").stat().st_size > 20_000
 
 
-@pytest.mark.slow  # 20 s; the diagnose command is tested by default in tests/plugins/diagnose
+@pytest.mark.slow  # 45 s; the diagnose command is tested by default in tests/plugins/diagnose
 def test_the_diagnosis_step_of_the_tour_runs_as_written(tmp_path):
     """Step 1e: the bundled survey (drawn from fdem's run of facade-1 settling under x = 1.2 .. 1.5 m, stopped at
-    6.65 mm: datasets/surveys/README.md) points back to that step, and its levelling to that settlement."""
+    6.65 mm: datasets/surveys/README.md) points back to that step, and its levelling to that settlement: the
+    side, the edge, hogging and the family determined, the settlement's interval holding 6.65 mm."""
     step = README[README.index("**1e. Or ask the reverse"):README.index("**2. Solve, look")]
     commands = [line.strip().split() for line in step.splitlines() if line.startswith("    masonryfw ")]
     assert len(commands) == 3
@@ -154,8 +155,15 @@ def test_the_diagnosis_step_of_the_tour_runs_as_written(tmp_path):
                               capture_output=True, text=True, timeout=300)
         assert done.returncode == 0, (words, done.stderr)
         outputs.append(done.stdout)
-    best = json.loads(outputs[0])["candidates"][0]
+    data = json.loads(outputs[0])
+    best = data["candidates"][0]
     assert best["settlement"] == {"profile": "step", "start": 1.2, "end": 1.5, "segment": 0.1}
     assert best["magnitude"] == pytest.approx(6.65e-3, rel=0.15)
+    determined = data["determined"]
+    assert (determined["side"], determined["edge"], determined["mode"], determined["family"]) == (
+        "right", 1.2, "hogging", "step")
+    low, high = determined["magnitude_interval"]
+    assert low < 6.65e-3 < high and data["ranked_by"] == "fdem"
+    assert "the right part settled relative to the rest, the ground breaking at 1.20 m" in data["verdict"]
     assert (tmp_path / "diagnosis.png").stat().st_size > 20_000
     assert "Diagnosis" in (tmp_path / "diagnosis.html").read_text()

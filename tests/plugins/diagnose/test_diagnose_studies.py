@@ -40,8 +40,7 @@ def random_case(seed: int) -> dict:
     result = mf.solve(mf.build({**spec, "settlement": truth, "loading": {"type": "settlement"}}), "la", {})
     collection = sy.draw(result, sy.visible_cracks(result), SURVEYOR, np.random.default_rng(1000 + seed))
     diagnosis = diagnose(mf.build({**spec, **mf.STAND_IN_GROUND}), survey_of(collection))
-    return sy.judged([c.table for c in diagnosis.candidates], [c.table for c in diagnosis.plausible], truth,
-                     diagnosis.extent, diagnosis.segment)
+    return sy.judged(diagnosis, truth)
 
 
 @pytest.mark.slow  # 11-13 s; the bundled walls' diagnoses run by default (test_diagnose.py)
