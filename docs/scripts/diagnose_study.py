@@ -26,9 +26,19 @@ import numpy as np
 
 import masonryfw as mf
 import masonryfw.plugin_api as mfp
-from masonryfw_diagnose import Survey, describe, diagnose, read_cracks, read_levelling, to_dataset, wall_model
+from masonryfw_diagnose import (
+    DEFAULT_BUDGET,
+    Survey,
+    affordable,
+    describe,
+    diagnose,
+    read_cracks,
+    read_levelling,
+    rerank,
+    to_dataset,
+    wall_model,
+)
 from masonryfw_diagnose import synthetic as sy
-from masonryfw_diagnose.rerank import DEFAULT_BUDGET, affordable, rerank
 
 ROOT = Path(__file__).resolve().parents[2]
 IMAGES = ROOT / "docs" / "img" / "diagnose"

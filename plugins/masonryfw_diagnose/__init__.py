@@ -3,7 +3,7 @@
 Registration only (cheap to import); the work lives in :mod:`.survey` (reading crack maps and levellings),
 :mod:`.scenarios` (the ``[settlement]`` tables tried), :mod:`.scoring` (how well a mechanism explains a
 survey's cracks), :mod:`.levelling` (the levelling as evidence, the free profile), :mod:`.diagnosis` (the
-search and the ranking), :mod:`.parallel` (where the scenarios are solved), :mod:`.rerank` (the second
+search and the ranking), :mod:`.parallel` (where the scenarios are solved), :mod:`.reranking` (the second
 physics), :mod:`.features` (what a survey determines), :mod:`.dataset` (the ``diagnosis`` dataset and the
 ``--json`` contract), :mod:`.plotting` (the ``diagnosis`` plot) and :mod:`.commands` (the CLI command).
 docs/diagnose.md says what the scores mean and where the method stops.
@@ -26,6 +26,8 @@ from .commands import COMMANDS
 __getattr__, _, __all__ = lazy_loader.attach(__name__, submod_attrs={
     "dataset": ["to_dataset", "to_json"],
     "diagnosis": ["diagnose", "prepare", "search", "verify", "wall_model"],
+    "parallel": ["local_processes"],
+    "reranking": ["DEFAULT_BUDGET", "affordable", "rerank"],
     "scenarios": ["describe"],
     "survey": ["Survey", "read_cracks", "read_levelling"],
     "synthetic": ["visible_cracks"],

@@ -136,8 +136,8 @@ def diagnose_command(wall: str, cracks: str, cracks_layer: str | None, levelling
     """
     from . import dataset, parallel
     from .diagnosis import KEPT, prepare, search, verify, wall_model
-    from .rerank import affordable
-    from .rerank import rerank as rerank_by
+    from .reranking import affordable
+    from .reranking import rerank as rerank_by
     from .survey import read_cracks, read_levelling
 
     if scheduler and workers > 1:

@@ -21,6 +21,7 @@ height ``h`` (the median masonry block height):
 """
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
@@ -125,22 +126,6 @@ def weight(d: np.ndarray, scale: float) -> np.ndarray:
 
 
 @dataclass(frozen=True)
-class Score:
-    crack: float
-    precision: float
-    recall: float
-    unexplained: tuple[int, ...]  # surveyed lines whose points the scenario explains less than half
-    unobserved: int  # predicted cracked joints whose points were mostly not seen
-    magnitude: float | None
-    levelling: float | None = None  # levelling score (set when the candidates are ranked), None without a levelling
-    fit: levelling.Fit | None = None  # the fit to the levelling
-
-    @property
-    def total(self) -> float:
-        return self.crack if self.levelling is None else float(np.sqrt(self.crack * self.levelling))
-
-
-@dataclass(frozen=True)
 class Match:
     """How well a pattern of cracked joints explains the surveyed cracks (module docstring)."""
 
@@ -149,6 +134,19 @@ class Match:
     recall: float
     unexplained: tuple[int, ...]  # surveyed lines whose points the pattern explains less than half
     unobserved: int  # predicted cracked joints whose points were mostly not seen
+
+
+@dataclass(frozen=True)
+class Score(Match):
+    """A scenario's match to the survey's cracks, its magnitude and its fit to the levelling."""
+
+    magnitude: float | None
+    levelling: float | None = None  # levelling score (set when the candidates are ranked), None without a levelling
+    fit: levelling.Fit | None = None  # the fit to the levelling
+
+    @property
+    def total(self) -> float:
+        return self.crack if self.levelling is None else float(np.sqrt(self.crack * self.levelling))
 
 
 def match(wall: Wall, observed: Observed, indicator: np.ndarray) -> Match:
@@ -183,8 +181,7 @@ def score(wall: Wall, observed: Observed, result: xr.Dataset, widths_mm, levelle
         opening = np.maximum(result.interface_opening.values, 0.0).max(axis=1)[wall.inner]
         widest = float(opening.max(initial=0.0))
         magnitude = 1e-3 * max(w for w in widths_mm if w is not None) / widest if widest > 0 else None
-    return Score(matched.crack, matched.precision, matched.recall, matched.unexplained, matched.unobserved,
-                 magnitude, fit=fit)
+    return Score(**dataclasses.asdict(matched), magnitude=magnitude, fit=fit)
 
 
 def vertical_motion(result: xr.Dataset, x: np.ndarray, y: np.ndarray) -> np.ndarray:
