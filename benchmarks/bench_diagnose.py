@@ -22,6 +22,7 @@ from _report import command_line, write_section
 import masonryfw as mf
 from masonryfw_diagnose import (
     Survey,
+    describe,
     diagnose,
     local_processes,
     prepare,
@@ -96,9 +97,8 @@ for their mechanisms), median of {RUNS} runs in one process (load average before
 cracks of its right 0.3 m settling 6.65 mm and a levelling): the error of the best candidate's inner edge
 against 1.2 m and of its settlement (from the levelling) against 6.65 mm. Facade 3: 482 blocks, its own
 la cracks, the default segment, in one process and on two. Then the re-ranking of Facade 1's best five by
-fdem to their settlements: {reranking:.1f} s, the best after it {first.table['profile']}
-{first.table.get('start', float('nan')):.3g}..{first.table.get('end', float('nan')):.3g} (fdem's score
-{first.reranked:.2f}).
+fdem to their settlements: {reranking:.1f} s, the best after it """ + describe(first.table) + f""" (fdem's
+score {first.reranked:.2f}).
 
 | wall | segment [m] | scenarios | wall time [s] | per scenario [ms] | best | edge error [mm] | settlement error | plausible |
 |---|---:|---:|---:|---:|---|---:|---:|---:|

@@ -205,8 +205,11 @@ def _report(diagnosis, wall: str, top: int, as_json: bool, seconds: float, out: 
     for k in diagnosis.observed.unmatched:
         _echo(f"  no joint near crack {survey.names[k]!r}: drawn across units, or off the wall's joints", as_json)
     failed = f", {len(diagnosis.failed)} could not be solved" if diagnosis.failed else ""
-    _echo(f"tried {len(diagnosis.candidates) + len(diagnosis.failed)} scenarios with {diagnosis.solver}{failed} "
-          f"in {seconds:.3g} s", as_json)
+    again = f"; re-ranked the best {diagnosis.reranked} with {diagnosis.ranked_by}" if diagnosis.reranked else ""
+    if diagnosis.rerank_failed:
+        again += f" ({len(diagnosis.rerank_failed)} forward run(s) failed: {diagnosis.rerank_failed[0][1]})"
+    _echo(f"tried {len(diagnosis.candidates) + len(diagnosis.failed)} scenarios with {diagnosis.solver}{failed}{again}"
+          f"; {seconds:.3g} s in all", as_json)
     for line in _ranking_lines(diagnosis, top):
         _echo(line, as_json)
     _echo(diagnosis.verdict(), as_json)

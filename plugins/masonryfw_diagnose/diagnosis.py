@@ -80,6 +80,7 @@ class Diagnosis:
     ranked_by: str = ""  # the physics whose cracks ranked the best candidates (the search's solver, or fdem)
     reranked: int = 0  # how many of the best were re-ranked by a forward run
     rerank_interrupted: bool = False  # Ctrl-C stopped the re-ranking: the re-ranked are those finished before
+    rerank_failed: list[tuple[dict, str]] = field(default_factory=list)  # forward runs that failed, and why
 
     @property
     def best(self) -> Candidate:

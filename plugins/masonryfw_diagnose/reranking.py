@@ -90,7 +90,7 @@ def rerank(diagnosis: Diagnosis, count: int, solver: str = "fdem", progress=mfp.
             try:
                 result = mf.solve(forward_model(diagnosis, candidate), solver, {})
             except mf.MasonryError as exc:
-                diagnosis.failed.append((candidate.table, f"{solver}: {str(exc).splitlines()[0]}"))
+                diagnosis.rerank_failed.append((candidate.table, f"{solver}: {str(exc).splitlines()[0]}"))
                 continue
             if int(result.attrs.get("interrupted", 0)):
                 raise KeyboardInterrupt

@@ -198,7 +198,8 @@ def test_a_diagnosis_counts_its_scenarios_before_it_searches_and_refuses_what_no
 
 def test_a_diagnosis_says_its_scenario_count_and_time_before_it_starts(tmp_path):
     (tmp_path / "c.geojson").write_text(CRACKS)
-    done = cli(["diagnose", "facade-1", "--cracks", "c.geojson", "--profiles", "step", "--no-progress"], tmp_path)
+    done = cli(["diagnose", "facade-1", "--cracks", "c.geojson", "--profiles", "step", "--no-progress", "--rerank",
+                "0"], tmp_path)
     assert done.returncode == 0, done.stderr
     said = re.match(r"diagnose: (\d+) scenarios \(step\) with la on (\d+) ground pieces; expect about \d", done.stderr)
     pieces = int(said.group(2))
@@ -261,7 +262,7 @@ def test_an_interrupted_verification_is_not_a_verification(tmp_path):
     """``diagnose --verify fdem`` interrupted exited 0 and stored the cut-short fdem numbers as verified."""
     (tmp_path / "c.geojson").write_text(CRACKS)
     running = Command(["diagnose", "facade-1", "--cracks", "c.geojson", "--profiles", "step", "--verify", "fdem",
-                       "-o", "d.nc"], tmp_path)
+                       "--rerank", "0", "-o", "d.nc"], tmp_path)
     try:
         running.wait_for(r"verify: .* with fdem")
         status, stderr, _ = running.signal(signal.SIGINT)
@@ -296,7 +297,8 @@ def test_markup_in_every_string_a_user_controls_is_quoted_as_text_in_the_report(
     spec = (DATASETS / "facade-1.toml").read_text().replace('title = "', f'title = "{MARKUP}', 1)
     (tmp_path / "f.toml").write_text(spec.replace('description = """', f'description = """{MARKUP}', 1))
     assert cli(["solve", "f.toml", "--plugin", "la", "-o", "f.la.nc"], tmp_path).returncode == 0
-    done = cli(["diagnose", "f.toml", "--cracks", crack_map, "--profiles", "step", "-o", "d.nc"], tmp_path)
+    done = cli(["diagnose", "f.toml", "--cracks", crack_map, "--profiles", "step", "--rerank", "0", "-o", "d.nc"],
+               tmp_path)
     assert done.returncode == 0, done.stderr
     assert cli(["report", "f.la.nc", "d.nc", "-o", "r.html"], tmp_path).returncode == 0
     page = (tmp_path / "r.html").read_text()
@@ -313,7 +315,7 @@ def test_a_report_or_plot_of_a_damaged_diagnosis_names_the_damage(tmp_path):
     import netCDF4
 
     (tmp_path / "c.geojson").write_text(CRACKS)
-    assert cli(["diagnose", "facade-1", "--cracks", "c.geojson", "--profiles", "step", "-o", "d.nc"],
+    assert cli(["diagnose", "facade-1", "--cracks", "c.geojson", "--profiles", "step", "--rerank", "0", "-o", "d.nc"],
                tmp_path).returncode == 0
     with netCDF4.Dataset(tmp_path / "d.nc", "a") as file:
         file["candidate_score"][:] = np.nan
