@@ -361,5 +361,13 @@ def _ring(polygon: Polygon, clean: float) -> np.ndarray:
     simplified = shapely.simplify(polygon, clean)
     if isinstance(simplified, Polygon) and simplified.is_valid and not simplified.is_empty:
         polygon = simplified
-    ring = shapely.geometry.polygon.orient(polygon, 1.0).exterior.coords
-    return np.asarray(ring)[:-1]
+    ring = np.asarray(shapely.geometry.polygon.orient(polygon, 1.0).exterior.coords)[:-1]
+    while len(ring) > 3:  # what a simplification left for its result's validity: a straight vertex, one by one
+        before, after = np.roll(ring, 1, axis=0), np.roll(ring, -1, axis=0)
+        chord = after - before
+        offset = np.abs(np.cross(chord, ring - before)) / np.maximum(np.hypot(*chord.T), 1e-300)
+        straight = int(np.argmin(offset))
+        if offset[straight] > clean:
+            break
+        ring = np.delete(ring, straight, axis=0)
+    return ring

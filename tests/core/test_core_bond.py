@@ -273,6 +273,27 @@ def test_an_arch_is_a_ring_of_voussoirs_on_the_openings_curved_head():
     assert distance.min() == pytest.approx(radius, rel=1e-3)  # the intrados is the opening's chords
 
 
+def test_no_laid_block_keeps_a_vertex_on_a_straight_edge():
+    """An arched window 0.45 m wide beside a door (a facade of the diagnosis's study, seed 5036): a cut unit's
+    simplification was dropped as invalid and kept a vertex 0 m off its neighbours' chord, a model refused
+    ("zero turn"). Every block now turns at every vertex by more than the laying's clean length."""
+    spec = {"title": "arched window beside a door", "wall": {"width": 2.925, "height": 1.05, "thickness": 0.2},
+            "unit": {"length": 0.225, "height": 0.075}, "bond": {"pattern": "running", "first_course": "full"},
+            "openings": [{"x": 1.7209, "y": 0.0, "width": 0.675, "height": 0.225, "head": "lintel"},
+                         {"x": 0.5336, "y": 0.15, "width": 0.45, "height": 0.375, "shape": "arched"}],
+            "material": {"unit_weight": 18000.0, "friction_angle": 30.0},
+            "settlement": {"profile": "step", "start": 2.0, "end": 3.0}, "loading": {"type": "settlement"}}
+    model = mf.build(spec)
+    x, y, counts = model.node_x.values, model.node_y.values, model.block_node_count.values
+    starts = np.concatenate([[0], np.cumsum(counts)[:-1]])
+    for start, count in zip(starts, counts):
+        ring = np.c_[x[start:start + count], y[start:start + count]]
+        before, after = np.roll(ring, 1, axis=0), np.roll(ring, -1, axis=0)
+        chord = after - before
+        offset = np.abs(np.cross(chord, ring - before)) / np.hypot(*chord.T)
+        assert offset.min() > 4e-6 * math.hypot(2.925, 1.05)
+
+
 def test_an_outline_drawing_given_as_blocks_is_recognised_and_the_message_says_how(tmp_path):
     """An architect's outline read as one polyline per block: it said the outline "overlaps" its openings, and
     with the openings ignored it built one block 6.5 x 10.5 m, exit 0."""

@@ -222,13 +222,13 @@ def test_the_search_on_processes_and_on_a_dask_cluster_ranks_alike(tmp_path):
 
     case = STUDY / "case-06"
     args = ["diagnose", str(case / "wall.toml"), "--cracks", str(case / "cracks.geojson"), "--levelling",
-            str(case / "levelling.csv"), "--rerank", "0", "--top", "40"]
+            str(case / "levelling.csv"), "--rerank", "0", "--top", "40", "--profiles", "step,linear"]
     here = cli_json(args, tmp_path)
     processes = cli_json(args + ["--workers", "2"], tmp_path)
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster:
         cluster_run = cli_json(args + ["--scheduler", cluster.scheduler_address], tmp_path)
     assert ranking(here) == ranking(processes) == ranking(cluster_run)
-    assert here["tried"] == processes["tried"] == cluster_run["tried"] > 100
+    assert here["tried"] == processes["tried"] == cluster_run["tried"] > 80
 
 
 def test_ctrl_c_stops_the_processes_and_keeps_the_ranking(tmp_path):
