@@ -365,7 +365,8 @@ def _ring(polygon: Polygon, clean: float) -> np.ndarray:
     while len(ring) > 3:  # what a simplification left for its result's validity: a straight vertex, one by one
         before, after = np.roll(ring, 1, axis=0), np.roll(ring, -1, axis=0)
         chord = after - before
-        offset = np.abs(np.cross(chord, ring - before)) / np.maximum(np.hypot(*chord.T), 1e-300)
+        away = ring - before
+        offset = np.abs(chord[:, 0] * away[:, 1] - chord[:, 1] * away[:, 0]) / np.maximum(np.hypot(*chord.T), 1e-300)
         straight = int(np.argmin(offset))
         if offset[straight] > clean:
             break

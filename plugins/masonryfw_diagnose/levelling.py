@@ -65,7 +65,6 @@ class Fit:
     spread: float  # its standard error [m]
     residual: float  # SS [m^2]
     share_ground: float  # t_g / (t_m + t_g): 0 moving as the mechanism, 1 following the ground
-    r2: float  # 1 - SS / SS_tot
     fitted: np.ndarray  # the fitted dy at the levelled points [m]
 
 
@@ -81,14 +80,13 @@ def fit(dy: np.ndarray, mechanism: np.ndarray, ground: np.ndarray, sigma: float)
     datum, t_m, t_g = solution.x * scale / norms
     shape = t_m * mechanism + t_g * ground
     residual = float(((dy - datum - shape) ** 2).sum())
-    total = float(((dy - dy.mean()) ** 2).sum())
     magnitude = t_m + t_g
     centred = shape / magnitude - (shape / magnitude).mean() if magnitude > 0 else np.zeros_like(dy)
     spread_of_shape = math.sqrt(float((centred**2).sum()))
     noise = max(sigma, math.sqrt(residual / max(dy.size - 3, 1)))
     spread = math.hypot(noise / spread_of_shape, MODEL_ERROR * magnitude) if spread_of_shape > 0 else math.inf
     return Fit(float(magnitude), float(spread), residual, float(t_g / magnitude) if magnitude > 0 else 0.0,
-               max(0.0, 1.0 - residual / total) if total > 0 else 1.0, datum + shape)
+               datum + shape)
 
 
 def scores(fits: list[Fit], sigma: float, points: int) -> np.ndarray:

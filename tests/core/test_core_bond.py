@@ -290,7 +290,8 @@ def test_no_laid_block_keeps_a_vertex_on_a_straight_edge():
         ring = np.c_[x[start:start + count], y[start:start + count]]
         before, after = np.roll(ring, 1, axis=0), np.roll(ring, -1, axis=0)
         chord = after - before
-        offset = np.abs(np.cross(chord, ring - before)) / np.hypot(*chord.T)
+        away = ring - before
+        offset = np.abs(chord[:, 0] * away[:, 1] - chord[:, 1] * away[:, 0]) / np.hypot(*chord.T)
         assert offset.min() > 4e-6 * math.hypot(2.925, 1.05)
 
 
