@@ -135,7 +135,7 @@ def test_a_figure_and_a_report_of_an_interrupted_diagnosis_say_it_is_partial(tmp
     from masonryfw_compare.report import _diagnosis_section
 
     done = cli(["diagnose", "facade-1", "--cracks", str(_survey("facade-1-cracks.geojson")), "--profiles", "step",
-                "-o", "d.nc"], tmp_path)
+                "--rerank", "0", "-o", "d.nc"], tmp_path)
     assert done.returncode == 0, done.stderr
     whole = mf.open_dataset(tmp_path / "d.nc")
     assert "PARTIAL" not in mf.render([whole], "diagnosis")._suptitle.get_text()

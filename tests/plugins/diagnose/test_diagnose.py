@@ -323,7 +323,7 @@ def test_the_json_contract(cli_diagnosis, cracks_12c):
 def test_a_survey_without_widths_or_levelling_has_no_magnitude(tmp_path, cracks_12c):
     write_geojson(tmp_path / "c.geojson", cracks_12c)
     run = cli_run(["diagnose", "test-12c", "--cracks", "c.geojson", "--profiles", "step", "--json", "-o", "d.nc",
-                   "--no-progress"], tmp_path)
+                   "--no-progress", "--rerank", "0"], tmp_path)
     assert run.exit_code == 0, run.output
     data = json.loads(run.stdout)
     assert all(c["magnitude"] is None and c["settlement"]["profile"] == "step" for c in data["candidates"])
@@ -399,7 +399,7 @@ def test_a_drawn_wall_with_a_dxf_crack_map(tmp_path):
                                     dxfattribs={"layer": "OUTLINE"})
     doc.saveas(tmp_path / "survey.dxf")
     run = cli_run(["diagnose", "stepped-units", "--cracks", "survey.dxf", "--cracks-layer", "CRACKS", "--json",
-                   "-o", "d.nc", "--no-progress"], tmp_path)
+                   "-o", "d.nc", "--no-progress", "--rerank", "0"], tmp_path)
     assert run.exit_code == 0, run.output
     best = json.loads(run.stdout)["candidates"][0]["settlement"]
     segment = best["segment"]
@@ -408,7 +408,7 @@ def test_a_drawn_wall_with_a_dxf_crack_map(tmp_path):
     bare = {k: v for k, v in spec.items() if k != "loading"}
     (tmp_path / "bare.toml").write_text(mf.dump_toml(bare))
     again = cli_run(["diagnose", "bare.toml", "--cracks", "survey.dxf", "--cracks-layer", "CRACKS", "--json",
-                     "-o", "e.nc", "--no-progress"], tmp_path)
+                     "-o", "e.nc", "--no-progress", "--rerank", "0"], tmp_path)
     assert again.exit_code == 0, again.output
     assert json.loads(again.stdout)["candidates"][0]["settlement"] == best
 
