@@ -6,10 +6,12 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
+import numba
 import numpy as np
 
 from .costs import call_steps
 from .scene import Scene
+from .threads import Threads
 
 
 @dataclass(frozen=True)
@@ -32,6 +34,7 @@ class Controls:
     max_steps: int
     record_steps: int
     call_steps: int  # the most steps of one kernel call (Ctrl-C is taken between calls)
+    threads: Threads  # the threads of each kernel call, chosen as the run goes
     buffer: float
     max_penetration: float
     min_cos: float
@@ -124,6 +127,7 @@ def make_controls(scene: Scene, options: Mapping[str, Any]) -> Controls:
         max_steps=options["max_steps"],
         record_steps=record_steps,
         call_steps=call_steps(scene.driven.size),
+        threads=Threads.chosen(options["threads"], scene.driven.size, numba.config.NUMBA_NUM_THREADS),
         buffer=options["buffer_ratio"] * scene.unit_height,
         max_penetration=0.25 * scene.unit_height,
         min_cos=float(np.cos(np.radians(options["max_contact_angle"]))),

@@ -6,7 +6,8 @@ time (H the masonry's height; measured 0.23-0.68 on six bundled walls, from the 
 to the 6 m tunnel facade: a fixed share of the settlement steps was 5 % where it is 25-80 % for a
 short target); a step costs about ``STEP_SECONDS_PER_BLOCK`` a block on one thread (2-core AMD
 EPYC, 2026-11-27, after the kernels dropped ``np.hypot``: 0.38-0.42 us on the 2,432-block wall of
-docs/benchmarks.md "Where users wait", 1,035-block scale wall below), ``PARALLEL_EFFICIENCY`` of that less per added thread, times
+docs/benchmarks.md "Where users wait", 1,035-block scale wall below), ``PARALLEL_EFFICIENCY`` of that less per added thread (the count the run will
+most likely settle on, :mod:`.threads`), divided by the share of a core the run gets on a busy machine, times
 ``DEFORMABLE_FACTOR`` in the (serial) CST mode. A reaction plateau often stops the run earlier: the
 estimate is the longest. The shared machine's speed itself varies from day to day: the same code ran the
 1,035-block wall 1.65x faster on 2026-11-25 (same steps, same reactions), so no constant holds to 25 %
@@ -22,28 +23,15 @@ import xarray as xr
 
 import masonryfw.plugin_api as mfp
 
+from . import threads
 from .controls import make_controls, masonry_height
 from .costs import DEFORMABLE_FACTOR, STEP_SECONDS_PER_BLOCK
 from .scene import build_scene
 
 PARALLEL_EFFICIENCY = 0.95
-# two threads add ~20 us a step of start-up and save ~0.145 us a block: whole processes in alternating pairs,
-# Test 12C (72 blocks) 0.86x on two threads, Facade 3 (480 blocks) 1.59x (docs/benchmarks.md, fdem)
-PARALLEL_MIN_BLOCKS = 300
 GRAVITY_TIME = 0.4  # the gravity phase in units of sqrt(masonry height / g)
 BASE_MEMORY = 250 * 2**20
 MEMORY_PER_BLOCK = 20e3
-
-
-def threads(options: Mapping[str, Any], blocks: int) -> int:
-    """The threads a run will use: the option, at most numba's (NUMBA_NUM_THREADS, else the cores); auto:
-    one below ``PARALLEL_MIN_BLOCKS``, where the parallel loops' start-up costs more than they share."""
-    import numba
-
-    available = numba.config.NUMBA_NUM_THREADS
-    if options["threads"] is None:
-        return available if blocks >= PARALLEL_MIN_BLOCKS else 1
-    return min(options["threads"], available)
 
 
 def estimate(model: xr.Dataset, options: Mapping[str, Any]) -> mfp.Estimate:
@@ -55,7 +43,9 @@ def estimate(model: xr.Dataset, options: Mapping[str, Any]) -> mfp.Estimate:
     if options["mode"] == "deformable":
         seconds = steps * blocks * STEP_SECONDS_PER_BLOCK * DEFORMABLE_FACTOR
     else:
-        seconds = steps * blocks * STEP_SECONDS_PER_BLOCK / (1 + PARALLEL_EFFICIENCY * (threads(options, blocks) - 1))
+        count = controls.threads.current
+        seconds = steps * blocks * STEP_SECONDS_PER_BLOCK / (1 + PARALLEL_EFFICIENCY * (count - 1)) \
+            / threads.core_share(threads.cores(), threads.machine_load())
     return mfp.Estimate(seconds=seconds, memory=BASE_MEMORY + MEMORY_PER_BLOCK * blocks,
                        basis=f"at most {steps:,.0f} time steps of {blocks:,} blocks, as fitted on the 2-core machine "
                              "of docs/benchmarks.md",

@@ -76,8 +76,10 @@ OPTIONS = (
     mfp.Option("wake_force", float, 0.01,
               "a sleeping block wakes when its unbalanced force exceeds this share of its load", above=0.0),
     mfp.Option("threads", int, None,
-              "threads of the contact and block loops (numba); auto: all numba has (NUMBA_NUM_THREADS, the cores) "
-              "from 300 blocks, one below; the trajectory does not depend on it, bit for bit", at_least=1),
+              "threads of the contact and block loops (numba, at most NUMBA_NUM_THREADS); auto: one below 300 "
+              "blocks, else the count that runs fastest on the machine as it is, measured as the run goes (a "
+              "busy machine makes more threads slower); the trajectory does not depend on it, bit for bit",
+              at_least=1),
     mfp.Option("snapshots", float, (), "settlements [m] at which block positions are stored (comma-separated)",
               many=True, at_least=0.0),
 )

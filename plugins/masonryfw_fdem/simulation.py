@@ -19,9 +19,11 @@ from __future__ import annotations
 
 import copy
 import logging
+import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
+import numba
 import numpy as np
 
 import masonryfw as mf
@@ -202,7 +204,11 @@ def chunk(scene: Scene, controls: Controls, state: State, n_steps: int, rate: fl
     wrench = np.zeros((scene.driven.size, 3))
     left = n_steps
     while True:
-        report = state.advance_chunk(scene, controls, min(left, controls.call_steps), rate, target, wrench)
+        threads, steps = controls.threads.next_call(min(left, controls.call_steps))
+        numba.set_num_threads(threads)
+        started = time.perf_counter()
+        report = state.advance_chunk(scene, controls, steps, rate, target, wrench)
+        controls.threads.ran(threads, report.steps, time.perf_counter() - started)
         if not report.kinetic < UNSTABLE_KINETIC_ENERGY:  # also catches nan
             raise mf.SolveError(
                 f"fdem: the time integration blew up (kinetic energy {report.kinetic:.3g} W x length after "

@@ -16,7 +16,7 @@ import xarray as xr
 import masonryfw as mf
 import masonryfw.plugin_api as mfp
 
-from . import estimate, postprocess
+from . import postprocess
 from .compilation import Compilations
 from .controls import make_controls
 from .scene import Scene, build_scene
@@ -34,16 +34,13 @@ def solve(model: xr.Dataset, options: Mapping[str, Any], progress=mfp.no_progres
     from numba.core import event
 
     compilations = Compilations(options["mode"], progress)
-    threads = estimate.threads(options, model.sizes["block"])
     before = numba.get_num_threads()
-    numba.set_num_threads(threads)
     try:
         with event.install_listener("numba:compile", compilations):
             result = _solve(model, options, progress)
     finally:
         numba.set_num_threads(before)
     result.attrs["compile_time_s"] = compilations.seconds
-    result.attrs["fdem_threads"] = threads
     return result
 
 
@@ -78,6 +75,8 @@ def _solve(model: xr.Dataset, options: Mapping[str, Any], progress) -> xr.Datase
         fdem_steps=int(state.steps),
         fdem_gravity_steps=int(state.gravity_steps),
         fdem_rebuilds=int(state.rebuilds),
+        fdem_threads=controls.threads.most_used(),
+        fdem_thread_steps=", ".join(f"{count}: {steps}" for count, steps in sorted(controls.threads.steps_on.items())),
         fdem_face_pairs=int(state.pairs.faces.shape[0]),
         fdem_asleep_blocks=int((~scene.driven & (state.active == 0)).sum()),
         fdem_target_settlement=controls.target * scene.scales.length,
