@@ -219,7 +219,13 @@ def _support_dofs(mesh: WallMesh, disc: Discretisation, model: xr.Dataset, lengt
         moving.append(np.concatenate([2 * dofs, 2 * dofs + 1]))
         direction.append(np.concatenate([ux, uy]))
     if not fixed and not moving:
-        raise mf.ModelError("jmm: no mesh edge lies on a support interface: the wall stands on nothing")
+        lengths = np.hypot(*(mesh.supports[:, 1] - mesh.supports[:, 0]).T)
+        if lengths.size == 0:
+            raise mf.ModelError("jmm: the model has no interface between masonry and a support: the wall stands "
+                                "on nothing")
+        raise mf.ModelError(f"jmm: no edge of the {mesh.mesher} mesh lies on any of the {lengths.size} support "
+                            f"interfaces ({lengths.min():.4g} to {lengths.max():.4g} m long); a mesh_size of at "
+                            f"most {lengths.min():.4g} m puts nodes on every one")
     fixed = np.unique(np.concatenate(fixed)) if fixed else np.zeros(0, int)
     vertical.sort(key=lambda entry: entry[0])  # fixed supports first: they keep shared nodes
     uy, first = np.unique(np.concatenate([dofs for _, dofs, _ in vertical]), return_index=True)

@@ -119,3 +119,20 @@ def test_a_wall_that_does_not_stand_in_the_continuum_is_a_clear_error():
     model = laid('shape = "arched"')
     with pytest.raises(mf.SolveError, match=r"does not stand under its own weight .* least in balance near x"):
         mf.solve(model, "jmm", {"max_steps": 2, "mesh_size": 0.15, "max_iterations": 1, "tolerance": 1e-12})
+
+
+@pytest.mark.parametrize("size", [0.05, 0.5, 3.0])
+@pytest.mark.parametrize("name", ["gable-house", "tunnel-facade"])
+def test_every_ground_segment_holds_mesh_edges_whatever_the_mesh_size(name, size):
+    """A drawn house (gmsh: 122 ground segments, the shortest 0.9 mm, under cut bricks) and a parametric facade
+    (the structured grid: 128 segments of 62.5 mm) over a tunnel's trough: every segment the masonry rests on has mesh edges
+    lying on it, from cells smaller than a segment to cells of 3 m (a coarse mesh once stood on nothing)."""
+    from masonryfw_jmm.problem import support_facets
+
+    model = mf.open_model(name)
+    mesh = wall_mesh(model, size)
+    p, t = mesh.points, mesh.triangles
+    edges = np.sort(np.concatenate([t[[0, 1]], t[[1, 2]], t[[2, 0]]], axis=1), axis=0)
+    unique, counts = np.unique(edges, axis=1, return_counts=True)
+    on = support_facets(p, unique[:, counts == 1], mesh.supports, 1e-9 * mfp.model_scale(p[0], p[1]))
+    assert np.array_equal(np.unique(on[on >= 0]), np.arange(len(mesh.supports)))
