@@ -147,14 +147,15 @@ class NewtonSolver:
 
     def step(self, start: State, gravity_factor: float, settlement: float,
              max_iterations: int | None = None, guess: np.ndarray | None = None,
-             load_factor: float = 0.0) -> tuple[State, StepReport]:
+             load_factor: float = 0.0, iterated=None) -> tuple[State, StepReport]:
         """One load step from the converged ``start``; the first solve is the tangent predictor.
 
         ``guess`` (displacements, e.g. the last step's increment extrapolated) replaces the
         predictor when its residual is lower. The tangent predictor sees the kappa-stiffened
         tangent at open or sliding points, so it underestimates the motion of a mechanism that
         is already forming; the extrapolated increment does not (measured on Facade 1: half
-        the Newton iterations to the same settlement, docs/jmm.md).
+        the Newton iterations to the same settlement, docs/jmm.md). ``iterated(iterations, residual)``, if
+        given, hears of every iteration (a long step's sign of life).
         """
         limit = max_iterations or self.max_iterations
         p, free, fixed_all = self.problem, self.free, self.prescribed
@@ -185,6 +186,8 @@ class NewtonSolver:
             iterations += 1
             state = self._line_search(state, du, start, gravity_factor, residuals[-1], load_factor)
             residuals.append(self._norm(state))
+            if iterated is not None:
+                iterated(iterations, residuals[-1])
         converged = bool(residuals[-1] <= self.tolerance)
         return state, StepReport(converged, iterations, residuals)
 

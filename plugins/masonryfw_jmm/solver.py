@@ -103,12 +103,19 @@ GRAVITY_ITERATIONS = 4  # times max_iterations: with c = sigma_t = 0 the domain 
 # gravity increments meet the same (scaled) problem and do not help; more iterations do
 
 
-def _gravity_stage(newton: NewtonSolver, state: State, history: History) -> tuple[State, str]:
-    """Apply gravity (halved when a step fails); all supports held."""
+def _gravity_stage(newton: NewtonSolver, state: State, history: History,
+                   progress=mfp.no_progress) -> tuple[State, str]:
+    """Apply gravity (halved when a step fails); all supports held. Every Newton iteration is reported (on a
+    big wall each takes seconds, and the stage can take many)."""
     factor, increment, iterations = 0.0, 1.0, 0
     while factor < 1.0:
         target = min(1.0, factor + increment)
-        trial, report = newton.step(state, target, 0.0, GRAVITY_ITERATIONS * newton.max_iterations)
+
+        def iterated(k: int, residual: float, target: float = target) -> None:
+            progress(0.0, f"gravity {target:.3g}: Newton iteration {k}, residual {residual:.2e} "
+                          f"(converged at {newton.tolerance:.0e})")
+        trial, report = newton.step(state, target, 0.0, GRAVITY_ITERATIONS * newton.max_iterations,
+                                    iterated=iterated)
         iterations += report.iterations
         if report.converged:
             state, factor = trial, target
@@ -168,7 +175,7 @@ def _start(problem: Problem, options) -> tuple[NewtonSolver, History, dict, Stat
 def _gravity(newton: NewtonSolver, state: State, history: History, info: dict, progress) -> tuple[State, bool]:
     """The gravity stage; ``(state, failed)``, the failure written into ``info``."""
     progress(0.0, "gravity")
-    state, failure = _gravity_stage(newton, state, history)
+    state, failure = _gravity_stage(newton, state, history, progress)
     info["stop_reason"] = failure
     return state, bool(failure)
 

@@ -145,3 +145,15 @@ def test_elastic_unloading_settlement_is_one_linear_solve(model):
     settlement, measured_slope = elastic_unloading_settlement(newton, state)
     assert measured_slope == pytest.approx(slope, rel=1e-6)
     assert settlement == pytest.approx(newton.reaction(state) / -slope, rel=1e-6)
+
+
+def test_the_gravity_stage_reports_every_newton_iteration():
+    """On a big wall the gravity stage's iterations take seconds each (the gable house: minutes in all); each
+    is reported with its residual, which falls to the tolerance."""
+    messages: list[str] = []
+    mf.solve(mf.open_model("test-12c"), "jmm", {"max_steps": 1},
+             progress=lambda fraction, message="": messages.append(message))
+    gravity = [m for m in messages if m.startswith("gravity 1: Newton iteration")]
+    assert len(gravity) >= 2
+    residuals = [float(m.split("residual ")[1].split(" ")[0]) for m in gravity]
+    assert residuals[-1] <= 1e-3 < residuals[0]
