@@ -162,7 +162,7 @@ def main() -> None:
         f"{os.cpu_count()} cores), compile time excluded. "
         "R0 = the moving support's dead reaction (uniform distribution, the paper's loading).\n\n"
         "### Throughput\n\n" + "\n".join(throughput) + "\n\n"
-        "### Threads (option `threads`; default: all cores from 300 blocks)\n\n" + "\n".join(threads) + "\n\n"
+        "### Threads (option `threads`; default: one below 300 blocks, from 300 the faster count as measured during the run)\n\n" + "\n".join(threads) + "\n\n"
         "### Sleeping blocks at rest\n\n" + "\n".join(sleeping) + "\n\n"
         "### Run time against error (Test 12C, 12 mm, no plateau stop; one option changed at a time)\n\n"
         + "\n".join(sweep) + "\n\n"

@@ -1,7 +1,9 @@
 """What a time step costs, as measured on the 2-core machine of docs/benchmarks.md (the estimate's basis, and the
 length of a kernel call)."""
 
-STEP_SECONDS_PER_BLOCK = 0.40e-6  # 2026-11-27: 0.38e-6 to 0.42e-6 (2,432 blocks, two runs); 0.29e-6 on 2026-11-25
+# 2026-11-27 evening (the 2-core VM on an Intel Xeon host): 0.256e-6 (2,432 blocks to 5 mm, one thread);
+# the same day on an AMD EPYC host 0.38e-6 to 0.42e-6; 0.29e-6 on 2026-11-25
+STEP_SECONDS_PER_BLOCK = 0.26e-6
 DEFORMABLE_FACTOR = 6.0  # Test 12C: 14.4 s against 2.3 s (docs/benchmarks.md, fdem-deformable)
 #: Seconds a kernel call runs at most, as estimated: Python takes Ctrl-C between calls.
 CALL_SECONDS = 0.25

@@ -4,9 +4,9 @@ The number of time steps to the target settlement is known from the controls (ta
 (rate x dt)); the gravity phase lasts about ``GRAVITY_TIME`` times sqrt(H / g) of simulated
 time (H the masonry's height; measured 0.23-0.68 on six bundled walls, from the 0.6 m Test 12C
 to the 6 m tunnel facade: a fixed share of the settlement steps was 5 % where it is 25-80 % for a
-short target); a step costs about ``STEP_SECONDS_PER_BLOCK`` a block on one thread (2-core AMD
-EPYC, 2026-11-27, after the kernels dropped ``np.hypot``: 0.38-0.42 us on the 2,432-block wall of
-docs/benchmarks.md "Where users wait", 1,035-block scale wall below), ``PARALLEL_EFFICIENCY`` of that less per added thread (the count the run will
+short target); a step costs about ``STEP_SECONDS_PER_BLOCK`` a block on one thread (the 2-core
+machine, ``costs.py`` says which day and host: the same VM ran 1.5x faster on an Intel Xeon host than on an
+AMD EPYC one the same day), ``PARALLEL_EFFICIENCY`` of that less per added thread (the count the run will
 most likely settle on, :mod:`.threads`), divided by the share of a core the run gets on a busy machine, times
 ``DEFORMABLE_FACTOR`` in the (serial) CST mode. A reaction plateau often stops the run earlier: the
 estimate is the longest. The shared machine's speed itself varies from day to day: the same code ran the
@@ -28,7 +28,7 @@ from .controls import make_controls, masonry_height
 from .costs import DEFORMABLE_FACTOR, STEP_SECONDS_PER_BLOCK
 from .scene import build_scene
 
-PARALLEL_EFFICIENCY = 0.95
+PARALLEL_EFFICIENCY = 0.55  # two threads 1.53x one on the 2,432-block wall (2026-11-27 evening; 1.59x on Facade 3)
 GRAVITY_TIME = 0.4  # the gravity phase in units of sqrt(masonry height / g)
 BASE_MEMORY = 250 * 2**20
 MEMORY_PER_BLOCK = 20e3
