@@ -158,7 +158,7 @@ def test_an_interrupted_solve_does_not_report_completion(solver):
 
     def progress(fraction, message=""):
         calls.append(fraction)
-        if len(calls) == 6:
+        if sum(f > 0 for f in calls) == 3:  # in the settlement: jmm's gravity stage reports 0 at every iteration
             raise KeyboardInterrupt
 
     options = {"settlement": 0.002} if solver == "fdem" else {"mesh_size": 0.1}

@@ -169,7 +169,8 @@ def test_cracks_alone_name_what_they_cannot_tell_apart(tmp_path):
     differential settlement within 25 % of fdem's."""
     case = STUDY / "case-06"
     about = truth("case-06")
-    args = ["diagnose", str(case / "wall.toml"), "--cracks", str(case / "cracks.geojson"), "--rerank", "0"]
+    args = ["diagnose", str(case / "wall.toml"), "--cracks", str(case / "cracks.geojson"), "--rerank", "0",
+            "--workers", "2"]  # the same ranking as one process (tested below), in about half the time
     alone = cli_json(args, tmp_path)
     assert len(alone["determined"]["families"]) > 1 and alone["determined"]["family"] is None
     assert "explain the data equally; a levelling of one course would tell them apart" in alone["verdict"]
@@ -204,7 +205,8 @@ def test_a_re_ranking_by_fdem_says_so(tmp_path):
     """--rerank 2: the best two run forward by fdem and scored on its cracks lead the ranking in that order."""
     case = STUDY / "case-06"
     data = cli_json(["diagnose", str(case / "wall.toml"), "--cracks", str(case / "cracks.geojson"), "--levelling",
-                     str(case / "levelling.csv"), "--rerank", "2"], tmp_path)
+                     str(case / "levelling.csv"), "--rerank", "2", "--profiles", "step,linear", "--workers", "2"],
+                    tmp_path)
     assert data["ranked_by"] == "fdem" and data["reranked"] == 2 and "ranked by fdem" in data["verdict"]
     first, second = data["candidates"][:2]
     assert first["reranked_score"] >= second["reranked_score"]
