@@ -26,8 +26,9 @@ PARALLEL_MIN_BLOCKS = 300
 PROBE_SECONDS = 10.0
 #: Seconds of calls on one count that make one measure of its speed.
 MEASURE_SECONDS = 0.02
-#: A try of another count runs calls of about this long at its own last pace; its first call is one step. A busy machine was seen to stretch a step of two threads to
-#: 32 ms (Facade 3, 0.12 ms on one): a try costs about two such steps.
+#: A try of another count runs calls of about this long at its own last pace; its first call is one step. A
+#: busy machine was seen to stretch a step of two threads to 32 ms (Facade 3, 0.12 ms on one): a try costs
+#: about two such steps.
 TRY_SECONDS = 0.005
 #: Seconds of kernel calls over which a count's measured speed is averaged.
 WINDOW_SECONDS = 1.0
