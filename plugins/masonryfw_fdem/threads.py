@@ -12,12 +12,11 @@ in face order), so switching changes no result.
 """
 from __future__ import annotations
 
+import math
 import os
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
-
-import numpy as np
 
 #: Below this many blocks one thread: two threads add ~20 us a step of start-up and save ~0.145 us a block
 #: (whole processes in alternating pairs: Test 12C, 72 blocks, 0.86x on two threads; Facade 3, 480 blocks, 1.59x).
@@ -109,7 +108,7 @@ class Threads:
             now = self.clock()
             for count in self.counts:
                 if count != self.current and now - self.measured_at.get(count, -PROBE_SECONDS) >= PROBE_SECONDS:
-                    return count, min(steps, max(1, int(TRY_SECONDS / self.pace.get(count, np.inf))))
+                    return count, min(steps, max(1, int(TRY_SECONDS / self.pace.get(count, math.inf))))
         return self.current, steps
 
     def ran(self, count: int, steps: int, seconds: float) -> None:
