@@ -56,7 +56,9 @@ class Contribution:
 _manager: pluggy.PluginManager | None = None
 
 
-_distributions: dict[str, tuple[str, str]] = {}  # plugin name -> (distribution, version)
+# plugin name -> its distribution, whose name and version are read only when asked: reading them parses the
+# package's metadata (2 ms a plugin, 15 ms of every CLI process with the bundled plugins)
+_distributions: dict[str, Any] = {}
 
 
 def plugin_manager() -> pluggy.PluginManager:
@@ -80,7 +82,6 @@ def reset() -> None:
 
 def _load_entry_point(manager: pluggy.PluginManager, entry_point) -> None:
     dist = getattr(entry_point, "dist", None)
-    origin = f"{dist.name} {dist.version}" if dist is not None else "unknown distribution"
     try:
         manager.register(entry_point.load(), name=entry_point.name)
         try:
@@ -89,6 +90,7 @@ def _load_entry_point(manager: pluggy.PluginManager, entry_point) -> None:
             manager.unregister(name=entry_point.name)
             raise
     except Exception as exc:  # a broken plugin must not take the others down
+        origin = f"{dist.name} {dist.version}" if dist is not None else "unknown distribution"
         warnings.warn(
             f"masonryfw plugin {entry_point.name!r} ({entry_point.value}, from {origin}) "
             f"failed to load: {type(exc).__name__}: {exc}",
@@ -97,11 +99,11 @@ def _load_entry_point(manager: pluggy.PluginManager, entry_point) -> None:
         )
         return
     if dist is not None:
-        _distributions[entry_point.name] = (dist.name, dist.version)
+        _distributions[entry_point.name] = dist
 
 
 def describe_plugin(plugin: str) -> str:
-    dist = _distributions.get(plugin)
+    dist = distribution(plugin)
     return f"{plugin!r} (distribution {dist[0]} {dist[1]})" if dist else repr(plugin)
 
 
@@ -202,12 +204,13 @@ def installed_plugins() -> list[PluginInfo]:
             by_plugin[item.plugin][kind].append(item.record)
     infos = []
     for name, records in sorted(by_plugin.items()):
-        dist, version = _distributions.get(name, (None, None))
+        dist, version = distribution(name) or (None, None)
         infos.append(PluginInfo(name, dist, version, *(tuple(records[kind]) for kind in _HOOKS)))
     return infos
 
 
 def distribution(plugin: str) -> tuple[str, str] | None:
     """``(distribution, version)`` of the plugin registered under ``plugin`` (None: registered by hand)."""
-    return _distributions.get(plugin)
+    dist = _distributions.get(plugin)
+    return None if dist is None else (dist.name, dist.version)
 
