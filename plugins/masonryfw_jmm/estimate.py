@@ -3,10 +3,12 @@
 The degrees of freedom follow from the mesh's cells (two triangles each: about 8 DOFs a
 cell with quadratic elements, 2 with linear ones), counted on the grid lines of an
 axis-aligned wall, else from the masonry's area and its blocks' perimeters (gmsh refines
-along the sides of small blocks). The constants are fitted on docs/benchmarks.md (2026-11-25, 2-core AMD
-EPYC): a Newton iteration costs 0.175 s at 131,566 DOFs and grows as DOFs^1.2 (the CHOLMOD
-factor); a run to the plateau takes 200-600 iterations on the bundled and scale walls
-(500 assumed); memory is 5 kB a DOF over the interpreter's 200 MiB (the factor's fill).
+along the sides of small blocks). The time constants are fitted on the 2-core VM of docs/benchmarks.md on an
+Intel Xeon host (2026-11-28): a Newton iteration costs 0.27 s at 131,566 DOFs (the 1,035-block scale wall: 594
+iterations in 161 s) and grows as DOFs^1.35 (the 2,432-block paper wall, 308,962 DOFs: 495 iterations in
+413-428 s); the same VM on an AMD EPYC host ran them 1.55x faster (104 s; 2026-11-25) and fdem 1.5x slower,
+so an estimate is good to its host. A run to the plateau takes 200-600 iterations on the bundled and scale
+walls (500 assumed); memory is 5 kB a DOF over the interpreter's 200 MiB (the factor's fill).
 The limit LP (``jmm-limit``) is one interior-point solve of a 2-3x larger programme.
 """
 from __future__ import annotations
@@ -25,9 +27,9 @@ DOFS_PER_CELL = {"p2": 8.0, "p1": 2.0}
 UNSTRUCTURED_CELLS = 1.15  # gmsh's triangles of side mesh_size, in cells (two triangles) per mesh_size^2
 UNSTRUCTURED_EDGE_DOFS = 4.5  # the finer cells along block sides: DOFs per mesh_size of perimeter (fitted on
 # arch-settlement, lact3-arch and lact3-portal: 3.2-7.2)
-ITERATION_SECONDS = 0.175  # 1,035 blocks: 594 Newton iterations in 104 s (nested-dissection ordering)
+ITERATION_SECONDS = 0.27  # 1,035 blocks: 594 Newton iterations in 161 s (nested-dissection ordering)
 ITERATION_DOFS = 131_566
-TIME_EXPONENT = 1.2
+TIME_EXPONENT = 1.35
 NEWTON_ITERATIONS = 500
 LIMIT_LP_SECONDS = 11.5  # Facade 3 at the default mesh, 65,664 LP variables (about 2.2 a DOF)
 LIMIT_LP_DOFS = 30_170
