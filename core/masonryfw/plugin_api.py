@@ -12,6 +12,7 @@ import lazy_loader
 __getattr__, __dir__, __all__ = lazy_loader.attach("masonryfw", submod_attrs={
     "assessment": ["LTSM_LIMITS", "POISSON", "Part", "assess", "deep_beam_strains", "wall_extent"],
     "command_kit": ["LENGTH", "OPTIONS", "PROGRESS", "command_line"],
+    "cores": ["core_share", "cores", "free_cores", "machine_load"],
     "damage": ["distortion", "support_profile"],
     "dofs": ["block_loads", "block_motion", "load_variables", "motion_variables"],
     "drawing": ["DxfLines", "Elevation", "read_drawing", "read_dxf_lines", "read_elevation"],

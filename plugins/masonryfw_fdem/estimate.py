@@ -23,7 +23,6 @@ import xarray as xr
 
 import masonryfw.plugin_api as mfp
 
-from . import threads
 from .controls import make_controls, masonry_height
 from .costs import DEFORMABLE_FACTOR, STEP_SECONDS_PER_BLOCK
 from .scene import build_scene
@@ -45,7 +44,7 @@ def estimate(model: xr.Dataset, options: Mapping[str, Any]) -> mfp.Estimate:
     else:
         count = controls.threads.current
         seconds = steps * blocks * STEP_SECONDS_PER_BLOCK / (1 + PARALLEL_EFFICIENCY * (count - 1)) \
-            / threads.core_share(threads.cores(), threads.machine_load())
+            / mfp.core_share(mfp.cores(), mfp.machine_load())
     return mfp.Estimate(seconds=seconds, memory=BASE_MEMORY + MEMORY_PER_BLOCK * blocks,
                        basis=f"at most {steps:,.0f} time steps of {blocks:,} blocks, as fitted on the 2-core machine "
                              "of docs/benchmarks.md",

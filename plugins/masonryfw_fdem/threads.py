@@ -13,10 +13,11 @@ in face order), so switching changes no result.
 from __future__ import annotations
 
 import math
-import os
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
+
+import masonryfw.plugin_api as mfp
 
 #: Below this many blocks one thread: two threads add ~20 us a step of start-up and save ~0.145 us a block
 #: (whole processes in alternating pairs: Test 12C, 72 blocks, 0.86x on two threads; Facade 3, 480 blocks, 1.59x).
@@ -31,61 +32,10 @@ MEASURE_SECONDS = 0.02
 TRY_SECONDS = 0.005
 #: Seconds of kernel calls over which a count's measured speed is averaged.
 WINDOW_SECONDS = 1.0
-#: Samples of the runnable tasks whose median is the machine's load now (:func:`machine_load`), and their spacing.
-LOAD_SAMPLES = 5
-LOAD_SAMPLE_SECONDS = 0.002
-
-
-def cores() -> int:
-    """The cores this process may run on."""
-    return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
-
-
-def free_cores(cores: int, load: float) -> float:
-    """Cores the machine's other work leaves (``load``: :func:`machine_load`, before the run)."""
-    return max(cores - load, 0.0)
-
-
-def machine_load() -> float:
-    """The other work on the machine now: the median, over a few milliseconds, of the tasks the kernel has
-    runnable, less this one (Linux's ``/proc/loadavg``); elsewhere the one-minute load average (0 where the
-    system does not tell). The average lags a minute behind: just after another job ends it still counts it
-    (a 10,067-block wall run right after another job was estimated at "about 5 min" and took 3 min 8 s)."""
-    samples = []
-    for _ in range(LOAD_SAMPLES):
-        running = runnable_tasks()
-        if running is None:
-            break
-        samples.append(running - 1)
-        time.sleep(LOAD_SAMPLE_SECONDS)
-    if samples:
-        return float(sorted(samples)[len(samples) // 2])
-    try:
-        return os.getloadavg()[0]
-    except OSError:
-        return 0.0
-
-
-def runnable_tasks() -> int | None:
-    """The tasks running or ready to run now, this one included (None where ``/proc/loadavg`` is missing)."""
-    try:
-        with open("/proc/loadavg") as stream:
-            return int(stream.read().split()[3].split("/")[0])
-    except (OSError, IndexError, ValueError):
-        return None
-
-
-def core_share(cores: int, load: float) -> float:
-    """The share of a core one busy thread of the run gets: 1 while a core is free, else cores / (load + 1)
-    (the scheduler shares the cores evenly; measured on Facade 3 beside two busy processes: 1.5x slower, as
-    2 / 3 says)."""
-    return 1.0 if free_cores(cores, load) >= 1.0 else cores / (load + 1.0)
-
-
 def expected_count(available: int, cores: int, load: float) -> int:
     """The count the run will most likely settle on: every thread numba has while the machine has cores for
     them, else the free cores (at least one)."""
-    return int(min(available, max(1, round(free_cores(cores, load)))))
+    return int(min(available, max(1, round(mfp.free_cores(cores, load)))))
 
 
 @dataclass
@@ -123,7 +73,7 @@ class Threads:
             return cls.fixed(min(option, available))
         if blocks < PARALLEL_MIN_BLOCKS:
             return cls.fixed(1)
-        return cls.measured(available, cores(), machine_load())
+        return cls.measured(available, mfp.cores(), mfp.machine_load())
 
     def next_call(self, steps: int) -> tuple[int, int]:
         """``(threads, steps)`` of the next kernel call of up to ``steps``: a stale count gets short tries (one

@@ -8,7 +8,9 @@ Intel Xeon host (2026-11-28): a Newton iteration costs 0.27 s at 131,566 DOFs (t
 iterations in 161 s) and grows as DOFs^1.35 (the 2,432-block paper wall, 308,962 DOFs: 495 iterations in
 413-428 s); the same VM on an AMD EPYC host ran them 1.55x faster (104 s; 2026-11-25) and fdem 1.5x slower,
 so an estimate is good to its host. A run to the plateau takes 200-600 iterations on the bundled and scale
-walls (500 assumed); memory is 5 kB a DOF over the interpreter's 200 MiB (the factor's fill).
+walls (500 assumed). On a busy machine the time is divided by the share of a core the run gets
+(``mfp.core_share``): the 1,035-block wall beside two spinning processes took 276 s, estimated 199 s (133 s
+without the share). Memory is 5 kB a DOF over the interpreter's 200 MiB (the factor's fill).
 The limit LP (``jmm-limit``) is one interior-point solve of a 2-3x larger programme.
 """
 from __future__ import annotations
@@ -80,7 +82,8 @@ def advice(size: float) -> str:
 
 def estimate(model: xr.Dataset, options: Mapping[str, Any]) -> mfp.Estimate:
     dofs, size = mesh_dofs(model, options, options["element"])
-    seconds = NEWTON_ITERATIONS * ITERATION_SECONDS * (dofs / ITERATION_DOFS) ** TIME_EXPONENT
+    seconds = NEWTON_ITERATIONS * ITERATION_SECONDS * (dofs / ITERATION_DOFS) ** TIME_EXPONENT \
+        / mfp.core_share(mfp.cores(), mfp.machine_load())
     return mfp.Estimate(seconds=seconds, memory=BASE_MEMORY + MEMORY_PER_DOF * dofs,
                        basis=f"about {dofs:,} DOFs and {NEWTON_ITERATIONS} Newton iterations, as fitted on the 2-core "
                              "machine of docs/benchmarks.md", advice=advice(size))

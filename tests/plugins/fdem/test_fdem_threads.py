@@ -2,10 +2,6 @@
 count, tries the other again, keeps its tries short on a count that stalls, and changes no result."""
 from __future__ import annotations
 
-import subprocess
-import sys
-import time
-
 import numpy as np
 import pytest
 
@@ -106,27 +102,6 @@ def test_the_expected_count_and_the_share_of_a_core_follow_the_load():
     assert threads.expected_count(2, cores=2, load=0.2) == 2
     assert threads.expected_count(2, cores=2, load=1.2) == 1
     assert threads.expected_count(2, cores=2, load=4.0) == 1
-    assert threads.core_share(2, load=0.5) == 1.0
-    assert threads.core_share(2, load=2.0) == pytest.approx(2 / 3)
-
-
-@pytest.mark.skipif(threads.runnable_tasks() is None, reason="needs Linux's /proc/loadavg")
-def test_the_load_counts_processes_started_a_moment_ago():
-    """Two spinning processes a second old: the one-minute average has barely moved, the load now says two."""
-    spinners = [subprocess.Popen([sys.executable, "-c", "while True: pass"]) for _ in range(2)]
-    try:
-        time.sleep(1.0)
-        assert threads.machine_load() >= 2
-    finally:
-        for spinner in spinners:
-            spinner.kill()
-            spinner.wait()
-
-
-def test_without_proc_the_load_is_the_one_minute_average(monkeypatch):
-    monkeypatch.setattr(threads, "runnable_tasks", lambda: None)
-    monkeypatch.setattr(threads.os, "getloadavg", lambda: (1.25, 0.5, 0.25))
-    assert threads.machine_load() == 1.25
 
 
 def test_switching_counts_at_every_call_changes_no_bit(monkeypatch):
