@@ -170,6 +170,13 @@ def key_numbers(result: xr.Dataset) -> list[KeyNumber]:
                                      "settlement reaction at collapse, (1 - alpha) R0"))
     if "step_reaction" in result and "step_settlement" in result:
         numbers += _history_numbers(result)
+    for name, unit, what in (("settlement_capacity", "m", "settlement at collapse (the last moved configuration "
+                                                          "that carries its dead load)"),
+                             ("capacity_reaction", "N", "settlement reaction of the configuration at collapse"),
+                             ("displacement_capacity", "m", "largest block translation where the live load's "
+                                                            "multiplier of the moved configuration falls to zero")):
+        if name in result:
+            numbers.append(KeyNumber(name, float(result[name].values), unit, what))
     if "step_crack_width_max" in result:
         numbers += _crack_numbers(result)
     for name, what in (("deflection_ratio", "deflection ratio of the imposed profile at the last record "

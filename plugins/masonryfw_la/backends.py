@@ -46,6 +46,14 @@ DEAD_LOAD_MESSAGE = (
 )
 
 
+class LiveLoadUnbounded(mf.SolveError):
+    """No mechanism lets the live load do positive work: any multiple of it is carried."""
+
+
+class DeadLoadNotCarried(mf.SolveError):
+    """A mechanism lets the dead load do positive work: no multiplier lets the wall stand."""
+
+
 @dataclass(frozen=True)
 class LPSolution:
     """What every backend returns (non-dimensional)."""
@@ -103,9 +111,9 @@ def solve_highs(cost, constraints, live, tolerance, method: str = "highs-ds") ->
         },
     )
     if res.status == 2:
-        raise mf.SolveError(UNBOUNDED_MESSAGE)
+        raise LiveLoadUnbounded(UNBOUNDED_MESSAGE)
     if res.status == 3:
-        raise mf.SolveError(DEAD_LOAD_MESSAGE)
+        raise DeadLoadNotCarried(DEAD_LOAD_MESSAGE)
     if res.status != 0:
         raise mf.SolveError(f"HiGHS failed: {res.message}")
     return LPSolution(
@@ -143,9 +151,9 @@ def solve_clarabel(cost, constraints, live, tolerance) -> LPSolution:
     sol = mfp.interruptible(solver.solve)
     status = str(sol.status).split(".")[-1]
     if status in ("PrimalInfeasible", "AlmostPrimalInfeasible"):
-        raise mf.SolveError(UNBOUNDED_MESSAGE)
+        raise LiveLoadUnbounded(UNBOUNDED_MESSAGE)
     if status in ("DualInfeasible", "AlmostDualInfeasible"):
-        raise mf.SolveError(DEAD_LOAD_MESSAGE)
+        raise DeadLoadNotCarried(DEAD_LOAD_MESSAGE)
     if status not in ("Solved", "AlmostSolved"):
         raise mf.SolveError(f"Clarabel failed: {status}")
     x = np.asarray(sol.x)
@@ -207,7 +215,7 @@ def solve_osqp(cost, constraints, live, tolerance) -> LPSolution:
         iterations += res.info.iter
         status = res.info.status
         if status == "primal infeasible":
-            raise mf.SolveError(UNBOUNDED_MESSAGE)
+            raise LiveLoadUnbounded(UNBOUNDED_MESSAGE)
         if status not in ("solved", "solved inaccurate"):
             raise mf.SolveError(f"OSQP failed: {status} after {iterations} ADMM iterations")
         force = OSQP_REGULARISATION * np.abs(res.x - x).max()
@@ -219,7 +227,7 @@ def solve_osqp(cost, constraints, live, tolerance) -> LPSolution:
             inner = tighter
             solver.update_settings(eps_abs=inner, eps_rel=inner)
     else:
-        raise mf.SolveError(
+        raise DeadLoadNotCarried(
             DEAD_LOAD_MESSAGE + f" (OSQP: the proximal steps did not settle in "
             f"{OSQP_MAX_PROXIMAL_STEPS} steps; last regularisation force {force:.3g})"
         )

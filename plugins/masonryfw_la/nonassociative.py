@@ -241,9 +241,7 @@ def solve(wall: assembly.Wall, scales: assembly.Scales, kin: assembly.Kinematics
         first = backends.solve_lp(backend, lp.cost, lp.constraints, lp.live, lp_tolerance)
         normal = end_normal_forces(lp, first.y, wall.n_interface, scales)
         alpha_associative = first.alpha_primal
-    except mf.SolveError as error:
-        if backends.UNBOUNDED_MESSAGE not in str(error):
-            raise
+    except backends.LiveLoadUnbounded:
         normal = np.zeros(2 * wall.n_interface)  # the dilatancy is blocked: start from no friction at all
         alpha_associative = np.nan
     selection = Selection(backend, lp_tolerance, SELECTION_WEIGHT * min(1.0, SELECTION_BLOCKS / wall.n_block))

@@ -14,19 +14,9 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
-import masonryfw as mf
 import masonryfw.plugin_api as mfp
 
-from . import assembly, backends, nonassociative, postprocess, topology
-
-
-def check_live_load(lp: assembly.KinematicLP) -> None:
-    """A live load that no admissible motion can do work on leaves alpha undefined."""
-    if not np.any(np.abs(lp.live) > 1e-12 * max(1.0, np.abs(lp.cost).max(initial=0.0))):
-        raise mf.SolveError(
-            "no live load: the multiplier is undefined (live_load is zero on every component "
-            "of motion that is not held)"
-        )
+from . import assembly, backends, limit, nonassociative, topology
 
 
 def solve(model: xr.Dataset, options: Mapping[str, Any], progress=mfp.no_progress) -> xr.Dataset:
@@ -38,7 +28,7 @@ def solve(model: xr.Dataset, options: Mapping[str, Any], progress=mfp.no_progres
     scales = assembly.model_scales(model, wall)
     kin = assembly.interface_kinematics(wall, scales)
     lp = assembly.assemble(wall, scales, kin)
-    check_live_load(lp)
+    limit.check_live_load(lp)
     t_assembly = time.perf_counter() - clock
 
     rows, cols = lp.constraints.shape
@@ -54,7 +44,7 @@ def solve(model: xr.Dataset, options: Mapping[str, Any], progress=mfp.no_progres
 
     progress(0.9, "la: post-processing")
     clock = time.perf_counter()
-    result = result_dataset(wall, lp, sol, scales, "associative" if flow is None else "nonassociative")
+    result = result_dataset(limit.state_of(wall, lp, sol, scales), "associative" if flow is None else "nonassociative")
     if flow is not None:
         result.attrs.update(
             la_flow_iterations=len(flow.alphas),
@@ -84,29 +74,19 @@ def solve(model: xr.Dataset, options: Mapping[str, Any], progress=mfp.no_progres
     return result
 
 
-def result_dataset(
-    wall: assembly.Wall,
-    lp: assembly.KinematicLP,
-    sol: backends.LPSolution,
-    scales: assembly.Scales,
-    flow_rule: str = "associative",
-) -> xr.Dataset:
+def result_dataset(state: limit.LimitState, flow_rule: str = "associative") -> xr.Dataset:
     """The primary result variables of one solved programme (docs/format.md)."""
-    forces = postprocess.contact_forces(lp, sol.y, wall.n_interface, scales)
     ie = ("interface", "end")
+    sol = state.solution
     data = {
         "collapse_multiplier": ((), sol.alpha_primal, mfp.variable_attrs("collapse_multiplier")),
-        **mfp.motion_variables(postprocess.mechanism(lp, sol.x, scales)),
-        "interface_normal_force": (ie, forces.normal, mfp.variable_attrs("interface_normal_force")),
-        "interface_shear_force": (ie, forces.shear, mfp.variable_attrs("interface_shear_force")),
+        **mfp.motion_variables(state.motion),
+        "interface_normal_force": (ie, state.normal, mfp.variable_attrs("interface_normal_force")),
+        "interface_shear_force": (ie, state.shear, mfp.variable_attrs("interface_shear_force")),
         "lp_status": ((), sol.status, {"long_name": "status of the linear programme", "units": "1"}),
         "lp_iterations": ((), np.int64(sol.iterations), {"long_name": "iterations of the LP backend", "units": "1"}),
     }
-    if lp.settlement_column is not None:
-        data["moving_support_reaction"] = (
-            (),
-            postprocess.moving_support_reaction(wall, forces),
-            mfp.variable_attrs("moving_support_reaction"),
-        )
+    if state.reaction is not None:
+        data["moving_support_reaction"] = ((), state.reaction, mfp.variable_attrs("moving_support_reaction"))
     return xr.Dataset(data, attrs={"la_alpha_dual": float(sol.alpha_dual), "rotations": "small",
                                    "flow_rule": flow_rule})

@@ -1,0 +1,129 @@
+"""A wall in a moved configuration, as the arrays ``la``'s programme reads (:class:`masonryfw_la.Wall`).
+
+What does not change through the run (the model's polygons, loads, materials and scales) is read once
+into a :class:`Reference`; :func:`wall_at` places the blocks at a pose, finds their contacts again
+(:mod:`.contacts`) and gives every contact the friction of the joint between its two blocks (the
+smaller of their joints' where they were not in contact in the model). Moving supports are placed
+by the settlement parameter alone and move on at their velocity in the moved configuration.
+"""
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+
+import numpy as np
+import xarray as xr
+
+import masonryfw as mf
+import masonryfw.plugin_api as mfp
+from masonryfw_la import Scales, Wall, wall_scales
+
+from . import motion
+from .contacts import Contacts, Polygons, find_contacts
+
+
+@dataclass(frozen=True)
+class Reference:
+    """The model's configuration and everything a moved one keeps."""
+
+    wall: Wall
+    scales: Scales
+    node_x: np.ndarray
+    node_y: np.ndarray
+    counts: np.ndarray
+    owner: np.ndarray
+    ground: np.ndarray  # support blocks: their mutual contacts do not count
+    radius: np.ndarray  # (block,) largest distance of a vertex from the centroid [m]
+    unit_height: float  # median height of the masonry units [m]: the length steps are measured in
+    pair_keys: np.ndarray  # sorted a * n + b (a < b) of the model's interfaces
+    pair_friction: np.ndarray
+    block_friction: np.ndarray  # the smallest friction of a block's joints
+    gap: float  # a vertex this far outside a face still touches it [m]
+    cornered: np.ndarray  # sorted pair keys of blocks that meet corner to corner in the model
+
+    @property
+    def centroid(self) -> np.ndarray:
+        return self.wall.centroid
+
+    @property
+    def n_block(self) -> int:
+        return self.wall.n_block
+
+
+def check_dry(model: xr.Dataset) -> None:
+    """Cohesion and tensile strength are not followed through moved configurations: name the first joint."""
+    bonded = np.flatnonzero((model.interface_cohesion.values > 0) | (model.interface_tensile_strength.values > 0))
+    if bonded.size:
+        i = int(bonded[0])
+        raise mf.SolveError(
+            f"la-incremental follows dry joints only: interface {i} (blocks "
+            f"{' and '.join(map(str, model.interface_blocks.values[i]))}) has cohesion "
+            f"{float(model.interface_cohesion.values[i]):.6g} Pa and tensile strength "
+            f"{float(model.interface_tensile_strength.values[i]):.6g} Pa ({bonded.size} such joints); "
+            "solve it with la (first instant), fdem or jmm")
+
+
+def reference(model: xr.Dataset, gap_share: float) -> Reference:
+    """The :class:`Reference` of ``model``; contacts within ``gap_share`` of the median unit height."""
+    wall = Wall.from_model(model)
+    counts = model.block_node_count.values.astype(np.int64)
+    owner = np.repeat(np.arange(counts.size), counts)
+    x, y = model.node_x.values.astype(float), model.node_y.values.astype(float)
+    radius = np.zeros(counts.size)
+    np.maximum.at(radius, owner, np.hypot(x - wall.centroid[owner, 0], y - wall.centroid[owner, 1]))
+    masonry = mfp.masonry_blocks(wall.role)
+    _, _, ymin, ymax = mfp.block_bounds(x, y, counts)
+    unit_height = float(np.median((ymax - ymin)[masonry]))
+    sides = np.sort(wall.sides, axis=1)
+    keys = sides[:, 0] * counts.size + sides[:, 1]
+    order = np.argsort(keys, kind="stable")
+    block_friction = np.full(counts.size, np.inf)
+    for side in (0, 1):
+        np.minimum.at(block_friction, wall.sides[:, side], wall.friction)
+    block_friction[~np.isfinite(block_friction)] = float(np.median(wall.friction)) if wall.friction.size else 0.0
+    ground = mfp.support_blocks(wall.role)
+    gap = gap_share * unit_height
+    polygons = Polygons.of(x, y, counts)
+    every = find_contacts(polygons, ground, gap, gap, cornered=np.zeros(0, dtype=np.int64))
+    faces = find_contacts(polygons, ground, gap, gap)
+    every_keys = every.sides[:, 0] * counts.size + every.sides[:, 1]
+    cornered = np.setdiff1d(every_keys, faces.sides[:, 0] * counts.size + faces.sides[:, 1])
+    return Reference(wall, wall_scales(model, wall), x, y, counts, owner, ground, radius, unit_height, keys[order],
+                     wall.friction[order], block_friction, gap, cornered)
+
+
+def contact_friction(ref: Reference, sides: np.ndarray) -> np.ndarray:
+    """The model's friction of the joint between each contact's blocks, else the smaller of theirs."""
+    keys = sides[:, 0] * ref.n_block + sides[:, 1]
+    at = np.clip(np.searchsorted(ref.pair_keys, keys), 0, max(ref.pair_keys.size - 1, 0))
+    known = ref.pair_keys.size > 0
+    same = ref.pair_keys[at] == keys if known else np.zeros(keys.size, dtype=bool)
+    fallback = np.minimum(ref.block_friction[sides[:, 0]], ref.block_friction[sides[:, 1]])
+    return np.where(same, ref.pair_friction[at] if known else 0.0, fallback)
+
+
+def wall_at(ref: Reference, pose: np.ndarray) -> tuple[Wall, Contacts]:
+    """The wall with every block at ``pose`` ``(block, 3)`` and its contacts found again."""
+    x, y = motion.vertices(pose, ref.centroid, ref.node_x, ref.node_y, ref.owner)
+    contacts = find_contacts(Polygons(x, y, ref.counts, np.r_[0, np.cumsum(ref.counts)], ref.owner), ref.ground,
+                             ref.gap, ref.gap, ref.cornered)
+    n = contacts.sides.shape[0]
+    direction = np.where(ref.wall.moving[:, None], motion.current_twist(ref.wall.direction, pose), 0.0)
+    wall = dataclasses.replace(
+        ref.wall,
+        direction=direction,
+        settlement_weights=direction,
+        centroid=ref.centroid + pose[:, :2],
+        node_x=x,
+        node_y=y,
+        sides=contacts.sides,
+        end_x=contacts.end_x,
+        end_y=contacts.end_y,
+        normal=contacts.normal,
+        tangent=contacts.tangent,
+        length=contacts.length,
+        friction=contact_friction(ref, contacts.sides),
+        cohesion=np.zeros(n),
+        tensile_strength=np.zeros(n),
+    )
+    return wall, contacts

@@ -1,0 +1,240 @@
+"""The increments: limit state of the current configuration, blocks moved by its mechanism, contacts again.
+
+Each increment solves la's associative programme on the current configuration
+(:func:`masonryfw_la.limit_state`), moves every block along its mechanism by the exact rigid motion of
+a constant twist (:func:`.motion.screw`) and finds the contacts of the moved configuration. The size
+is adaptive: the fastest point of any block moves ``step`` times the median unit height; a step whose
+blocks overlap by more than the contact gap is halved. A step after which the configuration cannot
+carry its dead load (the programme is unbounded) brackets the collapse: the bracket is halved until
+the fastest point would move less than :data:`COLLAPSE_RESOLUTION` of a step, and the last
+configuration that stands is the capacity. A failure seen from one configuration is forgotten once a
+shorter step from it stands: a long step can lose a contact the wall needs (a block stepping off its
+support's corner) where shorter ones do not, so only a configuration that falls within the resolution
+of the last one that stands is a collapse. Settlement runs are driven by the settlement parameter t
+(the mechanism is per unit t); runs with a live load and no moving support by the largest block
+translation (a capacity curve: the multiplier of the moved configuration against it), and collapse
+where the multiplier falls to zero.
+"""
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+
+import masonryfw as mf
+import masonryfw.plugin_api as mfp
+from masonryfw_la import DeadLoadNotCarried, LimitState, LiveLoadUnbounded, Wall, falling_motion, limit_state
+
+from . import motion
+from .configuration import Reference, wall_at
+
+#: The collapse is bracketed to this share of a step's largest motion.
+COLLAPSE_RESOLUTION = 1e-2
+#: A step is halved at most this many times in a row before the run stops (the LP keeps failing).
+MAX_HALVINGS = 30
+#: A part that falls lands within this many median unit heights (its fastest point's travel), or the wall collapses.
+LANDING_DISTANCE = 0.5
+#: The most steps a fall takes (its fastest point moving a step each, shorter where it would go into a block).
+MAX_FALL_STEPS = 100
+
+
+class Controls(NamedTuple):
+    """What the user set (options.py), in the units of the run."""
+
+    target: float  # settlement parameter [m] or largest translation [m] to stop at
+    step: float  # the fastest point's motion per increment [m]
+    max_increments: int
+    solver: str
+    tolerance: float
+    flow: str  # "nonassociative": joints slide without opening; "associative": la's dilatant joints
+
+
+class Configuration(NamedTuple):
+    """One configuration that stands: its parameter, block poses and limit state."""
+
+    t: float
+    pose: np.ndarray  # (block, 3) finite displacement of the centroid and rotation
+    wall: Wall  # its contacts as la's interfaces
+    keys: np.ndarray  # (interface, 2) what each end is known by (its vertex and the other block)
+    state: LimitState
+    overlap: float  # the deepest vertex inside another block [m]
+
+
+class Outcome(NamedTuple):
+    """How the run ended."""
+
+    collapsed: bool
+    capacity: float | None  # the parameter at collapse (the last configuration that stands)
+    reason: str
+    interrupted: bool
+
+
+def settlement_driven(ref: Reference) -> bool:
+    return bool(ref.wall.moving.any())
+
+
+def pose_at(ref: Reference, pose: np.ndarray, mechanism: np.ndarray, dt: float, t_support: float) -> np.ndarray:
+    """The blocks moved by ``mechanism`` over ``dt``; the moving supports placed at ``t_support`` from the start."""
+    moved = pose + motion.screw(mechanism, dt)
+    if settlement_driven(ref):
+        moving = ref.wall.moving
+        moved[moving] = motion.screw(ref.wall.direction[moving], t_support)
+    held = ~ref.wall.moving & (ref.ground | ref.wall.fixed.all(axis=1))
+    moved[held] = pose[held]
+    return moved
+
+
+def fastest_point(ref: Reference, mechanism: np.ndarray) -> float:
+    """The largest velocity of any point of a moving masonry block per unit of the parameter."""
+    masonry = ~ref.ground
+    speed = np.hypot(mechanism[:, 0], mechanism[:, 1]) + np.abs(mechanism[:, 2]) * ref.radius
+    return float(speed[masonry].max(initial=0.0))
+
+
+def end_keys(ref: Reference, wall: Wall, end_vertex: np.ndarray) -> np.ndarray:
+    """``(interface, 2)``: each end's vertex and the block it touches, as one integer."""
+    owner = ref.owner[end_vertex]
+    other = np.where(owner == wall.sides[:, 0, None], wall.sides[:, 1, None], wall.sides[:, 0, None])
+    return end_vertex * ref.n_block + other
+
+
+def carried_forces(previous: Configuration, keys: np.ndarray) -> np.ndarray:
+    """The normal force each end carried in the previous configuration [N] (0 for a new contact)."""
+    known = previous.keys.ravel()
+    order = np.argsort(known, kind="stable")
+    at = np.clip(np.searchsorted(known[order], keys.ravel()), 0, max(known.size - 1, 0))
+    found = known[order][at] == keys.ravel() if known.size else np.zeros(keys.size, dtype=bool)
+    force = np.where(found, previous.state.normal.ravel()[order][at] if known.size else 0.0, 0.0)
+    return np.maximum(force, 0.0).reshape(keys.shape)
+
+
+def solved(ref: Reference, pose: np.ndarray, controls: Controls, t: float,
+           previous: Configuration | None) -> Configuration:
+    """The configuration at ``pose``: its contacts and limit state (module docstring).
+
+    Non-associative joints take the shear capacity of the normal forces their ends carried in
+    ``previous``: one LP of la's non-associative sequence per increment. Where those lagging capacities
+    cannot carry the dead load (the load moved onto ends that carried little), the configuration gets
+    the capacities of its own associative state, as la's sequence starts; where the associative state
+    cannot carry it either, the configuration falls whatever the joints' dilatancy (a mechanism that
+    opens as it slides does no work against friction), and :class:`DeadLoadNotCarried` is raised.
+    """
+    wall, contacts = wall_at(ref, pose)
+    keys = end_keys(ref, wall, contacts.end_vertex)
+    if controls.flow == "associative":
+        state = limit_state(wall, ref.scales, controls.solver, controls.tolerance)
+    else:
+        try:
+            if previous is None:
+                raise DeadLoadNotCarried("no forces to start from")
+            state = limit_state(wall, ref.scales, controls.solver, controls.tolerance, carried_forces(previous, keys))
+        except DeadLoadNotCarried:
+            start = limit_state(wall, ref.scales, controls.solver, controls.tolerance)
+            state = limit_state(wall, ref.scales, controls.solver, controls.tolerance, start.normal)
+    return Configuration(t, pose, wall, keys, state, contacts.overlap)
+
+
+def first_configuration(ref: Reference, controls: Controls) -> Configuration:
+    pose = np.zeros((ref.n_block, 3))
+    try:
+        return solved(ref, pose, controls, 0.0, None)
+    except DeadLoadNotCarried as error:
+        raise mf.SolveError(f"la-incremental: the wall does not stand under its dead load before it moves ({error})") \
+            from error
+
+
+def fall(ref: Reference, controls: Controls, pose: np.ndarray, t: float,
+         previous: Configuration) -> Configuration | Outcome:
+    """Let the part that cannot stand at ``pose`` fall, the supports held, until it lands (a configuration
+    that stands: a block dropping onto the one that settled beneath it). When it has not landed after its
+    fastest point fell :data:`LANDING_DISTANCE` unit heights, or cannot move along its fall without
+    going into another block, the run ends: the wall collapses in the first case; in the second a contact
+    the programme does not see (a corner on a corner) holds the part, and no capacity is claimed."""
+    travelled, shrink = 0.0, 1.0
+    for _ in range(MAX_FALL_STEPS):
+        wall, _ = wall_at(ref, pose)
+        falling = falling_motion(wall, ref.scales)
+        speed = fastest_point(ref, falling)
+        if speed <= 0:
+            break
+        blocks = np.flatnonzero(np.abs(falling).max(axis=1) > 1e-6 * np.abs(falling).max())
+        if travelled >= LANDING_DISTANCE * ref.unit_height:
+            return Outcome(True, t, f"{falling_text(blocks)} fell {travelled:.3g} m without landing", False)
+        moved = pose_at(ref, pose, falling, shrink * controls.step / speed, t)
+        if wall_at(ref, moved)[1].overlap > ref.gap:
+            if shrink < COLLAPSE_RESOLUTION:
+                return Outcome(False, None, f"at {t:.6g} m {falling_text(blocks)} cannot stand in the programme and "
+                                            "cannot move without going into another block: a contact the "
+                                            "programme does not see (a corner on a corner) holds it", False)
+            shrink *= 0.5
+            continue
+        pose, travelled = moved, travelled + shrink * controls.step
+        shrink = min(1.0, 1.5 * shrink)
+        try:
+            return solved(ref, pose, controls, t, previous)
+        except DeadLoadNotCarried:
+            continue
+    return Outcome(True, t, "the moved configuration cannot carry its dead load", False)
+
+
+def falling_text(blocks: np.ndarray) -> str:
+    return f"block {blocks[0]}" if blocks.size == 1 else f"{blocks.size} blocks ({mfp.listed(blocks)})"
+
+
+def run(ref: Reference, controls: Controls, record, progress) -> Outcome:
+    """Follow the wall from the model's configuration (module docstring); ``record(configuration)`` for each."""
+    current = first_configuration(ref, controls)
+    record(current)
+    driven = settlement_driven(ref)
+    failing: tuple[float, np.ndarray] | None = None  # a parameter (and pose) that does not stand: bracketed
+    shrink = 1.0  # the share of the step the last overlaps or failed solves allow
+    halvings = 0
+    try:
+        for _ in range(controls.max_increments):
+            if not driven and current.state.alpha <= 0.0:
+                return Outcome(True, current.t, "the multiplier of the moved configuration fell to zero", False)
+            if current.t >= controls.target * (1 - 1e-12):
+                return Outcome(False, None, f"reached the target {controls.target:.6g} m before collapse", False)
+            speed = fastest_point(ref, current.state.motion)
+            if speed <= 0:
+                return Outcome(False, None, "no block moves: the mechanism is the supports' motion alone", False)
+            resolution = COLLAPSE_RESOLUTION * controls.step / speed
+            if failing is not None and failing[0] - current.t <= resolution:
+                landed = fall(ref, controls, failing[1], failing[0], current)
+                if isinstance(landed, Outcome):
+                    return landed._replace(capacity=current.t) if landed.collapsed else landed
+                current, failing = landed, None
+                record(current)
+                continue
+            dt = min(shrink * controls.step / speed, controls.target - current.t)
+            if failing is not None:
+                dt = min(dt, 0.5 * (failing[0] - current.t))
+            pose = pose_at(ref, current.pose, current.state.motion, dt, current.t + dt)
+            try:
+                trial = solved(ref, pose, controls, current.t + dt, current)
+            except DeadLoadNotCarried:
+                failing = (current.t + dt, pose)  # from this configuration: a fall once it is this close
+                shrink *= 0.5
+                continue
+            except LiveLoadUnbounded:
+                return Outcome(False, None, f"at {current.t + dt:.6g} m the wall stands free of the moving supports: "
+                                            "further settlement does not load it", False)
+            except mf.SolveError as error:
+                halvings += 1
+                if halvings > MAX_HALVINGS or dt <= resolution:
+                    return Outcome(False, None, f"the programme failed at {current.t + dt:.6g} m: {error}", False)
+                shrink *= 0.5
+                continue
+            if trial.overlap > ref.gap and dt > resolution:
+                shrink *= 0.5  # the step was too long for its contacts: a vertex went into a block
+                continue
+            halvings = 0
+            shrink = min(1.0, 1.5 * shrink)
+            failing = None  # a failure seen from the last configuration may be the long step's, not the wall's
+            current = trial
+            record(current)
+            progress(min(current.t / controls.target, 1.0), f"la-incremental: {current.t:.4g} m, "
+                                                            f"{current.wall.n_interface} contacts")
+        return Outcome(False, None, f"stopped after {controls.max_increments} increments at {current.t:.6g} m", False)
+    except KeyboardInterrupt:
+        return Outcome(False, None, f"interrupted at {current.t:.6g} m (Ctrl-C)", True)
