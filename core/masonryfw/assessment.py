@@ -205,3 +205,35 @@ def ltsm_variables(model: xr.Dataset, settlement: np.ndarray) -> dict[str, tuple
     strain = np.abs(np.asarray(settlement, dtype=float)) * unit.strain
     return {"step_ltsm_strain": ("step", strain, variable_attrs("step_ltsm_strain")),
             "step_ltsm_category": ("step", ltsm_category(strain), variable_attrs("step_ltsm_category"))}
+
+
+# ---------------------------------------------------------------- where each category is first reached
+
+def ltsm_thresholds(model: xr.Dataset) -> np.ndarray | None:
+    """Stage 2 backwards: the settlement parameter t [m] at which the LTSM strain first reaches each limit of
+    :data:`LTSM_LIMITS` (categories 1 to 4; inf where the strain stays zero), None without a profile."""
+    unit = assess(model, 1.0)
+    if unit is None:
+        return None
+    with np.errstate(divide="ignore"):
+        return np.array(LTSM_LIMITS) / unit.strain if unit.strain > 0 else np.full(len(LTSM_LIMITS), np.inf)
+
+
+def screen_threshold(model: xr.Dataset) -> float | None:
+    """Stage 1 backwards: the smallest t [m] at which the wall is no longer screened out (the greenfield slope
+    reaches 1/500 or the settlement 10 mm under it), None without a profile."""
+    unit = assess(model, 1.0)
+    if unit is None:
+        return None
+    bounds = [limit / value for limit, value in ((SCREEN_SLOPE, unit.slope),
+                                                 (SCREEN_SETTLEMENT, unit.greenfield_settlement)) if value > 0]
+    return min(bounds, default=math.inf)
+
+
+def volume_loss_per_settlement(model: xr.Dataset) -> float | None:
+    """A tunnel's volume loss [%] per metre of its S_max (the trough keeps its shape: S_max is proportional to
+    V_L), None for any other model."""
+    profile = model_profile(model)
+    if profile is None or profile.kind != "tunnel" or not profile.target or profile.volume_loss is None:
+        return None
+    return profile.volume_loss / profile.target

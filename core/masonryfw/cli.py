@@ -204,22 +204,10 @@ def _open_input(path_or_name: str, validate: bool = True):
     return mf.open_model(path_or_name, validate=validate)
 
 
-@cli.command()
-@click.argument("model")
-@click.option("--plugin", "solver", required=True, help="Name of the solver (see `masonryfw plugins`).")
-@click.option("-o", "--output", type=click.Path(dir_okay=False), help="[default: <model>.<plugin>.nc]")
-@OPTIONS
-@PROGRESS
-@click.option("--force", is_flag=True, help=f"Start a run estimated longer than {UNASKED_RUN / 3600:g} h.")
-def solve(model: str, solver: str, output: str | None, options: dict[str, str], progress: bool | None,
-          force: bool) -> None:
-    """Solve MODEL (a model file, a spec file or a bundled case name) with a solver plugin.
-
-    Prints the headline numbers: alpha and the reaction at collapse (limit
-    analysis); the dead, smallest and plateau reactions with their settlements
-    (incremental solvers); else the solver's scalar outputs. Ctrl-C keeps what an incremental solver has computed
-    so far (exit status 130).
-    """
+def _solved(model: str, solver: str, output: str | None, options: dict[str, str], progress: bool | None,
+            force: bool):
+    """Solve and write the result (``solve`` and ``capacity``): the output path checked before the work, long
+    runs announced, Ctrl-C keeping what an incremental solver computed (exit 130)."""
     inputs = mfp.input_files(model)
     out = Path(output) if output else Path(f"{Path(model).stem if inputs else model}.{solver}.nc")
     mfp.check_output_path(out, inputs)
@@ -244,6 +232,26 @@ def solve(model: str, solver: str, output: str | None, options: dict[str, str], 
     mf.save(result, out, command=command_line(), protect=inputs)
     if int(result.attrs.get("interrupted", 0)):
         raise mf.Interrupted(f"interrupted at settlement {_last_settlement(result)}: partial result written to {out}")
+    return result, out, plan
+
+
+@cli.command()
+@click.argument("model")
+@click.option("--plugin", "solver", required=True, help="Name of the solver (see `masonryfw plugins`).")
+@click.option("-o", "--output", type=click.Path(dir_okay=False), help="[default: <model>.<plugin>.nc]")
+@OPTIONS
+@PROGRESS
+@click.option("--force", is_flag=True, help=f"Start a run estimated longer than {UNASKED_RUN / 3600:g} h.")
+def solve(model: str, solver: str, output: str | None, options: dict[str, str], progress: bool | None,
+          force: bool) -> None:
+    """Solve MODEL (a model file, a spec file or a bundled case name) with a solver plugin.
+
+    Prints the headline numbers: alpha and the reaction at collapse (limit
+    analysis); the dead, smallest and plateau reactions with their settlements
+    (incremental solvers); else the solver's scalar outputs. Ctrl-C keeps what an incremental solver has computed
+    so far (exit status 130).
+    """
+    result, out, plan = _solved(model, solver, output, options, progress, force)
     numbers = ", ".join(map(str, mf.key_numbers(result))) or _scalar_summary(
         result, [name for name in result.data_vars if name not in plan.model.variables])
     stop = f"; {result.attrs['stop_reason']}" if result.attrs.get("stop_reason") else ""
@@ -255,6 +263,48 @@ def solve(model: str, solver: str, output: str | None, options: dict[str, str], 
     stages = mf.stages_text(result)
     if stages:
         click.echo(f"stages {stages}")
+
+
+@cli.command()
+@click.argument("model")
+@click.option("--plugin", "solver", default="fdem", show_default=True,
+              help="An incremental solver with crack widths: fdem or la-incremental.")
+@click.option("--category", type=click.IntRange(1, 5), help="Say first where this damage category is reached.")
+@click.option("--settlement", type=float, help="Run to this settlement parameter [m] (a tunnel's S_max).")
+@click.option("--volume-loss", "volume_loss", type=float, help="Run a tunnel to this volume loss [%].")
+@click.option("-o", "--output", type=click.Path(dir_okay=False), help="[default: <model>.<plugin>.nc]")
+@OPTIONS
+@PROGRESS
+@click.option("--force", is_flag=True, help=f"Start a run estimated longer than {UNASKED_RUN / 3600:g} h.")
+def capacity(model: str, solver: str, category: int | None, settlement: float | None, volume_loss: float | None,
+             output: str | None, options: dict[str, str], progress: bool | None, force: bool) -> None:
+    """How much settlement (a tunnel: volume loss) MODEL takes before each damage category, from one run.
+
+    The run's widest crack gives the settlement at which each category is first reached (stage 3), beside
+    the LTSM's (stage 2) and the greenfield screen's (stage 1) over the model's settlement profile. A
+    tunnel's S_max is proportional to its volume loss and the trough keeps its shape, so one run to a larger
+    settlement answers every smaller volume loss. The result file keeps them (``category_settlement``, ...).
+    """
+    if settlement is not None and volume_loss is not None:
+        raise mf.InputError("give --settlement or --volume-loss, not both")
+    if volume_loss is not None:
+        per_metre = mfp.volume_loss_per_settlement(mf.open_model(model))
+        if per_metre is None:
+            raise mf.InputError(f"--volume-loss: {model} is not over a tunnel's trough; give --settlement [m]")
+        settlement = volume_loss / per_metre
+    if settlement is not None:
+        if not settlement > 0:
+            raise mf.InputError(f"--settlement {settlement:g}: the run's settlement must be positive")
+        options = {**options, "settlement": repr(settlement)}
+    result, out, _ = _solved(model, solver, output, options, progress, force)
+    text = mf.capacity_text(result, category)
+    if not text:
+        raise mf.SolveError(f"{solver}: its result has no crack-width history to find the damage categories in; "
+                            "use fdem or la-incremental")
+    click.echo(f"result: {out}")
+    stop = f" ({result.attrs['stop_reason']})" if result.attrs.get("stop_reason") else ""
+    click.echo(f"{solver}: wall time {result.attrs['wall_time_s']:.3g} s{stop}")
+    click.echo(text)
 
 
 def _last_settlement(result) -> str:

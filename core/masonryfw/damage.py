@@ -22,6 +22,12 @@ categories and the distortion of the imposed settlement profile.
   the largest slope between neighbouring points once the chord's tilt is
   removed. Both grow linearly with the settlement parameter
   (``step_deflection_ratio``, ``step_angular_distortion``);
+- **where each category is first reached** (``category_settlement``, derived by the core from one run's
+  history): the settlement at which the widest crack first exceeds the category's lower width, linear
+  between the two records around it; beside it the settlement at which the LTSM (stage 2) first reaches
+  the category and the one at which the greenfield screen (stage 1) first fails, both linear in t, and
+  for a tunnel the volume loss of each (S_max is proportional to V_L: one run to a larger settlement
+  answers every smaller volume loss);
 - the engineers' **stage 2** on the continuous greenfield profile a model was
   built over, the LTSM strain and its category (``step_ltsm_strain``,
   ``step_ltsm_category``, :mod:`masonryfw.assessment`), beside the model's own
@@ -34,7 +40,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .assessment import ltsm_variables
+from .assessment import ltsm_thresholds, ltsm_variables, screen_threshold, volume_loss_per_settlement
 from .roles import masonry_blocks, support_blocks
 from .schema import variable_attrs
 from .semantics import relative_motion
@@ -46,7 +52,9 @@ if TYPE_CHECKING:  # annotations only
 DAMAGE_LIMITS = (1.0e-4, 1.0e-3, 5.0e-3, 15.0e-3, 25.0e-3)
 #: Variables the core derives from a result's history (a solver must not return them).
 DERIVED_STEP_VARIABLES = ("step_damage_category", "step_deflection_ratio", "step_angular_distortion",
-                          "step_ltsm_strain", "step_ltsm_category")
+                          "step_ltsm_strain", "step_ltsm_category", "category", "category_settlement",
+                          "category_ltsm_settlement", "screen_settlement", "category_volume_loss",
+                          "category_ltsm_volume_loss", "screen_volume_loss")
 
 
 def damage_category(width) -> np.ndarray:
@@ -108,6 +116,45 @@ def distortion(x: np.ndarray, v: np.ndarray) -> tuple[float, float]:
     return float(offset[largest] / span), float(np.abs(slopes - tilt).max(initial=0.0))
 
 
+def first_exceeding(settlement: np.ndarray, width: np.ndarray, limit: float) -> float:
+    """The settlement at which ``width`` first exceeds ``limit``, linear between the records around it (NaN
+    when it never does; the first record's settlement when it already does)."""
+    over = np.flatnonzero(width > limit)
+    if over.size == 0:
+        return float("nan")
+    k = int(over[0])
+    if k == 0 or width[k] == width[k - 1]:
+        return float(settlement[k])
+    share = (limit - width[k - 1]) / (width[k] - width[k - 1])
+    return float(settlement[k - 1] + share * (settlement[k] - settlement[k - 1]))
+
+
+def category_variables(model: xr.Dataset, settlement: np.ndarray, width: np.ndarray) -> dict[str, tuple]:
+    """Where the run first reaches damage categories 1 to 5 (stage 3), beside stage 2 and stage 1 and, of a
+    tunnel, their volume losses (module docstring)."""
+    categories = np.arange(1, len(DAMAGE_LIMITS) + 1, dtype=np.int8)
+    reached = np.array([first_exceeding(settlement, width, limit) for limit in DAMAGE_LIMITS])
+    derived: dict[str, tuple] = {
+        "category": ("category", categories, variable_attrs("category")),
+        "category_settlement": ("category", reached, variable_attrs("category_settlement")),
+    }
+    ltsm = ltsm_thresholds(model)
+    screen = screen_threshold(model)
+    if ltsm is not None:
+        derived["category_ltsm_settlement"] = ("category", np.r_[ltsm, np.nan],
+                                               variable_attrs("category_ltsm_settlement"))
+    if screen is not None:
+        derived["screen_settlement"] = ((), screen, variable_attrs("screen_settlement"))
+    per_metre = volume_loss_per_settlement(model)
+    if per_metre is not None:
+        for name in ("category_settlement", "category_ltsm_settlement", "screen_settlement"):
+            if name in derived:
+                dims, values, _ = derived[name]
+                loss = name.replace("settlement", "volume_loss")
+                derived[loss] = (dims, per_metre * np.asarray(values), variable_attrs(loss))
+    return derived
+
+
 def damage_variables(model: xr.Dataset, produced: xr.Dataset) -> dict[str, tuple]:
     """The damage variables the core derives from a solver's history: the category of every
     ``step_crack_width_max`` and the distortion of the imposed profile at every ``step_settlement``."""
@@ -121,5 +168,7 @@ def damage_variables(model: xr.Dataset, produced: xr.Dataset) -> dict[str, tuple
         derived["step_deflection_ratio"] = ("step", ratio * settlement, variable_attrs("step_deflection_ratio"))
         derived["step_angular_distortion"] = ("step", angle * settlement, variable_attrs("step_angular_distortion"))
         derived.update(ltsm_variables(model, settlement))
+        if "step_crack_width_max" in produced:
+            derived.update(category_variables(model, settlement, np.asarray(produced.step_crack_width_max.values)))
     return derived
 

@@ -279,6 +279,55 @@ def short_of_target(result: xr.Dataset) -> float | None:
     return reached if reached < target * (1 - 1e-3) else None
 
 
+def _at(result: xr.Dataset, settlement: float, loss: float | None) -> str:
+    if not np.isfinite(settlement):
+        return "not reached"
+    return _mm(settlement) + ("" if loss is None else f" (V_L {loss:.3g} %)")
+
+
+def _per_category(result: xr.Dataset, name: str) -> np.ndarray:
+    values = result[name].values if name in result else np.full(result.sizes.get("category", 0), np.nan)
+    return np.asarray(values, dtype=float)
+
+
+def capacity_text(result: xr.Dataset, category: int | None = None) -> str:
+    """Where the run first reached each damage category (stage 3), beside the LTSM (stage 2) and the greenfield
+    screen (stage 1), in settlement and, of a tunnel, volume loss (``mf.damage``: derived by the core); with
+    ``category`` that one's sentence first. Empty for a result without them."""
+    if "category_settlement" not in result:
+        return ""
+    tunnel = "category_volume_loss" in result
+    names = {value: name.replace("_", " ") for name, value in flags("step_damage_category").items()}
+    model, ltsm = _per_category(result, "category_settlement"), _per_category(result, "category_ltsm_settlement")
+    model_loss = _per_category(result, "category_volume_loss")
+    ltsm_loss = _per_category(result, "category_ltsm_volume_loss")
+    solver = result.attrs.get("solver", "the run")
+    last = float(result.step_settlement.values[-1]) if result.step_settlement.size else 0.0
+    per_metre = float(model_loss[0] / model[0]) if tunnel and np.isfinite(model_loss[0]) and model[0] else None
+    reach = _mm(last) + ("" if per_metre is None else f" (V_L {per_metre * last:.3g} %)")
+    rows = []
+    for k, n in enumerate(result.category.values.astype(int)):
+        stage3 = _at(result, model[k], model_loss[k] if tunnel else None)
+        stage2 = "lumped with 4" if n == 5 and "category_ltsm_settlement" in result else \
+            _at(result, ltsm[k], ltsm_loss[k] if tunnel else None) if "category_ltsm_settlement" in result else "-"
+        rows.append(Row(f"{n} {names.get(n, '')}", (stage3, stage2), "", (model[k], ltsm[k])))
+    lines = [text_table(("category", f"stage 3: {solver} (to {reach})", "stage 2: LTSM"), rows, note=False)]
+    if "screen_settlement" in result:
+        loss = float(result.screen_volume_loss.values) if "screen_volume_loss" in result else None
+        lines.append(f"stage 1: the greenfield screen (slope 1/500 or 10 mm under the wall) fails at "
+                     f"{_at(result, float(result.screen_settlement.values), loss)}")
+    if category is not None:
+        k = int(category) - 1
+        if not 0 <= k < model.size:
+            raise ValueError(f"--category {category}: the damage categories are 1 to {model.size}")
+        found = (f"first reached at {_at(result, model[k], model_loss[k] if tunnel else None)} in the {solver} run"
+                 if np.isfinite(model[k]) else
+                 f"not reached in the {solver} run, which went to {reach}: run it further (--settlement"
+                 f"{' or --volume-loss' if tunnel else ''})")
+        lines.insert(0, f"category {category} ({names.get(int(category), '')}): {found}")
+    return "\n".join(lines)
+
+
 def _slope(radians: float) -> str:
     """``1/830`` (the engineers' way of writing a small slope), ``0`` for none, ``2.4/1`` for one steeper than
     1/1 (which the 1/N form wrote as 1/0)."""

@@ -102,11 +102,21 @@ def contact_friction(ref: Reference, sides: np.ndarray) -> np.ndarray:
     return np.where(same, ref.pair_friction[at] if known else 0.0, fallback)
 
 
+def still_cornered(ref: Reference, pose: np.ndarray) -> np.ndarray:
+    """The pairs that met corner to corner in the model and have not moved apart since (their relative motion
+    under the gap): they have no contact, as in the model; once they move, their corners hold each other."""
+    a, b = np.divmod(ref.cornered, ref.n_block)
+    relative = pose[a] - pose[b]
+    shift = np.hypot(relative[:, 0], relative[:, 1]) + np.abs(relative[:, 2]) * np.maximum(ref.radius[a],
+                                                                                         ref.radius[b])
+    return ref.cornered[shift < ref.gap]
+
+
 def wall_at(ref: Reference, pose: np.ndarray) -> tuple[Wall, Contacts]:
     """The wall with every block at ``pose`` ``(block, 3)`` and its contacts found again."""
     x, y = motion.vertices(pose, ref.centroid, ref.node_x, ref.node_y, ref.owner)
     contacts = find_contacts(Polygons(x, y, ref.counts, np.r_[0, np.cumsum(ref.counts)], ref.owner), ref.ground,
-                             ref.gap, ref.gap, ref.cornered)
+                             ref.gap, ref.gap, still_cornered(ref, pose))
     n = contacts.sides.shape[0]
     direction = np.where(ref.wall.moving[:, None], motion.current_twist(ref.wall.direction, pose), 0.0)
     wall = dataclasses.replace(

@@ -7,9 +7,9 @@ shared corner). A touching vertex is a point contact whose normal is the edge's,
 vertex's block. The point contacts of one pair of blocks along one normal are one interface whose two
 ends are the extreme points along the tangent: two flush faces give the ends of their overlap, as the
 model's interfaces; a corner on a face gives an interface with its two ends at the corner (a hinge); a
-corner on a corner, which has no face, gives none where the model's blocks met corner to corner (four
-units at a cross joint: la has no interface there either), and elsewhere the faces of both corners (the
-corner may not go into either: a blocks coming to rest corner to corner holds).
+corner on a corner gives the faces of both corners (the corner may go into neither: blocks coming to
+rest corner to corner hold each other), but none between blocks that met corner to corner in the model
+and have not moved apart since (four units at a cross joint: la has no interface there either).
 Joints that open by more than ``gap`` have no contact; blocks that come to touch get one.
 """
 from __future__ import annotations
@@ -57,7 +57,6 @@ class Contacts:
     normal: np.ndarray  # (interface, 2)
     tangent: np.ndarray
     length: np.ndarray
-    end_vertex: np.ndarray  # (interface, 2) the vertex at each end: what the same contact is known by a step later
     overlap: float  # the deepest vertex inside another block [m] (0 when none)
     overlap_at: tuple[int, int]  # (vertex's block, other block) of the deepest, (-1, -1) when none
 
@@ -165,7 +164,6 @@ def find_contacts(polygons: Polygons, skip: np.ndarray, gap: float, overlap: flo
         normal=np.c_[gx, gy][keep],
         tangent=np.c_[gy, -gx][keep],
         length=length[keep],
-        end_vertex=np.c_[vertex[lo], vertex[hi]][keep],
         overlap=deepest,
         overlap_at=where,
     )

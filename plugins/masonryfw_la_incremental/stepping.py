@@ -1,7 +1,7 @@
 """The increments: limit state of the current configuration, blocks moved by its mechanism, contacts again.
 
-Each increment solves la's associative programme on the current configuration
-(:func:`masonryfw_la.limit_state`), moves every block along its mechanism by the exact rigid motion of
+Each increment solves la's programme on the current configuration (:func:`masonryfw_la.limit_state`:
+associative, then by default non-associative with the associative state's normal forces), moves every block along its mechanism by the exact rigid motion of
 a constant twist (:func:`.motion.screw`) and finds the contacts of the moved configuration. The size
 is adaptive: the fastest point of any block moves ``step`` times the median unit height; a step whose
 blocks overlap by more than the contact gap is halved. A step after which the configuration cannot
@@ -55,7 +55,6 @@ class Configuration(NamedTuple):
     t: float
     pose: np.ndarray  # (block, 3) finite displacement of the centroid and rotation
     wall: Wall  # its contacts as la's interfaces
-    keys: np.ndarray  # (interface, 2) what each end is known by (its vertex and the other block)
     state: LimitState
     overlap: float  # the deepest vertex inside another block [m]
 
@@ -91,60 +90,30 @@ def fastest_point(ref: Reference, mechanism: np.ndarray) -> float:
     return float(speed[masonry].max(initial=0.0))
 
 
-def end_keys(ref: Reference, wall: Wall, end_vertex: np.ndarray) -> np.ndarray:
-    """``(interface, 2)``: each end's vertex and the block it touches, as one integer."""
-    owner = ref.owner[end_vertex]
-    other = np.where(owner == wall.sides[:, 0, None], wall.sides[:, 1, None], wall.sides[:, 0, None])
-    return end_vertex * ref.n_block + other
-
-
-def carried_forces(previous: Configuration, keys: np.ndarray) -> np.ndarray:
-    """The normal force each end carried in the previous configuration [N] (0 for a new contact)."""
-    known = previous.keys.ravel()
-    order = np.argsort(known, kind="stable")
-    at = np.clip(np.searchsorted(known[order], keys.ravel()), 0, max(known.size - 1, 0))
-    found = known[order][at] == keys.ravel() if known.size else np.zeros(keys.size, dtype=bool)
-    force = np.where(found, previous.state.normal.ravel()[order][at] if known.size else 0.0, 0.0)
-    return np.maximum(force, 0.0).reshape(keys.shape)
-
-
-def solved(ref: Reference, pose: np.ndarray, controls: Controls, t: float,
-           previous: Configuration | None) -> Configuration:
+def solved(ref: Reference, pose: np.ndarray, controls: Controls, t: float) -> Configuration:
     """The configuration at ``pose``: its contacts and limit state (module docstring).
 
-    Non-associative joints take the shear capacity of the normal forces their ends carried in
-    ``previous``: one LP of la's non-associative sequence per increment. Where those lagging capacities
-    cannot carry the dead load (the load moved onto ends that carried little), the configuration gets
-    the capacities of its own associative state, as la's sequence starts; where the associative state
-    cannot carry it either, the configuration falls whatever the joints' dilatancy (a mechanism that
-    opens as it slides does no work against friction), and :class:`DeadLoadNotCarried` is raised.
+    Non-associative joints (the default) take the shear capacity of the normal forces of the configuration's
+    own associative state: the first two LPs of la's non-associative sequence. :class:`DeadLoadNotCarried`
+    when the configuration cannot carry its dead load.
     """
     wall, contacts = wall_at(ref, pose)
-    keys = end_keys(ref, wall, contacts.end_vertex)
-    if controls.flow == "associative":
-        state = limit_state(wall, ref.scales, controls.solver, controls.tolerance)
-    else:
-        try:
-            if previous is None:
-                raise DeadLoadNotCarried("no forces to start from")
-            state = limit_state(wall, ref.scales, controls.solver, controls.tolerance, carried_forces(previous, keys))
-        except DeadLoadNotCarried:
-            start = limit_state(wall, ref.scales, controls.solver, controls.tolerance)
-            state = limit_state(wall, ref.scales, controls.solver, controls.tolerance, start.normal)
-    return Configuration(t, pose, wall, keys, state, contacts.overlap)
+    state = limit_state(wall, ref.scales, controls.solver, controls.tolerance)
+    if controls.flow == "nonassociative":
+        state = limit_state(wall, ref.scales, controls.solver, controls.tolerance, state.normal)
+    return Configuration(t, pose, wall, state, contacts.overlap)
 
 
 def first_configuration(ref: Reference, controls: Controls) -> Configuration:
     pose = np.zeros((ref.n_block, 3))
     try:
-        return solved(ref, pose, controls, 0.0, None)
+        return solved(ref, pose, controls, 0.0)
     except DeadLoadNotCarried as error:
         raise mf.SolveError(f"la-incremental: the wall does not stand under its dead load before it moves ({error})") \
             from error
 
 
-def fall(ref: Reference, controls: Controls, pose: np.ndarray, t: float,
-         previous: Configuration) -> Configuration | Outcome:
+def fall(ref: Reference, controls: Controls, pose: np.ndarray, t: float) -> Configuration | Outcome:
     """Let the part that cannot stand at ``pose`` fall, the supports held, until it lands (a configuration
     that stands: a block dropping onto the one that settled beneath it). When it has not landed after its
     fastest point fell :data:`LANDING_DISTANCE` unit heights, or cannot move along its fall without
@@ -171,7 +140,7 @@ def fall(ref: Reference, controls: Controls, pose: np.ndarray, t: float,
         pose, travelled = moved, travelled + shrink * controls.step
         shrink = min(1.0, 1.5 * shrink)
         try:
-            return solved(ref, pose, controls, t, previous)
+            return solved(ref, pose, controls, t)
         except DeadLoadNotCarried:
             continue
     return Outcome(True, t, "the moved configuration cannot carry its dead load", False)
@@ -200,7 +169,7 @@ def run(ref: Reference, controls: Controls, record, progress) -> Outcome:
                 return Outcome(False, None, "no block moves: the mechanism is the supports' motion alone", False)
             resolution = COLLAPSE_RESOLUTION * controls.step / speed
             if failing is not None and failing[0] - current.t <= resolution:
-                landed = fall(ref, controls, failing[1], failing[0], current)
+                landed = fall(ref, controls, failing[1], failing[0])
                 if isinstance(landed, Outcome):
                     return landed._replace(capacity=current.t) if landed.collapsed else landed
                 current, failing = landed, None
@@ -211,7 +180,7 @@ def run(ref: Reference, controls: Controls, record, progress) -> Outcome:
                 dt = min(dt, 0.5 * (failing[0] - current.t))
             pose = pose_at(ref, current.pose, current.state.motion, dt, current.t + dt)
             try:
-                trial = solved(ref, pose, controls, current.t + dt, current)
+                trial = solved(ref, pose, controls, current.t + dt)
             except DeadLoadNotCarried:
                 failing = (current.t + dt, pose)  # from this configuration: a fall once it is this close
                 shrink *= 0.5
