@@ -16,8 +16,8 @@ and loads are made; the parametric builder, the import of drawings and
   upward dead load ``W L_m / L_total`` and the same live load downward. Tilt
   loading: the weight acts horizontally as live load on every unit and lintel,
   and every support is held;
-- a moving support translates vertically (``block_fixed`` 1 0 1, direction
-  0 -1 0), rotates about a pivot (free, the small rotation that moves its
+- a moving support translates (vertically by default: ``block_fixed`` 1 0 1, direction
+  0 -1 0; along any ``direction``, its live load along it too: a springing moving out), rotates about a pivot (free, the small rotation that moves its
   centroid down by 1), either scaled by its ``rate``, or
   is a segment of a continuous ground (free: its top edge follows the ground's
   motion given at the edge's two ends, :func:`ground_direction`): all moving
@@ -70,6 +70,7 @@ class Support:
     pivot: tuple[float, float] | None = None
     rate: float = 1.0
     ground: GroundEdge | None = None
+    direction: tuple[float, float] = (0.0, -1.0)  # of a translation, a unit vector
 
 
 def rotation_direction(centre, pivot) -> np.ndarray:
@@ -111,8 +112,9 @@ def support_kinematics(supports, centres, loading: str):
             fixed[i] = 0
             direction[i] = ground_direction(support.ground, centres[i])
         else:
-            fixed[i] = (1, 0, 1)
-            direction[i] = (0.0, -support.rate, 0.0)
+            dx, dy = support.direction
+            fixed[i] = (dx == 0, dy == 0, 1)
+            direction[i] = (support.rate * dx, support.rate * dy, 0.0)
     return fixed, direction, roles
 
 
@@ -134,6 +136,12 @@ def support_contact(blocks, length, support_index: np.ndarray, n_support: int) -
     local = support_index[blocks]
     on = local >= 0
     return np.bincount(local[on], weights=np.broadcast_to(length[:, None], blocks.shape)[on], minlength=n_support)
+
+
+def live_direction(support: Support) -> tuple[float, float]:
+    """The unit direction of a moving support's live load: along its translation (down by default); a turning
+    support and a ground segment settle, their live load points down."""
+    return support.direction if support.motion == "translation" else (0.0, -1.0)
 
 
 def support_reactions(supports, contact: np.ndarray, weight_total: float, loading: str) -> np.ndarray:
@@ -206,7 +214,7 @@ def model_from_blocks(
     live = np.zeros((n_block, 3))
     dead[:, 1] = -weight
     dead[supported, 1] = reaction
-    live[supported, 1] = -reaction
+    live[supported, :2] = reaction[:, None] * np.array([live_direction(s) for s in supports]).reshape(-1, 2)
     if loading == "tilt":
         live[~is_support, 0] = tilt_direction * weight[~is_support]
     fixed = np.zeros((n_block, 3), dtype=np.int8)
@@ -269,7 +277,7 @@ def with_supports(model: xr.Dataset, supports) -> xr.Dataset:
     reaction = support_reactions(supports, contact, -dead[masonry, 1].sum(), "settlement")
     live = np.zeros_like(dead)
     dead[supported, 1] = reaction
-    live[supported, 1] = -reaction
+    live[supported, :2] = reaction[:, None] * np.array([live_direction(s) for s in supports]).reshape(-1, 2)
     fixed = model.block_fixed.values.copy()
     fixed[supported] = s_fixed
     direction = np.zeros((role.size, 3))

@@ -265,6 +265,10 @@ def solve(model: str, solver: str, output: str | None, options: dict[str, str], 
         click.echo(f"stages {stages}")
 
 
+#: A solver option that ends a run at its reaction plateau, before the damage the capacity asks for.
+PLATEAU_STOP = "plateau_tolerance"
+
+
 @cli.command()
 @click.argument("model")
 @click.option("--plugin", "solver", default="fdem", show_default=True,
@@ -284,6 +288,7 @@ def capacity(model: str, solver: str, category: int | None, settlement: float | 
     the LTSM's (stage 2) and the greenfield screen's (stage 1) over the model's settlement profile. A
     tunnel's S_max is proportional to its volume loss and the trough keeps its shape, so one run to a larger
     settlement answers every smaller volume loss. The result file keeps them (``category_settlement``, ...).
+    A solver that stops at a reaction plateau (fdem) runs to the end.
     """
     if settlement is not None and volume_loss is not None:
         raise mf.InputError("give --settlement or --volume-loss, not both")
@@ -296,6 +301,8 @@ def capacity(model: str, solver: str, category: int | None, settlement: float | 
         if not settlement > 0:
             raise mf.InputError(f"--settlement {settlement:g}: the run's settlement must be positive")
         options = {**options, "settlement": repr(settlement)}
+    if any(o.name == PLATEAU_STOP for o in mf.get_solver(solver).options) and PLATEAU_STOP not in options:
+        options = {**options, PLATEAU_STOP: "0"}  # the categories past a reaction plateau are what is asked
     result, out, _ = _solved(model, solver, output, options, progress, force)
     text = mf.capacity_text(result, category)
     if not text:

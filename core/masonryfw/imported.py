@@ -79,6 +79,7 @@ class DrawnSupport:
     motion: str
     pivot: tuple[float, float] | None
     rate: float
+    direction: tuple[float, float]
     table: SpecTable
 
 
@@ -191,8 +192,8 @@ def _drawn_supports(top: SpecTable, layers: dict[str, str]) -> tuple[DrawnSuppor
                                 f"{what!r} cannot be both a support and {layers[what]!r}")
         else:
             what = entry.point("at")
-        motion, pivot, rate = read_motion(entry, kind)
-        supports.append(DrawnSupport(name, kind, how, what, motion, pivot, rate, entry))
+        motion, pivot, rate, direction = read_motion(entry, kind)
+        supports.append(DrawnSupport(name, kind, how, what, motion, pivot, rate, direction, entry))
     return tuple(supports)
 
 
@@ -280,7 +281,8 @@ def _drawn_supports_model(spec: DrawnSpec, drawing: Drawing, kept: np.ndarray, p
     order = np.concatenate((masonry, support_order))
     roles = np.array(_masonry_roles(spec, drawing, masonry) + [ROLE["fixed_support"]] * support_order.size,
                      dtype=np.int8)
-    described = [blocks.Support(f"spec key 'supports.{s.name}'", s.kind, s.motion, s.pivot, s.rate)
+    described = [blocks.Support(f"spec key 'supports.{s.name}'", s.kind, s.motion, s.pivot, s.rate,
+                                direction=s.direction)
                  for s, members in zip(spec.supports, chosen) for _ in members]
     node_x, node_y, counts = _reordered(drawing, order)
     _check_pivots(spec, chosen, drawing)

@@ -172,24 +172,46 @@ def read_loading(top: SpecTable, any_moving: bool) -> tuple[str, int]:
     return kind, 0
 
 
-def read_motion(entry: SpecTable, kind: str) -> tuple[str, tuple[float, float] | None, float]:
-    """``(motion, pivot, rate)`` of a support table: ``none`` for a fixed support.
+#: A translating support's direction unless its table gives one: straight down.
+DOWN = (0.0, -1.0)
+
+
+def read_motion(entry: SpecTable, kind: str) -> tuple[str, tuple[float, float] | None, float, tuple[float, float]]:
+    """``(motion, pivot, rate, direction)`` of a support table: ``none`` for a fixed support.
 
     ``rate`` (default 1) scales the support's motion per unit of the settlement
-    parameter: a support at rate 0.5 settles half as fast as one at rate 1.
+    parameter: a support at rate 0.5 settles half as fast as one at rate 1. A
+    translating support moves along ``direction = [dx, dy]`` (default ``[0, -1]``,
+    down; ``[1, 0]``: an arch's right springing moving out), taken as a unit vector.
     """
     if kind != "moving":
-        for bad in ("motion", "pivot", "rate"):
+        for bad in ("motion", "pivot", "rate", "direction"):
             if entry.has(bad):
                 raise SpecError(f"spec key {entry.key(bad)!r} only applies to kind = 'moving'")
-        return "none", None, 0.0
+        return "none", None, 0.0, DOWN
     motion = entry.choice("motion", ("translation", "rotation"), "translation")
     rate = entry.number("rate", 1.0, positive=True)
     if motion == "rotation":
-        return motion, entry.point("pivot"), rate
+        if entry.has("direction"):
+            raise SpecError(f"spec key {entry.key('direction')!r} only applies to motion = 'translation'")
+        return motion, entry.point("pivot"), rate, DOWN
     if entry.has("pivot"):
         raise SpecError(f"spec key {entry.key('pivot')!r} only applies to motion = 'rotation'")
-    return motion, None, rate
+    return motion, None, rate, read_direction(entry)
+
+
+def read_direction(entry: SpecTable) -> tuple[float, float]:
+    """A translating support's unit direction of motion (default down)."""
+    if not entry.has("direction"):
+        return DOWN
+    value = entry.raw("direction")
+    if (not isinstance(value, list) or len(value) != 2
+            or any(isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v) for v in value)
+            or math.hypot(*value) == 0):
+        raise SpecError(f"spec key {entry.key('direction')!r} = {value!r}: must be a non-zero pair [dx, dy] "
+                        "(the direction the support moves in; [0, -1] down, [1, 0] to the right)")
+    length = math.hypot(*value)
+    return float(value[0]) / length, float(value[1]) / length
 
 
 def check_pivot(entry: SpecTable, pivot: tuple[float, float] | None, centre_x: float, tol: float) -> None:

@@ -15,7 +15,7 @@ from .spec import SpecTable, check_pivot, read_motion
 
 #: Position tolerance, relative to the wall size.
 POSITION_TOLERANCE = 1.0e-9
-_SUPPORT_KEYS = ("kind", "start", "end", "motion", "pivot", "rate")
+_SUPPORT_KEYS = ("kind", "start", "end", "motion", "pivot", "rate", "direction")
 
 
 @dataclass(frozen=True)
@@ -30,6 +30,7 @@ class Support:
     pivot: tuple[float, float] | None
     rate: float = 1.0
     ground: blocks.GroundEdge | None = None
+    direction: tuple[float, float] = (0.0, -1.0)
 
 
 def read_supports(top: SpecTable, x0: float, x1: float) -> tuple[Support, ...]:
@@ -52,9 +53,9 @@ def read_supports(top: SpecTable, x0: float, x1: float) -> tuple[Support, ...]:
             raise SpecError(f"spec key {entry.key('end')!r} = {entry.raw('end')!r}: beyond the wall's right end")
         if end <= start + tol:
             raise SpecError(f"spec key {entry.key('end')!r} = {entry.raw('end')!r}: must exceed start")
-        motion, pivot, rate = read_motion(entry, kind)
+        motion, pivot, rate, direction = read_motion(entry, kind)
         check_pivot(entry, pivot, 0.5 * (start + end), tol)
-        supports.append(Support(name, kind, max(start, x0), min(end, x1), motion, pivot, rate))
+        supports.append(Support(name, kind, max(start, x0), min(end, x1), motion, pivot, rate, direction=direction))
     ordered = sorted(supports, key=lambda s: s.start)
     for left, right in zip(ordered, ordered[1:]):
         if right.start < left.end - tol:
@@ -85,5 +86,6 @@ def support_blocks(supports: tuple[Support, ...], y0: float, height: float):
     descriptions for :func:`masonryfw.blocks.model_from_blocks`."""
     x0 = np.array([s.start for s in supports], dtype=float)
     x1 = np.array([s.end for s in supports], dtype=float)
-    described = [blocks.Support(support_label(s.name), s.kind, s.motion, s.pivot, s.rate, s.ground) for s in supports]
+    described = [blocks.Support(support_label(s.name), s.kind, s.motion, s.pivot, s.rate, s.ground, s.direction)
+                 for s in supports]
     return x0, x1, np.full(x0.size, y0 - height), np.full(x0.size, y0), described

@@ -1,6 +1,6 @@
 """A kit for solver authors (and the project's own tests): small models, and a conformance suite.
 
-Small models from rectangles::
+Small models from rectangles (and a semicircular arch, :func:`arch_model`)::
 
     import masonryfw.testing as mt
 
@@ -72,7 +72,8 @@ def rectangles_model(
 
     Roles are the format's (``unit``, ``lintel``, ``fixed_support``,
     ``moving_support``, names or flags). Moving supports translate straight down
-    unless ``motions`` maps their block index to ``("rotation", pivot)``.
+    unless ``motions`` maps their block index to ``("rotation", pivot)`` or ``("translation", (dx, dy))``
+    (along that direction: a springing moving out).
     ``loading``: ``settlement`` (the paper's) or ``tilt`` (horizontal live load =
     weight, supports held). ``length_unit`` scales the coordinates and thickness
     (1e3: the same wall in mm, with unit weight, cohesion, tensile strength and
@@ -88,8 +89,12 @@ def rectangles_model(
         if role[b] == ROLE["fixed_support"]:
             supports.append(blocks.Support(f"support block {b}"))
         else:
-            motion, pivot = motions.get(int(b), ("translation", None))
-            pivot = None if pivot is None else (pivot[0] * length_unit, pivot[1] * length_unit)
+            motion, point = motions.get(int(b), ("translation", None))
+            if motion == "translation":  # the point, if given, is the direction it moves in
+                direction = (0.0, -1.0) if point is None else tuple(np.asarray(point, float) / np.hypot(*point))
+                supports.append(blocks.Support(f"support block {b}", "moving", motion, direction=direction))
+                continue
+            pivot = None if point is None else (point[0] * length_unit, point[1] * length_unit)
             supports.append(blocks.Support(f"support block {b}", "moving", motion, pivot))
     material = Material(unit_weight / length_unit**3, friction, cohesion / length_unit**2,
                                tensile_strength / length_unit**2,
@@ -112,6 +117,31 @@ def small_settlement_wall(length_unit: float = 1.0) -> xr.Dataset:
     roles += ["fixed_support", "moving_support"]
     return rectangles_model(rects, roles, young_modulus=1.2e9, poisson_ratio=0.2, length_unit=length_unit,
                             title="conformance wall")
+
+
+def arch_model(thickness_ratio: float, voussoirs: int = 40, radius: float = 1.0, friction: float = 0.8,
+               spreading: bool = True) -> xr.Dataset:
+    """A semicircular arch of ``voussoirs`` equal voussoirs, mean radius ``radius`` and thickness
+    ``thickness_ratio * radius`` (0.1 m deep, 20 kN/m3), on two springings: the left one fixed, the right
+    one moving out to the right (``spreading``) or down. A semicircular arch stands under its own weight
+    only from ``thickness_ratio`` = 0.1075 on (Milankovitch 1907; Heyman 1969: 0.106)."""
+    inner, outer = radius * (1 - thickness_ratio / 2), radius * (1 + thickness_ratio / 2)
+    angles = np.linspace(np.pi, 0.0, voussoirs + 1)
+    a0, a1 = angles[1:, None], angles[:-1, None]  # a0 < a1, left to right
+    xs = np.hstack([outer * np.cos(a0), outer * np.cos(a1), inner * np.cos(a1), inner * np.cos(a0)])
+    ys = np.hstack([outer * np.sin(a0), outer * np.sin(a1), inner * np.sin(a1), inner * np.sin(a0)])
+    depth, overhang = 0.2 * radius, 0.05 * radius
+    for x0, x1 in ((-outer - overhang, -inner + overhang), (inner - overhang, outer + overhang)):
+        xs = np.vstack([xs, [x0, x1, x1, x0]])
+        ys = np.vstack([ys, [-depth, -depth, 0.0, 0.0]])
+    role = np.array([ROLE["voussoir"]] * voussoirs + [ROLE["fixed_support"], ROLE["moving_support"]], np.int8)
+    supports = [blocks.Support("left springing"),
+                blocks.Support("right springing", "moving", "translation",
+                               direction=(1.0, 0.0) if spreading else (0.0, -1.0))]
+    ds = blocks.model_from_blocks(xs.ravel(), ys.ravel(), np.full(voussoirs + 2, 4), role, 0.1,
+                                  Material(20e3, friction), supports, "settlement",
+                                  attrs={"title": f"semicircular arch, t/R = {thickness_ratio:g}"})
+    return checked_model(ds, "arch")
 
 
 def permuted(model: xr.Dataset, block_order: np.ndarray, interface_order: np.ndarray) -> xr.Dataset:

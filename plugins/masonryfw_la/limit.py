@@ -54,6 +54,8 @@ def limit_state(wall: assembly.Wall, scales: assembly.Scales, solver: str = "ipm
     given = None if normal_force is None else np.ravel(normal_force) / scales.force
     lp = assembly.assemble(wall, scales, assembly.interface_kinematics(wall, scales), normal_force=given)
     check_live_load(lp)
+    if lp.constraints.shape[0] == 0 and np.any(lp.cost != 0):  # no contact holds a block its weight moves
+        raise backends.DeadLoadNotCarried(backends.DEAD_LOAD_MESSAGE)
     sol = backends.solve_lp(solver, lp.cost, lp.constraints, lp.live, tolerance)
     return state_of(wall, lp, sol, scales)
 
@@ -76,6 +78,9 @@ def falling_motion(wall: assembly.Wall, scales: assembly.Scales) -> np.ndarray:
     """
     from scipy.optimize import linprog  # slow to import: only a configuration that falls needs it
 
+    if wall.n_interface == 0:  # nothing touches anything: every free block falls along its dead load
+        free = ~(wall.support | wall.fixed.all(axis=1))
+        return np.where(free[:, None], np.c_[wall.dead[:, :2], np.zeros(wall.n_block)], 0.0)
     lp = assembly.assemble(wall, scales, assembly.interface_kinematics(wall, scales))
     n = lp.cost.size
     bounds = np.full((n, 2), [-1.0, 1.0])

@@ -21,6 +21,10 @@ from masonryfw_la import Scales, Wall, wall_scales
 from . import motion
 from .contacts import Contacts, Polygons, find_contacts
 
+#: A vertex this many gaps inside a face still touches it (steps may leave it at most one gap deeper than before:
+#: one that slipped past a gap must be held, not freed, by the next programme).
+DEPTH_IN_CONTACT = 5.0
+
 
 @dataclass(frozen=True)
 class Reference:
@@ -83,11 +87,9 @@ def reference(model: xr.Dataset, gap_share: float) -> Reference:
     block_friction[~np.isfinite(block_friction)] = float(np.median(wall.friction)) if wall.friction.size else 0.0
     ground = mfp.support_blocks(wall.role)
     gap = gap_share * unit_height
-    polygons = Polygons.of(x, y, counts)
-    every = find_contacts(polygons, ground, gap, gap, cornered=np.zeros(0, dtype=np.int64))
-    faces = find_contacts(polygons, ground, gap, gap)
-    every_keys = every.sides[:, 0] * counts.size + every.sides[:, 1]
-    cornered = np.setdiff1d(every_keys, faces.sides[:, 0] * counts.size + faces.sides[:, 1])
+    at_rest = find_contacts(Polygons.of(x, y, counts), ground, gap, gap)
+    points = at_rest.length <= 2 * gap  # in the model's configuration every contact is a face but a corner on a corner
+    cornered = np.unique(at_rest.sides[points].min(axis=1) * counts.size + at_rest.sides[points].max(axis=1))
     return Reference(wall, wall_scales(model, wall), x, y, counts, owner, ground, radius, unit_height, keys[order],
                      wall.friction[order], block_friction, gap, cornered)
 
@@ -116,7 +118,7 @@ def wall_at(ref: Reference, pose: np.ndarray) -> tuple[Wall, Contacts]:
     """The wall with every block at ``pose`` ``(block, 3)`` and its contacts found again."""
     x, y = motion.vertices(pose, ref.centroid, ref.node_x, ref.node_y, ref.owner)
     contacts = find_contacts(Polygons(x, y, ref.counts, np.r_[0, np.cumsum(ref.counts)], ref.owner), ref.ground,
-                             ref.gap, ref.gap, still_cornered(ref, pose))
+                             ref.gap, DEPTH_IN_CONTACT * ref.gap, still_cornered(ref, pose))
     n = contacts.sides.shape[0]
     direction = np.where(ref.wall.moving[:, None], motion.current_twist(ref.wall.direction, pose), 0.0)
     wall = dataclasses.replace(

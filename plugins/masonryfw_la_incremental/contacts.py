@@ -1,25 +1,22 @@
-"""Contacts of a moved configuration: where a vertex of one block touches an edge of another.
+"""Contacts of a moved configuration: one interface per pair of blocks that touch, by separating axes.
 
-Every vertex that lies within ``gap`` outside an edge of another block and at most ``overlap``
-inside it, between the edge's ends, touches that edge, provided both of its own edges leave it
-outwards (the block's interior is on the far side of the edge: this rejects the other edge through a
-shared corner). A touching vertex is a point contact whose normal is the edge's, pointing into the
-vertex's block. The point contacts of one pair of blocks along one normal are one interface whose two
-ends are the extreme points along the tangent: two flush faces give the ends of their overlap, as the
-model's interfaces; a corner on a face gives an interface with its two ends at the corner (a hinge); a
-corner on a corner gives the faces of both corners (the corner may go into neither: blocks coming to
-rest corner to corner hold each other), but none between blocks that met corner to corner in the model
-and have not moved apart since (four units at a cross joint: la has no interface there either).
-Joints that open by more than ``gap`` have no contact; blocks that come to touch get one.
+Two convex blocks touch when no edge of either separates them by more than ``gap``: the edge that
+separates them most (or overlaps them least) is the reference face, its outward normal the contact
+normal (from its block, side 0, into the other, side 1). The other block's edge that faces it most
+squarely is the incident edge; the part of it that lies over the reference face (between the face's
+ends) and within ``gap`` of it is the contact, whose two ends are the interface's. Two
+flush faces give the ends of their overlap, as the model's interfaces; a corner on a face gives an
+interface whose ends are where the incident edge comes within ``gap`` of the face, a short hinge.
+Joints that open by more than ``gap`` have no contact; blocks that come to touch get one; blocks
+that went into each other (by at most ``overlap``) touch on the face they overlap least across.
+A corner on a corner (four units at a cross joint) gives no interface between blocks that met that
+way in the model and have not moved apart since (``cornered``): la has none there either.
 """
 from __future__ import annotations
 
 from dataclasses import dataclass
 
 import numpy as np
-
-#: Normals within this angle [rad] are one face; a vertex's edges may dip this much into the other block.
-ANGLE_TOLERANCE = 1e-2
 
 
 @dataclass(frozen=True)
@@ -79,48 +76,29 @@ def candidate_pairs(polygons: Polygons, pad: float, skip: np.ndarray) -> np.ndar
     return pairs
 
 
-def touching_vertices(polygons: Polygons, pairs: np.ndarray, gap: float, overlap: float):
-    """Every (vertex, edge of the other block) of the pairs, both ways: the touching ones and the deepest overlap."""
-    vert_block = np.concatenate([pairs[:, 0], pairs[:, 1]])
-    edge_block = np.concatenate([pairs[:, 1], pairs[:, 0]])
-    n_edge = polygons.counts[edge_block]
-    combos = polygons.counts[vert_block] * n_edge
-    which = np.repeat(np.arange(vert_block.size), combos)
+def separations(polygons: Polygons, pairs: np.ndarray):
+    """Every edge of both blocks of every pair: its block, its first node, its outward normal and how far the
+    other block lies beyond it (the least of its vertices' signed distances)."""
+    n_pair = pairs.shape[0]
+    edge_block = np.concatenate([pairs[:, 0], pairs[:, 1]])
+    vert_block = np.concatenate([pairs[:, 1], pairs[:, 0]])
+    which = np.tile(np.arange(n_pair), 2)
+    n_vert = polygons.counts[vert_block]
+    combos = polygons.counts[edge_block] * n_vert
+    owner = np.repeat(np.arange(edge_block.size), combos)
     k = np.arange(combos.sum()) - np.repeat(np.cumsum(combos) - combos, combos)
-    vertex = polygons.offsets[vert_block][which] + k // n_edge[which]
-    e0 = polygons.offsets[edge_block][which] + k % n_edge[which]
+    e0 = polygons.offsets[edge_block][owner] + k // n_vert[owner]
+    vertex = polygons.offsets[vert_block][owner] + k % n_vert[owner]
     e1 = polygons.next_node()[e0]
     x, y = polygons.x, polygons.y
-    ex, ey = x[e1] - x[e0], y[e1] - y[e0]
-    length = np.hypot(ex, ey)
-    dx, dy = ex / length, ey / length
-    nx, ny = dy, -dx  # outward normal of a counter-clockwise polygon
-    px, py = x[vertex] - x[e0], y[vertex] - y[e0]
-    g = px * nx + py * ny
-    s = px * dx + py * dy
-    # the deepest overlap: a vertex inside a convex block is behind all its edges (each group is one vertex's)
-    group_start = np.flatnonzero(np.r_[True, (vertex[1:] != vertex[:-1]) | (which[1:] != which[:-1])])
-    nearest_face = np.maximum.reduceat(g, group_start) if g.size else g
-    inside = nearest_face < 0
-    deepest = float(-nearest_face[inside].min()) if inside.any() else 0.0
-    where = (-1, -1)
-    if inside.any():
-        g_idx = group_start[inside][np.argmin(nearest_face[inside])]
-        where = (int(vert_block[which[g_idx]]), int(edge_block[which[g_idx]]))
-    touch = (g <= gap) & (g >= -overlap) & (s >= -gap) & (s <= length + gap)
-    touch &= leaves_outwards(polygons, vertex, nx, ny)
-    at_corner = (s[touch] <= gap) | (s[touch] >= length[touch] - gap)
-    return (vertex[touch], vert_block[which[touch]], edge_block[which[touch]], nx[touch], ny[touch], at_corner,
-            deepest, where)
-
-
-def leaves_outwards(polygons: Polygons, vertex: np.ndarray, nx: np.ndarray, ny: np.ndarray) -> np.ndarray:
-    """Both edges of the vertex's own polygon point away from the face (normal ``n``) or along it."""
-    ok = np.ones(vertex.size, dtype=bool)
-    for other in (polygons.next_node()[vertex], polygons.previous_node()[vertex]):
-        ux, uy = polygons.x[other] - polygons.x[vertex], polygons.y[other] - polygons.y[vertex]
-        ok &= (ux * nx + uy * ny) >= -ANGLE_TOLERANCE * np.hypot(ux, uy)
-    return ok
+    length = np.hypot(x[e1] - x[e0], y[e1] - y[e0])
+    nx, ny = (y[e1] - y[e0]) / length, -(x[e1] - x[e0]) / length  # outward: counter-clockwise polygons
+    g = (x[vertex] - x[e0]) * nx + (y[vertex] - y[e0]) * ny
+    starts = np.flatnonzero(np.r_[True, e0[1:] != e0[:-1]] | np.r_[True, owner[1:] != owner[:-1]])
+    separation = np.minimum.reduceat(g, starts) if g.size else g
+    edge = e0[starts]
+    side = owner[starts]
+    return which[side], edge_block[side], vert_block[side], edge, nx[starts], ny[starts], separation
 
 
 def find_contacts(polygons: Polygons, skip: np.ndarray, gap: float, overlap: float,
@@ -129,49 +107,75 @@ def find_contacts(polygons: Polygons, skip: np.ndarray, gap: float, overlap: flo
     count (the supports: ground against ground); ``cornered``: sorted pair keys ``a * n + b`` whose corner-on-
     corner contacts do not count (all when None)."""
     pairs = candidate_pairs(polygons, gap, skip)
-    vertex, v_block, e_block, nx, ny, at_corner, deepest, where = touching_vertices(polygons, pairs, gap, overlap)
-    # side 0 the lower block index: the normal from side 0 into side 1
-    flip = e_block > v_block
-    side0, side1 = np.where(flip, v_block, e_block), np.where(flip, e_block, v_block)
-    sign = np.where(flip, -1.0, 1.0)
-    nx, ny = nx * sign, ny * sign
-    angle = np.arctan2(ny, nx)
-    order = np.lexsort((angle, side1, side0))
-    side0, side1, angle, nx, ny, vertex, at_corner = (a[order] for a in (side0, side1, angle, nx, ny, vertex,
-                                                                         at_corner))
-    new = np.r_[True, (side0[1:] != side0[:-1]) | (side1[1:] != side1[:-1]) | (np.diff(angle) > ANGLE_TOLERANCE)]
-    group = np.cumsum(new) - 1
-    n_group = int(group[-1]) + 1 if group.size else 0
-    gx = np.bincount(group, nx, n_group)
-    gy = np.bincount(group, ny, n_group)
-    norm = np.hypot(gx, gy)
-    gx, gy = gx / norm, gy / norm
-    px, py = polygons.x[vertex], polygons.y[vertex]
-    along = px * gy[group] - py * gx[group]  # tangent t = (n_y, -n_x)
-    lo, hi = extremes(group, along, n_group)
-    end_x, end_y = np.c_[px[lo], px[hi]], np.c_[py[lo], py[hi]]
-    starts = np.flatnonzero(new)
-    length = np.hypot(end_x[:, 1] - end_x[:, 0], end_y[:, 1] - end_y[:, 0])
-    # a corner on a corner has no face: no contact (once it slips onto a face, that face holds it)
-    keep = (length > gap) | (np.bincount(group, ~at_corner, n_group) > 0)
+    pair, ref_block, inc_block, edge, nx, ny, separation = separations(polygons, pairs)
+    # per pair, the edge that separates most (ties: the first)
+    best = np.full(pairs.shape[0], -np.inf)
+    np.maximum.at(best, pair, separation)
+    chosen = np.flatnonzero(separation == best[pair])
+    chosen = chosen[np.unique(pair[chosen], return_index=True)[1]]
+    chosen = chosen[(separation[chosen] <= gap) & (separation[chosen] >= -overlap)]
+    deepest = float(-best[best < 0].min()) if np.any(best < 0) else 0.0
+    where = (-1, -1)
+    if np.any(best < 0):
+        at = np.flatnonzero(separation == -deepest)[0]
+        where = (int(inc_block[at]), int(ref_block[at]))
+    pair, ref_block, inc_block, edge, nx, ny = (v[chosen] for v in (pair, ref_block, inc_block, edge, nx, ny))
+    i0, i1 = incident_edges(polygons, inc_block, nx, ny)
+    x, y = polygons.x, polygons.y
+    e1 = polygons.next_node()[edge]
+    length = np.hypot(x[e1] - x[edge], y[e1] - y[edge])
+    tx, ty = -ny, nx  # along the reference edge, from its first node
+    s0 = (x[i0] - x[edge]) * tx + (y[i0] - y[edge]) * ty
+    s1 = (x[i1] - x[edge]) * tx + (y[i1] - y[edge]) * ty
+    g0 = (x[i0] - x[edge]) * nx + (y[i0] - y[edge]) * ny
+    g1 = (x[i1] - x[edge]) * nx + (y[i1] - y[edge]) * ny
+    lo, hi = np.zeros(pair.size), np.ones(pair.size)
+    for a, b, low, high in ((s0, s1, 0.0, length), (g0, g1, -np.inf, gap)):
+        lo, hi = clipped(a, b, low, high, lo, hi)
+    touching = lo <= hi
     if cornered is not None:
-        key = side0[starts] * polygons.counts.size + side1[starts]
-        keep |= ~np.isin(key, cornered)
+        key = np.minimum(ref_block, inc_block) * polygons.counts.size + np.maximum(ref_block, inc_block)
+        span = np.abs(hi - lo) * np.hypot(x[i1] - x[i0], y[i1] - y[i0])
+        touching &= ~(np.isin(key, cornered) & (span <= 2 * gap))
+    lo, hi = lo[touching], hi[touching]
+    i0, i1, nx, ny = i0[touching], i1[touching], nx[touching], ny[touching]
+    ends_x = np.c_[x[i0] + lo * (x[i1] - x[i0]), x[i0] + hi * (x[i1] - x[i0])]
+    ends_y = np.c_[y[i0] + lo * (y[i1] - y[i0]), y[i0] + hi * (y[i1] - y[i0])]
+    # the ends projected onto the reference face: the contact points of the face the normal is the face's
     return Contacts(
-        sides=np.c_[side0[starts], side1[starts]][keep],
-        end_x=end_x[keep],
-        end_y=end_y[keep],
-        normal=np.c_[gx, gy][keep],
-        tangent=np.c_[gy, -gx][keep],
-        length=length[keep],
+        sides=np.c_[ref_block[touching], inc_block[touching]],
+        end_x=ends_x,
+        end_y=ends_y,
+        normal=np.c_[nx, ny],
+        tangent=np.c_[ny, -nx],
+        length=np.hypot(ends_x[:, 1] - ends_x[:, 0], ends_y[:, 1] - ends_y[:, 0]),
         overlap=deepest,
         overlap_at=where,
     )
 
 
-def extremes(group: np.ndarray, value: np.ndarray, n_group: int) -> tuple[np.ndarray, np.ndarray]:
-    """The indices of the smallest and the largest ``value`` of every group."""
-    order = np.lexsort((value, group))
-    first = np.searchsorted(group[order], np.arange(n_group), side="left")
-    last = np.searchsorted(group[order], np.arange(n_group), side="right") - 1
-    return order[first], order[last]
+def clipped(a: np.ndarray, b: np.ndarray, low, high, lo: np.ndarray, hi: np.ndarray):
+    """Narrow the parameter intervals ``[lo, hi]`` of segments whose value runs linearly from ``a`` to ``b`` to
+    where it lies within ``[low, high]``."""
+    slope = b - a
+    flat = np.abs(slope) < 1e-300
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t_low, t_high = (low - a) / slope, (high - a) / slope
+    enter = np.where(flat, np.where((a >= low) & (a <= high), -np.inf, np.inf), np.minimum(t_low, t_high))
+    leave = np.where(flat, np.where((a >= low) & (a <= high), np.inf, -np.inf), np.maximum(t_low, t_high))
+    return np.maximum(lo, enter), np.minimum(hi, leave)
+
+
+def incident_edges(polygons: Polygons, block: np.ndarray, nx: np.ndarray, ny: np.ndarray):
+    """The first and second node of each block's edge that faces the normal ``n`` most squarely (its outward
+    normal most opposed to ``n``)."""
+    counts = polygons.counts[block]
+    owner = np.repeat(np.arange(block.size), counts)
+    node = polygons.offsets[block][owner] + np.arange(counts.sum()) - np.repeat(np.cumsum(counts) - counts, counts)
+    nxt = polygons.next_node()[node]
+    ex, ey = polygons.x[nxt] - polygons.x[node], polygons.y[nxt] - polygons.y[node]
+    facing = (ey * nx[owner] - ex * ny[owner]) / np.hypot(ex, ey)  # outward normal . n
+    order = np.lexsort((facing, owner))
+    first = np.searchsorted(owner[order], np.arange(block.size))
+    pick = node[order][first]
+    return pick, polygons.next_node()[pick]

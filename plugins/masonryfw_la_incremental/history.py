@@ -63,11 +63,12 @@ class History:
     def __call__(self, configuration: Configuration) -> None:
         cracks = mf.widest_crack(self.model, configuration.pose, "finite")
         state = configuration.state
-        at_rest = not self.rows and state.reaction is not None
-        if at_rest:  # the settlement record before the ground moves: R0, the key numbers' dead reaction
+        at_rest = not self.rows and state.reaction is not None and mf.dead_reaction(self.model) > 0
+        if not self.rows and state.reaction is not None:
             self.first_reaction = state.reaction
         self.rows.append({
             "t": configuration.t,
+            # at rest: R0, the key numbers' dead reaction (none for a support moving sideways: R0 = 0 there)
             "reaction": mf.dead_reaction(self.model) if at_rest else np.nan if state.reaction is None
             else state.reaction,
             "alpha": state.alpha,

@@ -4,7 +4,7 @@ Each increment solves la's programme on the current configuration (:func:`masonr
 associative, then by default non-associative with the associative state's normal forces), moves every block along its mechanism by the exact rigid motion of
 a constant twist (:func:`.motion.screw`) and finds the contacts of the moved configuration. The size
 is adaptive: the fastest point of any block moves ``step`` times the median unit height; a step whose
-blocks overlap by more than the contact gap is halved. A step after which the configuration cannot
+blocks overlap by more than the contact gap (or than before it) is halved. A step after which the configuration cannot
 carry its dead load (the programme is unbounded) brackets the collapse: the bracket is halved until
 the fastest point would move less than :data:`COLLAPSE_RESOLUTION` of a step, and the last
 configuration that stands is the capacity. A failure seen from one configuration is forgotten once a
@@ -32,10 +32,11 @@ from .configuration import Reference, wall_at
 COLLAPSE_RESOLUTION = 1e-2
 #: A step is halved at most this many times in a row before the run stops (the LP keeps failing).
 MAX_HALVINGS = 30
-#: A part that falls lands within this many median unit heights (its fastest point's travel), or the wall collapses.
+#: A part that falls lands within this many median unit heights (its fastest point's travel) more than the ground
+#: has moved, or the wall collapses.
 LANDING_DISTANCE = 0.5
-#: The most steps a fall takes (its fastest point moving a step each, shorter where it would go into a block).
-MAX_FALL_STEPS = 100
+#: A fall moves its fastest point this many steps at a time (halved where it would go into a block: it lands).
+FALL_STEPS = 5.0
 
 
 class Controls(NamedTuple):
@@ -83,6 +84,17 @@ def pose_at(ref: Reference, pose: np.ndarray, mechanism: np.ndarray, dt: float, 
     return moved
 
 
+#: A step may deepen an overlap that was already past the gap by this share of the gap (second order: the
+#: contacts hold the first).
+OVERLAP_GROWTH = 0.1
+
+
+def allowed_overlap(ref: Reference, before: float) -> float:
+    """How deep a step may leave a vertex in another block: the gap, or a little more than what a step too
+    short to split had already left (a step is judged by what it adds)."""
+    return ref.gap if before <= ref.gap else before + OVERLAP_GROWTH * ref.gap
+
+
 def fastest_point(ref: Reference, mechanism: np.ndarray) -> float:
     """The largest velocity of any point of a moving masonry block per unit of the parameter."""
     masonry = ~ref.ground
@@ -116,38 +128,52 @@ def first_configuration(ref: Reference, controls: Controls) -> Configuration:
 def fall(ref: Reference, controls: Controls, pose: np.ndarray, t: float) -> Configuration | Outcome:
     """Let the part that cannot stand at ``pose`` fall, the supports held, until it lands (a configuration
     that stands: a block dropping onto the one that settled beneath it). When it has not landed after its
-    fastest point fell :data:`LANDING_DISTANCE` unit heights, or cannot move along its fall without
+    fastest point fell :data:`LANDING_DISTANCE` unit heights further than the ground has moved (a block can drop
+    into the gap a settlement opened under it, not through the ground), or cannot move along its fall without
     going into another block, the run ends: the wall collapses in the first case; in the second a contact
     the programme does not see (a corner on a corner) holds the part, and no capacity is claimed."""
     travelled, shrink = 0.0, 1.0
-    for _ in range(MAX_FALL_STEPS):
-        wall, _ = wall_at(ref, pose)
+    reach = LANDING_DISTANCE * ref.unit_height + ground_motion(ref, t)
+    stride = FALL_STEPS * controls.step
+    blocks = np.zeros(0, dtype=np.int64)
+    for _ in range(int(4 * reach / stride) + 50):  # room for the halvings where it touches down
+        wall, contacts = wall_at(ref, pose)
         falling = falling_motion(wall, ref.scales)
         speed = fastest_point(ref, falling)
         if speed <= 0:
             break
         blocks = np.flatnonzero(np.abs(falling).max(axis=1) > 1e-6 * np.abs(falling).max())
-        if travelled >= LANDING_DISTANCE * ref.unit_height:
+        if travelled >= reach:
             return Outcome(True, t, f"{falling_text(blocks)} fell {travelled:.3g} m without landing", False)
-        moved = pose_at(ref, pose, falling, shrink * controls.step / speed, t)
-        if wall_at(ref, moved)[1].overlap > ref.gap:
+        moved = pose_at(ref, pose, falling, shrink * stride / speed, t)
+        if wall_at(ref, moved)[1].overlap > allowed_overlap(ref, contacts.overlap):
             if shrink < COLLAPSE_RESOLUTION:
                 return Outcome(False, None, f"at {t:.6g} m {falling_text(blocks)} cannot stand in the programme and "
                                             "cannot move without going into another block: a contact the "
                                             "programme does not see (a corner on a corner) holds it", False)
             shrink *= 0.5
             continue
-        pose, travelled = moved, travelled + shrink * controls.step
+        pose, travelled = moved, travelled + shrink * stride
         shrink = min(1.0, 1.5 * shrink)
         try:
             return solved(ref, pose, controls, t)
         except DeadLoadNotCarried:
             continue
-    return Outcome(True, t, "the moved configuration cannot carry its dead load", False)
+        except mf.SolveError as error:
+            return Outcome(False, None, f"the programme failed at {t:.6g} m while {falling_text(blocks)} fell: "
+                                        f"{error}", False)
+    return Outcome(False, None, f"at {t:.6g} m {falling_text(blocks) if blocks.size else 'a part'} kept falling in "
+                                f"short steps, {travelled:.3g} m in all, neither landing nor falling "
+                                f"{reach:.3g} m: no capacity is claimed", False)
+
+
+def ground_motion(ref: Reference, t: float) -> float:
+    """How far the ground has settled at ``t`` [m]: the settlement parameter (0 under a live load)."""
+    return abs(t) if settlement_driven(ref) else 0.0
 
 
 def falling_text(blocks: np.ndarray) -> str:
-    return f"block {blocks[0]}" if blocks.size == 1 else f"{blocks.size} blocks ({mfp.listed(blocks)})"
+    return "no block" if blocks.size == 0 else f"block {blocks[0]}" if blocks.size == 1 else f"{blocks.size} blocks ({mfp.listed(blocks)})"
 
 
 def run(ref: Reference, controls: Controls, record, progress) -> Outcome:
@@ -194,7 +220,7 @@ def run(ref: Reference, controls: Controls, record, progress) -> Outcome:
                     return Outcome(False, None, f"the programme failed at {current.t + dt:.6g} m: {error}", False)
                 shrink *= 0.5
                 continue
-            if trial.overlap > ref.gap and dt > resolution:
+            if trial.overlap > allowed_overlap(ref, current.overlap) and dt > resolution:
                 shrink *= 0.5  # the step was too long for its contacts: a vertex went into a block
                 continue
             halvings = 0

@@ -35,3 +35,9 @@ class TestJmmLimit(SolverConformance):
 
 class TestStatics(SolverConformance):
     solver = "statics"
+
+
+class TestLaIncremental(SolverConformance):
+    solver = "la-incremental"
+    options = {"settlement": 0.01}
+    invariance_tolerance = 1e-6

@@ -109,3 +109,22 @@ def test_la_ferris_tin_loi_wall_1(walls, backend):
     """Published lambda = 0.643 (associative friction)."""
     result = ferris_tin_loi_wall_1(walls, backend)
     assert float(result.collapse_multiplier) == pytest.approx(0.643, abs=1e-3)
+
+
+@pytest.mark.parametrize("thickness_ratio, stands", [(0.107, False), (0.108, True)])
+def test_la_semicircular_arch_stands_from_milankovitchs_thickness(thickness_ratio, stands):
+    """A semicircular arch carries its own weight only from t/R = 0.1075 on (Milankovitch 1907); with 40
+    voussoirs la puts the limit between 0.107 and 0.108. With the right springing moving out, alpha is minus
+    the least thrust over the springing's share of the weight (docs/la.md)."""
+    import masonryfw as mf
+    import masonryfw.testing as mt
+
+    arch = mt.arch_model(thickness_ratio)
+    if not stands:
+        with pytest.raises(mf.SolveError, match="dead load alone cannot be carried"):
+            mf.solve(arch, "la", {})
+        return
+    result = mf.solve(arch, "la", {})
+    share = float(arch.dead_load.values[-1, 1])
+    thrust = float(result.moving_support_reaction)
+    assert float(result.collapse_multiplier) == pytest.approx(-thrust / share, rel=1e-6)

@@ -1,0 +1,51 @@
+"""A semicircular arch on spreading supports: how far the springings can move apart before it falls.
+
+The references: the arch's least thickness (it cannot spread at all below t/R = 0.1075, Milankovitch
+1907), and fdem, a second physics, on the same arches (docs/la.md: the table of spans at collapse).
+"""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import masonryfw as mf
+import masonryfw.testing as mt
+
+
+def spread_at_collapse(thickness_ratio: float, **options) -> float:
+    result = mf.solve(mt.arch_model(thickness_ratio), "la-incremental", {"settlement": 0.5, **options})
+    return float(result.settlement_capacity)
+
+
+def test_a_thicker_arch_takes_more_spreading_and_none_at_its_least_thickness():
+    spreads = [spread_at_collapse(ratio) for ratio in (0.11, 0.15, 0.2)]
+    assert spreads == sorted(spreads)
+    assert spreads[0] < 0.005 * 2.0  # under half a percent of the 2 m span just above t/R = 0.1075
+    assert spreads[2] > 0.1 * 2.0
+
+
+def test_the_first_thrust_is_las_least_thrust():
+    arch = mt.arch_model(0.15)
+    la = mf.solve(arch, "la", {})
+    incremental = mf.solve(arch, "la-incremental", {"settlement": 0.01, "flow": "associative"})
+    assert incremental.attrs["la_incremental_first_reaction"] == pytest.approx(float(la.moving_support_reaction),
+                                                                               rel=1e-6)
+    assert float(incremental.step_reaction.values[0]) == pytest.approx(float(la.moving_support_reaction), rel=1e-6)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("thickness_ratio, within", [(0.15, 0.06), (0.2, 0.03)])
+def test_spread_at_collapse_and_thrust_against_fdem(thickness_ratio, within):
+    arch = mt.arch_model(thickness_ratio)
+    arch["block_young_modulus"] = ("block", np.full(arch.sizes["block"], 5e9), {"units": "Pa", "long_name": "E"})
+    arch["block_poisson_ratio"] = ("block", np.full(arch.sizes["block"], 0.2), {"units": "1", "long_name": "nu"})
+    incremental = mf.solve(arch, "la-incremental", {"settlement": 0.5})
+    spread = float(incremental.settlement_capacity)
+    fdem = mf.solve(arch, "fdem", {"settlement": 1.3 * spread, "plateau_tolerance": 0.0})
+    s, thrust = fdem.step_settlement.values, fdem.step_reaction.values
+    peak = int(np.argmax(thrust))
+    fallen = s[peak + np.flatnonzero(thrust[peak:] < 0.5 * thrust[peak])[0]]  # the thrust is gone: the arch fell
+    assert spread == pytest.approx(fallen, rel=within)
+    grid = np.linspace(0.05 * spread, 0.95 * spread, 20)
+    ours = np.interp(grid, incremental.step_settlement.values, incremental.step_reaction.values)
+    np.testing.assert_allclose(ours, np.interp(grid, s, thrust), rtol=0.02)

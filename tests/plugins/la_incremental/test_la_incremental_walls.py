@@ -1,0 +1,71 @@
+"""la-incremental on the bundled walls: its first instant is la's, and its histories are fdem's.
+
+fdem is a second physics (explicit dynamics, penalty contacts, no limit analysis anywhere): where both
+are quasi-static, the reaction histories agree to a few percent of R0, the blocks end up moving the same
+way, and a wall that falls falls at about the same settlement. Five walls differ for reasons that are the models', not the code's (docs/la.md, "Displacement
+capacity"): they are expected to fail and do.
+"""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import masonryfw as mf
+
+
+def test_the_first_instant_is_las():
+    model = mf.open_model("test-12c")
+    la = mf.solve(model, "la", {})
+    incremental = mf.solve(model, "la-incremental", {"flow": "associative", "settlement": 0.002})
+    assert incremental.attrs["la_incremental_first_reaction"] == pytest.approx(float(la.moving_support_reaction),
+                                                                               rel=1e-6)
+    assert float(incremental.step_reaction.values[0]) == pytest.approx(mf.dead_reaction(model), rel=1e-12)
+
+
+def reaction_gap(a, b, r0: float) -> float:
+    """The median distance between two reaction histories over the settlements both reached (from a tenth of
+    the shorter one on), over R0."""
+    top = min(a.step_settlement.values.max(), b.step_settlement.values.max())
+    grid = np.linspace(0.1 * top, top, 50)
+
+    def at(result):
+        settled = result.step_settlement.values > 0
+        return np.interp(grid, result.step_settlement.values[settled], result.step_reaction.values[settled])
+
+    return float(np.median(np.abs(at(a) - at(b)))) / r0
+
+
+DIFFERENT = pytest.mark.xfail(strict=True, reason="the rigid wall's reaction is the least admissible, fdem's the "
+                                                  "elastic one (docs/la.md)")
+EARLY = pytest.mark.xfail(strict=True, reason="the pier falls at 63 mm here, at about 84 mm in fdem (docs/la.md)")
+
+
+def fdem_fall(result) -> float:
+    """Where fdem's reaction falls below half of its largest (the wall fell onto the ground), NaN if it does not."""
+    reaction = result.step_reaction.values
+    peak = int(np.argmax(reaction))
+    below = np.flatnonzero(reaction[peak:] < 0.5 * reaction[peak])
+    return float(result.step_settlement.values[peak + below[0]]) if below.size else float("nan")
+
+
+@pytest.mark.parametrize("wall", [
+    "test-8c",
+    pytest.param("test-12c", marks=pytest.mark.slow),
+    pytest.param("panel-1", marks=[pytest.mark.slow, DIFFERENT]),
+    pytest.param("panel-2", marks=[pytest.mark.slow, DIFFERENT]),
+    pytest.param("panel-3", marks=pytest.mark.slow),
+    pytest.param("panel-4", marks=[pytest.mark.slow, DIFFERENT]),
+    pytest.param("panel-5", marks=[pytest.mark.slow, EARLY]),
+    pytest.param("facade-1", marks=pytest.mark.slow),
+    pytest.param("facade-2", marks=[pytest.mark.slow, DIFFERENT]),
+    pytest.param("facade-3", marks=pytest.mark.slow),
+])
+def test_reaction_history_follows_fdems(wall):
+    model = mf.open_model(wall)
+    fdem = mf.solve(model, "fdem", {"settlement_ratio": 0.1})
+    incremental = mf.solve(model, "la-incremental", {})
+    assert reaction_gap(incremental, fdem, mf.dead_reaction(model)) < 0.05
+    if "settlement_capacity" in incremental:  # both fall, at settlements within 15 %
+        assert float(incremental.settlement_capacity) == pytest.approx(fdem_fall(fdem), rel=0.15)
+    else:  # the same mechanism at the end
+        assert float(mf.compare(fdem, incremental).mechanism_cosine) > 0.99
