@@ -205,10 +205,23 @@ def draw_history(datasets: Sequence[xr.Dataset], ax, options: Mapping[str, Any])
         if options["settlement_max"] is not None:
             _fit_y_to_shown(ax, [(1e3 * ds.step_settlement.values, ds.step_reaction.values) for ds in incremental])
         _room_for_strips(ax, rows)
+    _volume_loss_axis(ax, incremental)
     if len(incremental) == 1 and not limits and not sweeps:
         ax.set_title(f"{title_of(incremental[0])}\n{mf.headline_text(incremental[0])}", fontsize="medium")
     else:
         ax.set_title(str(datasets[0].attrs.get("title", "")), fontsize="medium")
+
+
+def _volume_loss_axis(ax, results: Sequence[xr.Dataset]) -> None:
+    """Over one tunnel's trough, a second settlement axis along the top in volume loss (S_max is proportional to
+    V_L: ``mfp.volume_loss_per_settlement``)."""
+    rates = {mfp.volume_loss_per_settlement(ds) for ds in results}
+    if len(rates) != 1 or None in rates:
+        return
+    per_mm = rates.pop() / 1e3
+    top = ax.secondary_xaxis("top", functions=(lambda mm: mm * per_mm, lambda loss: loss / per_mm))
+    top.set_xlabel("tunnel volume loss V_L [%]", fontsize="small")
+    top.tick_params(labelsize="small")
 
 
 def _force_axis(ax, reference: float) -> str:

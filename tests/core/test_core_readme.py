@@ -167,3 +167,22 @@ def test_the_diagnosis_step_of_the_tour_runs_as_written(tmp_path):
     assert "the right part settled relative to the rest, the ground breaking at 1.20 m" in data["verdict"]
     assert (tmp_path / "diagnosis.png").stat().st_size > 20_000
     assert "Diagnosis" in (tmp_path / "diagnosis.html").read_text()
+
+
+@pytest.mark.slow  # 40 s: fdem to 60 mm, la-incremental on the tunnel facade
+def test_the_how_far_step_of_the_tour_runs_as_written(tmp_path):
+    """Step 1f: la-incremental follows Test 12C to 60 mm, fdem beside it, one history figure; capacity says where
+    the tunnel facade first reaches category 1, in volume loss."""
+    step = README[README.index("**1f. Or ask how far it can go.**"):README.index("**1e. Or ask the reverse")]
+    commands = [line.strip().split("#")[0].split() for line in step.splitlines() if line.startswith("    masonryfw ")]
+    assert len(commands) == 4
+    outputs = []
+    for words in commands:
+        extra = ["--no-progress"] if words[1] in ("solve", "capacity") else []
+        done = subprocess.run([sys.executable, "-m", "masonryfw", *words[1:], *extra], cwd=tmp_path,
+                              capture_output=True, text=True, timeout=300)
+        assert done.returncode == 0, (words, done.stderr)
+        outputs.append(done.stdout)
+    assert "reached the target 0.06 m before collapse" in outputs[0]
+    assert (tmp_path / "how-far.png").stat().st_size > 20_000
+    assert outputs[3].splitlines()[2].startswith("category 1 (very slight): first reached at")

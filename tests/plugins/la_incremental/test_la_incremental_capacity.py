@@ -105,3 +105,18 @@ def test_capacity_command_prints_the_category_in_volume_loss(tmp_path):
     assert "category_volume_loss" in result and float(result.step_settlement.values[-1]) > 0
     refused = cli(["capacity", "test-8c", "--volume-loss", "2", "--no-progress"], tmp_path)
     assert refused.returncode == 1 and "not over a tunnel" in refused.stderr
+
+
+def test_a_tunnel_history_has_a_volume_loss_axis(tmp_path):
+    spec = tmp_path / "tunnel-wall.toml"
+    spec.write_text(TUNNEL_WALL)
+    model = mf.build(spec)
+    result = mf.solve(model, "la-incremental", {"settlement": 0.01})
+    figure = mf.render([result], "history")
+    top = [child for child in figure.axes[0].child_axes if child.get_xlabel().startswith("tunnel volume loss")]
+    assert len(top) == 1
+    figure.canvas.draw()
+    ticks = [t.get_text().replace("\u2212", "-") for t in top[0].get_xticklabels() if t.get_text()]
+    assert ticks and all(0 <= float(t) <= 1.0 for t in ticks)  # V_L 1 % is S_max, the run went to 10 mm < S_max
+    plain = mf.render([mf.solve(mf.open_model("test-8c"), "la-incremental", {"settlement": 0.002})], "history")
+    assert not plain.axes[0].child_axes
