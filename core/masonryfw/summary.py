@@ -355,6 +355,9 @@ _HEADLINES = (
     ("plateau_reaction", "plateau reaction", lambda n: f"{force_text(n['plateau_reaction'])} from "
      f"{_mm(n['plateau_settlement'])}", "the reaction once it stops changing (within 1 % of R0)"),
     ("final_settlement", "final settlement", lambda n: _mm(n["final_settlement"]), "settlement of the last record"),
+    ("settlement_capacity", "settlement at collapse", lambda n: f"{_mm(n['settlement_capacity'])}, reaction "
+     f"{force_text(n['capacity_reaction'])}", "the last moved configuration that carries its dead load "
+     "(la-incremental), and its settlement reaction"),
     ("crack_width", "widest crack", lambda n: _crack_text(n),
      "widest opening of a joint in the masonry over the run: the joint, its midpoint, the settlement"),
     ("damage_category", "damage category", lambda n: _damage_name(n["damage_category"]),

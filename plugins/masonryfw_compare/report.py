@@ -154,6 +154,13 @@ def _history_section(datasets: Sequence[xr.Dataset]) -> list[str]:
     if all("step_damage_category" in ds for ds in incremental):
         parts.append(_figure(incremental, "history", "Widest crack in the masonry against settlement, over the "
                              "bands of the damage categories.", {"quantity": "damage"}))
+    tables = [(mf.result_label(ds), mf.capacity_text(ds)) for ds in incremental]
+    if any(text for _, text in tables):
+        parts.append("<h3>Where each damage category is first reached</h3>"
+                     '<p class="note">From one run: the widest crack (stage 3) beside the limiting tensile strain '
+                     "method (stage 2) and the greenfield screen (stage 1); over a tunnel also in volume loss "
+                     "(S_max is proportional to it). <code>masonryfw capacity</code> runs it.</p>")
+        parts += [f"<p>{html.escape(label)}</p><pre>{html.escape(text)}</pre>" for label, text in tables if text]
     return parts
 
 

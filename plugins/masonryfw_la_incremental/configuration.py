@@ -3,8 +3,10 @@
 What does not change through the run (the model's polygons, loads, materials and scales) is read once
 into a :class:`Reference`; :func:`wall_at` places the blocks at a pose, finds their contacts again
 (:mod:`.contacts`) and gives every contact the friction of the joint between its two blocks (the
-smaller of their joints' where they were not in contact in the model). Moving supports are placed
-by the settlement parameter alone and move on at their velocity in the moved configuration.
+smaller of their joints' where they were not in contact in the model), and a joint's cohesion and tensile
+strength as long as it has not opened or slid by more than the gap (:func:`intact_joints`: a broken
+bond does not heal). Moving supports are placed by the settlement parameter alone and move on at their
+velocity in the moved configuration.
 """
 from __future__ import annotations
 
@@ -14,7 +16,6 @@ from dataclasses import dataclass
 import numpy as np
 import xarray as xr
 
-import masonryfw as mf
 import masonryfw.plugin_api as mfp
 from masonryfw_la import Scales, Wall, wall_scales
 
@@ -39,8 +40,9 @@ class Reference:
     ground: np.ndarray  # support blocks: their mutual contacts do not count
     radius: np.ndarray  # (block,) largest distance of a vertex from the centroid [m]
     unit_height: float  # median height of the masonry units [m]: the length steps are measured in
+    model: xr.Dataset  # where the joints' relative motion is measured (``mfp.relative_motion``)
     pair_keys: np.ndarray  # sorted a * n + b (a < b) of the model's interfaces
-    pair_friction: np.ndarray
+    pair_order: np.ndarray  # the model's interface of each sorted key
     block_friction: np.ndarray  # the smallest friction of a block's joints
     gap: float  # a vertex this far outside a face still touches it [m]
     cornered: np.ndarray  # sorted pair keys of blocks that meet corner to corner in the model
@@ -52,19 +54,6 @@ class Reference:
     @property
     def n_block(self) -> int:
         return self.wall.n_block
-
-
-def check_dry(model: xr.Dataset) -> None:
-    """Cohesion and tensile strength are not followed through moved configurations: name the first joint."""
-    bonded = np.flatnonzero((model.interface_cohesion.values > 0) | (model.interface_tensile_strength.values > 0))
-    if bonded.size:
-        i = int(bonded[0])
-        raise mf.SolveError(
-            f"la-incremental follows dry joints only: interface {i} (blocks "
-            f"{' and '.join(map(str, model.interface_blocks.values[i]))}) has cohesion "
-            f"{float(model.interface_cohesion.values[i]):.6g} Pa and tensile strength "
-            f"{float(model.interface_tensile_strength.values[i]):.6g} Pa ({bonded.size} such joints); "
-            "solve it with la (first instant), fdem or jmm")
 
 
 def reference(model: xr.Dataset, gap_share: float) -> Reference:
@@ -90,18 +79,26 @@ def reference(model: xr.Dataset, gap_share: float) -> Reference:
     at_rest = find_contacts(Polygons.of(x, y, counts), ground, gap, gap)
     points = at_rest.length <= 2 * gap  # in the model's configuration every contact is a face but a corner on a corner
     cornered = np.unique(at_rest.sides[points].min(axis=1) * counts.size + at_rest.sides[points].max(axis=1))
-    return Reference(wall, wall_scales(model, wall), x, y, counts, owner, ground, radius, unit_height, keys[order],
-                     wall.friction[order], block_friction, gap, cornered)
+    return Reference(wall, wall_scales(model, wall), x, y, counts, owner, ground, radius, unit_height, model,
+                     keys[order], order, block_friction, gap, cornered)
 
 
-def contact_friction(ref: Reference, sides: np.ndarray) -> np.ndarray:
-    """The model's friction of the joint between each contact's blocks, else the smaller of theirs."""
-    keys = sides[:, 0] * ref.n_block + sides[:, 1]
-    at = np.clip(np.searchsorted(ref.pair_keys, keys), 0, max(ref.pair_keys.size - 1, 0))
-    known = ref.pair_keys.size > 0
-    same = ref.pair_keys[at] == keys if known else np.zeros(keys.size, dtype=bool)
-    fallback = np.minimum(ref.block_friction[sides[:, 0]], ref.block_friction[sides[:, 1]])
-    return np.where(same, ref.pair_friction[at] if known else 0.0, fallback)
+def model_joint(ref: Reference, sides: np.ndarray) -> np.ndarray:
+    """The model's interface between each contact's two blocks, -1 where they had none."""
+    if ref.pair_keys.size == 0:
+        return np.full(sides.shape[0], -1)
+    keys = sides.min(axis=1) * ref.n_block + sides.max(axis=1)
+    at = np.clip(np.searchsorted(ref.pair_keys, keys), 0, ref.pair_keys.size - 1)
+    return np.where(ref.pair_keys[at] == keys, ref.pair_order[at], -1)
+
+
+def intact_joints(ref: Reference, pose: np.ndarray, intact: np.ndarray) -> np.ndarray:
+    """The model's joints still intact at ``pose``: intact before and opened or slid by no more than the gap at
+    either end (a bond that broke does not heal)."""
+    if not intact.any():
+        return intact
+    opening, slip = mfp.relative_motion(ref.model, pose, "finite")
+    return intact & (np.hypot(np.maximum(opening, 0.0), slip).max(axis=1) <= ref.gap)
 
 
 def still_cornered(ref: Reference, pose: np.ndarray) -> np.ndarray:
@@ -114,12 +111,14 @@ def still_cornered(ref: Reference, pose: np.ndarray) -> np.ndarray:
     return ref.cornered[shift < ref.gap]
 
 
-def wall_at(ref: Reference, pose: np.ndarray) -> tuple[Wall, Contacts]:
-    """The wall with every block at ``pose`` ``(block, 3)`` and its contacts found again."""
+def wall_at(ref: Reference, pose: np.ndarray, intact: np.ndarray) -> tuple[Wall, Contacts]:
+    """The wall with every block at ``pose`` ``(block, 3)`` and its contacts found again; a contact on a model's
+    joint still ``intact`` keeps that joint's cohesion and tensile strength (the contact is the whole joint)."""
     x, y = motion.vertices(pose, ref.centroid, ref.node_x, ref.node_y, ref.owner)
     contacts = find_contacts(Polygons(x, y, ref.counts, np.r_[0, np.cumsum(ref.counts)], ref.owner), ref.ground,
                              ref.gap, DEPTH_IN_CONTACT * ref.gap, still_cornered(ref, pose))
-    n = contacts.sides.shape[0]
+    joint = model_joint(ref, contacts.sides)
+    bonded = (joint >= 0) & intact[np.maximum(joint, 0)]
     direction = np.where(ref.wall.moving[:, None], motion.current_twist(ref.wall.direction, pose), 0.0)
     wall = dataclasses.replace(
         ref.wall,
@@ -134,8 +133,9 @@ def wall_at(ref: Reference, pose: np.ndarray) -> tuple[Wall, Contacts]:
         normal=contacts.normal,
         tangent=contacts.tangent,
         length=contacts.length,
-        friction=contact_friction(ref, contacts.sides),
-        cohesion=np.zeros(n),
-        tensile_strength=np.zeros(n),
+        friction=np.where(joint >= 0, ref.wall.friction[joint],
+                          np.minimum(ref.block_friction[contacts.sides[:, 0]], ref.block_friction[contacts.sides[:, 1]])),
+        cohesion=np.where(bonded, ref.wall.cohesion[joint], 0.0),
+        tensile_strength=np.where(bonded, ref.wall.tensile_strength[joint], 0.0),
     )
     return wall, contacts

@@ -14,7 +14,7 @@ import xarray as xr
 import masonryfw.plugin_api as mfp
 
 from . import history, stepping
-from .configuration import check_dry, reference
+from .configuration import reference
 
 #: Without a target, a run follows the wall to this share of its height.
 DEFAULT_TARGET_SHARE = 0.1
@@ -31,7 +31,6 @@ def default_target(model: xr.Dataset) -> float:
 def solve(model: xr.Dataset, options: Mapping[str, Any], progress=mfp.no_progress) -> xr.Dataset:
     """Follow ``model`` from its configuration to collapse or to the target (module docstring)."""
     clock = time.perf_counter()
-    check_dry(model)
     ref = reference(model, options["gap"])
     controls = stepping.Controls(
         target=options["settlement"] or default_target(model),

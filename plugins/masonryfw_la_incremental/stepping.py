@@ -26,7 +26,7 @@ import masonryfw.plugin_api as mfp
 from masonryfw_la import DeadLoadNotCarried, LimitState, LiveLoadUnbounded, Wall, falling_motion, limit_state
 
 from . import motion
-from .configuration import Reference, wall_at
+from .configuration import Reference, intact_joints, wall_at
 
 #: The collapse is bracketed to this share of a step's largest motion.
 COLLAPSE_RESOLUTION = 1e-2
@@ -58,6 +58,7 @@ class Configuration(NamedTuple):
     wall: Wall  # its contacts as la's interfaces
     state: LimitState
     overlap: float  # the deepest vertex inside another block [m]
+    intact: np.ndarray  # (model interface,) the joints whose cohesion and tensile strength hold
 
 
 class Outcome(NamedTuple):
@@ -102,30 +103,38 @@ def fastest_point(ref: Reference, mechanism: np.ndarray) -> float:
     return float(speed[masonry].max(initial=0.0))
 
 
-def solved(ref: Reference, pose: np.ndarray, controls: Controls, t: float) -> Configuration:
+def solved(ref: Reference, pose: np.ndarray, controls: Controls, t: float, intact: np.ndarray) -> Configuration:
     """The configuration at ``pose``: its contacts and limit state (module docstring).
 
     Non-associative joints (the default) take the shear capacity of the normal forces of the configuration's
-    own associative state: the first two LPs of la's non-associative sequence. :class:`DeadLoadNotCarried`
-    when the configuration cannot carry its dead load.
+    own associative state: the first two LPs of la's non-associative sequence. A joint ``intact`` before that
+    opened or slid past the gap loses its bond here. :class:`DeadLoadNotCarried` when the configuration cannot
+    carry its dead load.
     """
-    wall, contacts = wall_at(ref, pose)
+    intact = intact_joints(ref, pose, intact)
+    wall, contacts = wall_at(ref, pose, intact)
     state = limit_state(wall, ref.scales, controls.solver, controls.tolerance)
     if controls.flow == "nonassociative":
         state = limit_state(wall, ref.scales, controls.solver, controls.tolerance, state.normal)
-    return Configuration(t, pose, wall, state, contacts.overlap)
+    return Configuration(t, pose, wall, state, contacts.overlap, intact)
+
+
+def bonded_joints(ref: Reference) -> np.ndarray:
+    """The model's joints with cohesion or tensile strength: intact at the start."""
+    return (ref.wall.cohesion > 0) | (ref.wall.tensile_strength > 0)
 
 
 def first_configuration(ref: Reference, controls: Controls) -> Configuration:
     pose = np.zeros((ref.n_block, 3))
     try:
-        return solved(ref, pose, controls, 0.0)
+        return solved(ref, pose, controls, 0.0, bonded_joints(ref))
     except DeadLoadNotCarried as error:
         raise mf.SolveError(f"la-incremental: the wall does not stand under its dead load before it moves ({error})") \
             from error
 
 
-def fall(ref: Reference, controls: Controls, pose: np.ndarray, t: float) -> Configuration | Outcome:
+def fall(ref: Reference, controls: Controls, pose: np.ndarray, t: float,
+         intact: np.ndarray) -> Configuration | Outcome:
     """Let the part that cannot stand at ``pose`` fall, the supports held, until it lands (a configuration
     that stands: a block dropping onto the one that settled beneath it). When it has not landed after its
     fastest point fell :data:`LANDING_DISTANCE` unit heights further than the ground has moved (a block can drop
@@ -137,7 +146,8 @@ def fall(ref: Reference, controls: Controls, pose: np.ndarray, t: float) -> Conf
     stride = FALL_STEPS * controls.step
     blocks = np.zeros(0, dtype=np.int64)
     for _ in range(int(4 * reach / stride) + 50):  # room for the halvings where it touches down
-        wall, contacts = wall_at(ref, pose)
+        intact = intact_joints(ref, pose, intact)
+        wall, contacts = wall_at(ref, pose, intact)
         falling = falling_motion(wall, ref.scales)
         speed = fastest_point(ref, falling)
         if speed <= 0:
@@ -146,7 +156,7 @@ def fall(ref: Reference, controls: Controls, pose: np.ndarray, t: float) -> Conf
         if travelled >= reach:
             return Outcome(True, t, f"{falling_text(blocks)} fell {travelled:.3g} m without landing", False)
         moved = pose_at(ref, pose, falling, shrink * stride / speed, t)
-        if wall_at(ref, moved)[1].overlap > allowed_overlap(ref, contacts.overlap):
+        if wall_at(ref, moved, intact)[1].overlap > allowed_overlap(ref, contacts.overlap):
             if shrink < COLLAPSE_RESOLUTION:
                 return Outcome(False, None, f"at {t:.6g} m {falling_text(blocks)} cannot stand in the programme and "
                                             "cannot move without going into another block: a contact the "
@@ -156,7 +166,7 @@ def fall(ref: Reference, controls: Controls, pose: np.ndarray, t: float) -> Conf
         pose, travelled = moved, travelled + shrink * stride
         shrink = min(1.0, 1.5 * shrink)
         try:
-            return solved(ref, pose, controls, t)
+            return solved(ref, pose, controls, t, intact)
         except DeadLoadNotCarried:
             continue
         except mf.SolveError as error:
@@ -195,7 +205,7 @@ def run(ref: Reference, controls: Controls, record, progress) -> Outcome:
                 return Outcome(False, None, "no block moves: the mechanism is the supports' motion alone", False)
             resolution = COLLAPSE_RESOLUTION * controls.step / speed
             if failing is not None and failing[0] - current.t <= resolution:
-                landed = fall(ref, controls, failing[1], failing[0])
+                landed = fall(ref, controls, failing[1], failing[0], current.intact)
                 if isinstance(landed, Outcome):
                     return landed._replace(capacity=current.t) if landed.collapsed else landed
                 current, failing = landed, None
@@ -206,7 +216,7 @@ def run(ref: Reference, controls: Controls, record, progress) -> Outcome:
                 dt = min(dt, 0.5 * (failing[0] - current.t))
             pose = pose_at(ref, current.pose, current.state.motion, dt, current.t + dt)
             try:
-                trial = solved(ref, pose, controls, current.t + dt)
+                trial = solved(ref, pose, controls, current.t + dt, current.intact)
             except DeadLoadNotCarried:
                 failing = (current.t + dt, pose)  # from this configuration: a fall once it is this close
                 shrink *= 0.5

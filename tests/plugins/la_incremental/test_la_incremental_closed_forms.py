@@ -56,3 +56,18 @@ def test_la_incremental_pier_on_a_tilting_base_follows_its_capacity_curve(b, h):
     np.testing.assert_allclose(result.step_load_factor.values, np.tan(np.arctan(b / h) - phi), atol=1e-7)
     radius = 0.5 * np.hypot(b, h)
     assert float(result.displacement_capacity) == pytest.approx(2 * radius * np.sin(np.arctan(b / h) / 2), rel=1e-4)
+
+
+def test_a_bonded_pier_cracks_then_rocks_as_a_dry_one():
+    """A pier whose base joint has tensile strength ft (and cohesion above mu ft) first stands under
+    b/h + ft s b^2 / (W h) (la's closed form); once the joint has opened its bond is gone, and the pier
+    follows the dry capacity curve tan(atan(b/h) - phi)."""
+    b, h, ft, thickness = 0.4, 1.0, 2000.0, 0.1
+    pier = mt.rectangles_model([(-1.0, -0.2, 2.0, 0.0), (0.0, 0.0, b, h)], ["fixed_support", "unit"], friction=0.8,
+                               loading="tilt", tensile_strength=ft, cohesion=5000.0)
+    weight = 12e3 * b * h * thickness
+    result = mf.solve(pier, "la-incremental", {"settlement": 1.0})
+    factor = result.step_load_factor.values
+    assert factor[0] == pytest.approx(b / h + ft * thickness * b**2 / (weight * h), rel=1e-7)
+    phi = -result.step_block_rotation.values[1:, 1]
+    np.testing.assert_allclose(factor[1:], np.tan(np.arctan(b / h) - phi), atol=1e-7)
