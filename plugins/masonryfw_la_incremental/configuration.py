@@ -33,10 +33,11 @@ class Reference:
 
     wall: Wall
     scales: Scales
-    node_x: np.ndarray
+    node_x: np.ndarray  # the vertices of the convex pieces of every block (a convex block is its own piece)
     node_y: np.ndarray
-    counts: np.ndarray
-    owner: np.ndarray
+    counts: np.ndarray  # (piece,)
+    owner: np.ndarray  # (node,) its block
+    piece_block: np.ndarray  # (piece,) its block
     ground: np.ndarray  # support blocks: their mutual contacts do not count
     radius: np.ndarray  # (block,) largest distance of a vertex from the centroid [m]
     unit_height: float  # median height of the masonry units [m]: the length steps are measured in
@@ -76,11 +77,12 @@ def reference(model: xr.Dataset, gap_share: float) -> Reference:
     block_friction[~np.isfinite(block_friction)] = float(np.median(wall.friction)) if wall.friction.size else 0.0
     ground = mfp.support_blocks(wall.role)
     gap = gap_share * unit_height
-    at_rest = find_contacts(Polygons.of(x, y, counts), ground, gap, gap)
+    px, py, piece_counts, piece_block = mfp.convex_pieces(x, y, counts)
+    at_rest = find_contacts(Polygons.of(px, py, piece_counts), ground, gap, gap, group=piece_block)
     points = at_rest.length <= 2 * gap  # in the model's configuration every contact is a face but a corner on a corner
     cornered = np.unique(at_rest.sides[points].min(axis=1) * counts.size + at_rest.sides[points].max(axis=1))
-    return Reference(wall, wall_scales(model, wall), x, y, counts, owner, ground, radius, unit_height, model,
-                     keys[order], order, block_friction, gap, cornered)
+    return Reference(wall, wall_scales(model, wall), px, py, piece_counts, np.repeat(piece_block, piece_counts),
+                     piece_block, ground, radius, unit_height, model, keys[order], order, block_friction, gap, cornered)
 
 
 def model_joint(ref: Reference, sides: np.ndarray) -> np.ndarray:
@@ -115,8 +117,8 @@ def wall_at(ref: Reference, pose: np.ndarray, intact: np.ndarray) -> tuple[Wall,
     """The wall with every block at ``pose`` ``(block, 3)`` and its contacts found again; a contact on a model's
     joint still ``intact`` keeps that joint's cohesion and tensile strength (the contact is the whole joint)."""
     x, y = motion.vertices(pose, ref.centroid, ref.node_x, ref.node_y, ref.owner)
-    contacts = find_contacts(Polygons(x, y, ref.counts, np.r_[0, np.cumsum(ref.counts)], ref.owner), ref.ground,
-                             ref.gap, DEPTH_IN_CONTACT * ref.gap, still_cornered(ref, pose))
+    contacts = find_contacts(Polygons.of(x, y, ref.counts), ref.ground, ref.gap, DEPTH_IN_CONTACT * ref.gap,
+                             still_cornered(ref, pose), group=ref.piece_block)
     joint = model_joint(ref, contacts.sides)
     bonded = (joint >= 0) & intact[np.maximum(joint, 0)]
     direction = np.where(ref.wall.moving[:, None], motion.current_twist(ref.wall.direction, pose), 0.0)

@@ -58,8 +58,9 @@ class Contacts:
     overlap_at: tuple[int, int]  # (vertex's block, other block) of the deepest, (-1, -1) when none
 
 
-def candidate_pairs(polygons: Polygons, pad: float, skip: np.ndarray) -> np.ndarray:
-    """``(pair, 2)`` blocks ``a < b`` whose boxes, grown by ``pad``, overlap; none where ``skip`` holds for both."""
+def candidate_pairs(polygons: Polygons, pad: float, skip: np.ndarray, group: np.ndarray) -> np.ndarray:
+    """``(pair, 2)`` polygons ``a < b`` whose boxes, grown by ``pad``, overlap; none of one ``group`` (the pieces of
+    one block) and none where ``skip`` holds for both groups."""
     n = polygons.counts.size
     start = polygons.offsets[:-1]
     xmin, xmax = np.minimum.reduceat(polygons.x, start), np.maximum.reduceat(polygons.x, start)
@@ -71,14 +72,15 @@ def candidate_pairs(polygons: Polygons, pad: float, skip: np.ndarray) -> np.ndar
     first = np.repeat(np.arange(n), count)
     second = np.arange(count.sum()) - np.repeat(np.cumsum(count) - count, count) + first + 1
     a, b = order[first], order[second]
-    near = (ymin[a] <= ymax[b] + pad) & (ymin[b] <= ymax[a] + pad) & ~(skip[a] & skip[b])
+    near = (ymin[a] <= ymax[b] + pad) & (ymin[b] <= ymax[a] + pad) & ~(skip[group[a]] & skip[group[b]])
+    near &= group[a] != group[b]
     pairs = np.sort(np.c_[a[near], b[near]], axis=1)
     return pairs
 
 
 def separations(polygons: Polygons, pairs: np.ndarray):
-    """Every edge of both blocks of every pair: its block, its first node, its outward normal and how far the
-    other block lies beyond it (the least of its vertices' signed distances)."""
+    """Every edge of both polygons of every pair: the pair, its polygon and the other, its first node, its outward
+    normal and how far the other polygon lies beyond it (the least of its vertices' signed distances)."""
     n_pair = pairs.shape[0]
     edge_block = np.concatenate([pairs[:, 0], pairs[:, 1]])
     vert_block = np.concatenate([pairs[:, 1], pairs[:, 0]])
@@ -102,12 +104,15 @@ def separations(polygons: Polygons, pairs: np.ndarray):
 
 
 def find_contacts(polygons: Polygons, skip: np.ndarray, gap: float, overlap: float,
-                  cornered: np.ndarray | None = None) -> Contacts:
-    """The interfaces of the configuration (module docstring); ``skip``: blocks whose mutual contacts do not
-    count (the supports: ground against ground); ``cornered``: sorted pair keys ``a * n + b`` whose corner-on-
-    corner contacts do not count (all when None)."""
-    pairs = candidate_pairs(polygons, gap, skip)
-    pair, ref_block, inc_block, edge, nx, ny, separation = separations(polygons, pairs)
+                  cornered: np.ndarray | None = None, group: np.ndarray | None = None) -> Contacts:
+    """The interfaces of the configuration (module docstring) between blocks; ``group``: the block of every
+    polygon (the convex pieces of a non-convex block, ``mfp.convex_pieces``; default one polygon per block);
+    ``skip``: blocks whose mutual contacts do not count (the supports: ground against ground); ``cornered``:
+    sorted block pair keys ``a * n + b`` whose corner-on-corner contacts do not count (none when None)."""
+    group = np.arange(polygons.counts.size) if group is None else np.asarray(group)
+    n_block = int(group.max(initial=-1)) + 1
+    pairs = candidate_pairs(polygons, gap, skip, group)
+    pair, ref_polygon, inc_polygon, edge, nx, ny, separation = separations(polygons, pairs)
     # per pair, the edge that separates most (ties: the first)
     best = np.full(pairs.shape[0], -np.inf)
     np.maximum.at(best, pair, separation)
@@ -118,9 +123,10 @@ def find_contacts(polygons: Polygons, skip: np.ndarray, gap: float, overlap: flo
     where = (-1, -1)
     if np.any(best < 0):
         at = np.flatnonzero(separation == -deepest)[0]
-        where = (int(inc_block[at]), int(ref_block[at]))
-    pair, ref_block, inc_block, edge, nx, ny = (v[chosen] for v in (pair, ref_block, inc_block, edge, nx, ny))
-    i0, i1 = incident_edges(polygons, inc_block, nx, ny)
+        where = (int(group[inc_polygon[at]]), int(group[ref_polygon[at]]))
+    pair, ref_polygon, inc_polygon, edge, nx, ny = (v[chosen] for v in (pair, ref_polygon, inc_polygon, edge, nx, ny))
+    i0, i1 = incident_edges(polygons, inc_polygon, nx, ny)
+    ref_block, inc_block = group[ref_polygon], group[inc_polygon]
     x, y = polygons.x, polygons.y
     e1 = polygons.next_node()[edge]
     length = np.hypot(x[e1] - x[edge], y[e1] - y[edge])
@@ -134,7 +140,7 @@ def find_contacts(polygons: Polygons, skip: np.ndarray, gap: float, overlap: flo
         lo, hi = clipped(a, b, low, high, lo, hi)
     touching = lo <= hi
     if cornered is not None:
-        key = np.minimum(ref_block, inc_block) * polygons.counts.size + np.maximum(ref_block, inc_block)
+        key = np.minimum(ref_block, inc_block) * n_block + np.maximum(ref_block, inc_block)
         span = np.abs(hi - lo) * np.hypot(x[i1] - x[i0], y[i1] - y[i0])
         touching &= ~(np.isin(key, cornered) & (span <= 2 * gap))
     lo, hi = lo[touching], hi[touching]

@@ -69,3 +69,15 @@ def test_reaction_history_follows_fdems(wall):
         assert float(incremental.settlement_capacity) == pytest.approx(fdem_fall(fdem), rel=0.15)
     else:  # the same mechanism at the end
         assert float(mf.compare(fdem, incremental).mechanism_cosine) > 0.99
+
+
+@pytest.mark.parametrize("wall", ["lact3-arch", "lact3-wall", "lact3-portal"])
+def test_a_tilting_table_starts_at_las_multiplier(wall):
+    """LACT3's drawn walls on the tilting table (one of them on a non-convex base, taken as its convex pieces):
+    the first configuration's multiplier is la's, and the moved walls carry less."""
+    model = mf.open_model(wall)
+    la = float(mf.solve(model, "la", {}).collapse_multiplier)
+    incremental = mf.solve(model, "la-incremental", {"flow": "associative", "increments": 4})
+    factor = incremental.step_load_factor.values
+    assert factor[0] == pytest.approx(la, rel=1e-7)
+    assert factor[-1] < factor[0]
