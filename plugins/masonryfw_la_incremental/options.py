@@ -10,7 +10,7 @@ OPTIONS = (
     mfp.Option("settlement", float, None,
               "follow the wall to at most this settlement parameter t [m] (under a live load: this largest block "
               "translation); default the model's settlement_target, else a tenth of the wall's height", above=0.0),
-    mfp.Option("step", float, 0.02,
+    mfp.Option("step", float, 0.05,
               "the largest motion of any point of a block in one increment, as a share of the median unit height "
               "(adaptive: halved where blocks would overlap; docs/la.md has the convergence study)",
               above=0.0, at_most=0.5),

@@ -145,7 +145,7 @@ def fall(ref: Reference, controls: Controls, pose: np.ndarray, t: float,
     reach = LANDING_DISTANCE * ref.unit_height + ground_motion(ref, t)
     stride = FALL_STEPS * controls.step
     blocks = np.zeros(0, dtype=np.int64)
-    for _ in range(int(4 * reach / stride) + 50):  # room for the halvings where it touches down
+    for _ in range(int(20 * reach / stride) + 100):  # room for the halvings where it touches down
         intact = intact_joints(ref, pose, intact)
         wall, contacts = wall_at(ref, pose, intact)
         falling = falling_motion(wall, ref.scales)
