@@ -3,7 +3,8 @@
 Registration only (the solve is imported on first use). The method: :mod:`.stepping` (the increments),
 :mod:`.configuration` (a moved wall as la's programme reads it), :mod:`.contacts` (contacts found
 again), :mod:`.motion` (finite rigid motions), :mod:`.history` (the result dataset), :mod:`.solver`
-(the solve function); docs/la.md, section "Displacement capacity".
+(the solve function), :mod:`.estimate` (its time before it starts); docs/la.md, section "Displacement
+capacity".
 """
 from __future__ import annotations
 
@@ -22,5 +23,6 @@ def masonryfw_solvers():
             solve=mfp.lazy("masonryfw_la_incremental.solver:solve"),
             options=OPTIONS,
             gallery=False,
+            estimate=mfp.lazy("masonryfw_la_incremental.estimate:estimate"),
         )
     ]
