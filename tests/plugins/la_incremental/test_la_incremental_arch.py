@@ -48,3 +48,18 @@ def test_spread_at_collapse_and_thrust_against_fdem(thickness_ratio, within):
     grid = np.linspace(0.05 * spread, 0.95 * spread, 20)
     ours = np.interp(grid, incremental.step_settlement.values, incremental.step_reaction.values)
     np.testing.assert_allclose(ours, np.interp(grid, s, thrust), rtol=0.02)
+
+
+@pytest.mark.slow  # 25 s: jmm meshes 40 voussoirs
+def test_jmm_spreads_the_arch_too_and_jmm_limit_says_it_cannot():
+    """Every solver reads a springing that moves out: jmm's thrust as the springings start to spread is la's least
+    thrust plus the elastic arch's (within 10 %); jmm-limit's LP minimises one vertical reaction and refuses,
+    naming the direction."""
+    arch = mt.arch_model(0.15)
+    arch["block_young_modulus"] = ("block", np.full(arch.sizes["block"], 5e9), {"units": "Pa", "long_name": "E"})
+    arch["block_poisson_ratio"] = ("block", np.full(arch.sizes["block"], 0.2), {"units": "1", "long_name": "nu"})
+    least = float(mf.solve(arch, "la", {}).moving_support_reaction)
+    jmm = mf.solve(arch, "jmm", {"settlement": 0.002, "max_steps": 40})
+    assert float(jmm.step_reaction.values[1:].min()) == pytest.approx(least, rel=0.10)
+    with pytest.raises(mf.ModelError, match=r"settlement_direction \[1\.0, 0\.0, 0\.0\]"):
+        mf.solve(arch, "jmm-limit", {})
