@@ -39,10 +39,6 @@ class Polygons:
         local = np.arange(self.x.size) - self.offsets[self.owner]
         return self.offsets[self.owner] + (local + 1) % self.counts[self.owner]
 
-    def previous_node(self) -> np.ndarray:
-        local = np.arange(self.x.size) - self.offsets[self.owner]
-        return self.offsets[self.owner] + (local - 1) % self.counts[self.owner]
-
 
 @dataclass(frozen=True)
 class Contacts:
@@ -55,7 +51,6 @@ class Contacts:
     tangent: np.ndarray
     length: np.ndarray
     overlap: float  # the deepest vertex inside another block [m] (0 when none)
-    overlap_at: tuple[int, int]  # (vertex's block, other block) of the deepest, (-1, -1) when none
 
 
 def candidate_pairs(polygons: Polygons, pad: float, skip: np.ndarray, group: np.ndarray) -> np.ndarray:
@@ -119,11 +114,7 @@ def find_contacts(polygons: Polygons, skip: np.ndarray, gap: float, overlap: flo
     chosen = np.flatnonzero(separation == best[pair])
     chosen = chosen[np.unique(pair[chosen], return_index=True)[1]]
     chosen = chosen[(separation[chosen] <= gap) & (separation[chosen] >= -overlap)]
-    deepest = float(-best[best < 0].min()) if np.any(best < 0) else 0.0
-    where = (-1, -1)
-    if np.any(best < 0):
-        at = np.flatnonzero(separation == -deepest)[0]
-        where = (int(group[inc_polygon[at]]), int(group[ref_polygon[at]]))
+    deepest = float(-best.min(initial=0.0))  # the pair that overlaps most, across its least overlapping face
     pair, ref_polygon, inc_polygon, edge, nx, ny = (v[chosen] for v in (pair, ref_polygon, inc_polygon, edge, nx, ny))
     i0, i1 = incident_edges(polygons, inc_polygon, nx, ny)
     ref_block, inc_block = group[ref_polygon], group[inc_polygon]
@@ -156,7 +147,6 @@ def find_contacts(polygons: Polygons, skip: np.ndarray, gap: float, overlap: flo
         tangent=np.c_[ny, -nx],
         length=np.hypot(ends_x[:, 1] - ends_x[:, 0], ends_y[:, 1] - ends_y[:, 0]),
         overlap=deepest,
-        overlap_at=where,
     )
 
 

@@ -103,20 +103,33 @@ def fastest_point(ref: Reference, mechanism: np.ndarray) -> float:
     return float(speed[masonry].max(initial=0.0))
 
 
-def solved(ref: Reference, pose: np.ndarray, controls: Controls, t: float, intact: np.ndarray) -> Configuration:
-    """The configuration at ``pose``: its contacts and limit state (module docstring).
+class Placed(NamedTuple):
+    """The blocks at a pose: which bonds hold there and the contacts found (found once per pose)."""
 
-    Non-associative joints (the default) take the shear capacity of the normal forces of the configuration's
-    own associative state: the first two LPs of la's non-associative sequence. A joint ``intact`` before that
-    opened or slid past the gap loses its bond here. :class:`DeadLoadNotCarried` when the configuration cannot
-    carry its dead load.
-    """
+    pose: np.ndarray
+    intact: np.ndarray
+    wall: Wall
+    overlap: float
+
+
+def placed(ref: Reference, pose: np.ndarray, intact: np.ndarray) -> Placed:
+    """The wall at ``pose``; a joint ``intact`` before that opened or slid past the gap loses its bond here."""
     intact = intact_joints(ref, pose, intact)
     wall, contacts = wall_at(ref, pose, intact)
-    state = limit_state(wall, ref.scales, controls.solver, controls.tolerance)
+    return Placed(pose, intact, wall, contacts.overlap)
+
+
+def solved(ref: Reference, at: Placed, controls: Controls, t: float) -> Configuration:
+    """The configuration at a placed pose: its limit state (module docstring).
+
+    Non-associative joints (the default) take the shear capacity of the normal forces of the configuration's
+    own associative state: the first two LPs of la's non-associative sequence. :class:`DeadLoadNotCarried`
+    when the configuration cannot carry its dead load.
+    """
+    state = limit_state(at.wall, ref.scales, controls.solver, controls.tolerance)
     if controls.flow == "nonassociative":
-        state = limit_state(wall, ref.scales, controls.solver, controls.tolerance, state.normal)
-    return Configuration(t, pose, wall, state, contacts.overlap, intact)
+        state = limit_state(at.wall, ref.scales, controls.solver, controls.tolerance, state.normal)
+    return Configuration(t, at.pose, at.wall, state, at.overlap, at.intact)
 
 
 def bonded_joints(ref: Reference) -> np.ndarray:
@@ -127,7 +140,7 @@ def bonded_joints(ref: Reference) -> np.ndarray:
 def first_configuration(ref: Reference, controls: Controls) -> Configuration:
     pose = np.zeros((ref.n_block, 3))
     try:
-        return solved(ref, pose, controls, 0.0, bonded_joints(ref))
+        return solved(ref, placed(ref, pose, bonded_joints(ref)), controls, 0.0)
     except DeadLoadNotCarried as error:
         raise mf.SolveError(f"la-incremental: the wall does not stand under its dead load before it moves ({error})") \
             from error
@@ -145,28 +158,27 @@ def fall(ref: Reference, controls: Controls, pose: np.ndarray, t: float,
     reach = LANDING_DISTANCE * ref.unit_height + ground_motion(ref, t)
     stride = FALL_STEPS * controls.step
     blocks = np.zeros(0, dtype=np.int64)
+    here = placed(ref, pose, intact)
     for _ in range(int(20 * reach / stride) + 100):  # room for the halvings where it touches down
-        intact = intact_joints(ref, pose, intact)
-        wall, contacts = wall_at(ref, pose, intact)
-        falling = falling_motion(wall, ref.scales)
+        falling = falling_motion(here.wall, ref.scales)
         speed = fastest_point(ref, falling)
         if speed <= 0:
             break
         blocks = np.flatnonzero(np.abs(falling).max(axis=1) > 1e-6 * np.abs(falling).max())
         if travelled >= reach:
             return Outcome(True, t, f"{falling_text(blocks)} fell {travelled:.3g} m without landing", False)
-        moved = pose_at(ref, pose, falling, shrink * stride / speed, t)
-        if wall_at(ref, moved, intact)[1].overlap > allowed_overlap(ref, contacts.overlap):
+        moved = placed(ref, pose_at(ref, here.pose, falling, shrink * stride / speed, t), here.intact)
+        if moved.overlap > allowed_overlap(ref, here.overlap):
             if shrink < COLLAPSE_RESOLUTION:
                 return Outcome(False, None, f"at {t:.6g} m {falling_text(blocks)} cannot stand in the programme and "
                                             "cannot move without going into another block: a contact the "
                                             "programme does not see (a corner on a corner) holds it", False)
             shrink *= 0.5
             continue
-        pose, travelled = moved, travelled + shrink * stride
+        here, travelled = moved, travelled + shrink * stride
         shrink = min(1.0, 1.5 * shrink)
         try:
-            return solved(ref, pose, controls, t, intact)
+            return solved(ref, here, controls, t)
         except DeadLoadNotCarried:
             continue
         except mf.SolveError as error:
@@ -216,7 +228,7 @@ def run(ref: Reference, controls: Controls, record, progress) -> Outcome:
                 dt = min(dt, 0.5 * (failing[0] - current.t))
             pose = pose_at(ref, current.pose, current.state.motion, dt, current.t + dt)
             try:
-                trial = solved(ref, pose, controls, current.t + dt, current.intact)
+                trial = solved(ref, placed(ref, pose, current.intact), controls, current.t + dt)
             except DeadLoadNotCarried:
                 failing = (current.t + dt, pose)  # from this configuration: a fall once it is this close
                 shrink *= 0.5
