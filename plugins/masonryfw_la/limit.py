@@ -69,6 +69,11 @@ def state_of(wall: assembly.Wall, lp: assembly.KinematicLP, sol: backends.LPSolu
                       forces.shear, reaction, lp, sol)
 
 
+#: A falling motion does at least this share of the most work the dead load could do in the bounds (less is
+#: round-off of a motion that carries it).
+FALLING_WORK_TOLERANCE = 1e-9
+
+
 def falling_motion(wall: assembly.Wall, scales: assembly.Scales) -> np.ndarray:
     """``(block, 3)``: how a configuration that cannot carry its dead load falls, with the supports held.
 
@@ -88,6 +93,6 @@ def falling_motion(wall: assembly.Wall, scales: assembly.Scales) -> np.ndarray:
         bounds[lp.settlement_column] = 0.0
     res = linprog(lp.cost, A_ub=-lp.constraints, b_ub=np.zeros(lp.constraints.shape[0]),
                   A_eq=np.atleast_2d(lp.live), b_eq=np.zeros(1), bounds=bounds, method="highs")
-    if res.status != 0 or not res.fun < 0:
+    if res.status != 0 or not res.fun < -FALLING_WORK_TOLERANCE * np.abs(lp.cost).sum():
         return np.zeros((wall.n_block, 3))
     return (lp.column_map @ res.x[: lp.n_block_columns]).reshape(-1, 3) * scales.dof

@@ -12,7 +12,8 @@ OPTIONS = (
               "translation); default the model's settlement_target, else a tenth of the wall's height", above=0.0),
     mfp.Option("step", float, 0.05,
               "the largest motion of any point of a block in one increment, as a share of the median unit height "
-              "(adaptive: halved where blocks would overlap; docs/la.md has the convergence study)",
+              "(adaptive: halved where blocks would overlap, grown up to 8 times while the mechanism stays the same; "
+              "docs/la.md has the convergence study)",
               above=0.0, at_most=0.5),
     mfp.Option("gap", float, 0.005,
               "a vertex this close to a face of another block (as a share of the median unit height) touches it; "

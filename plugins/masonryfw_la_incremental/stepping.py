@@ -4,7 +4,9 @@ Each increment solves la's programme on the current configuration (:func:`masonr
 associative, then by default non-associative with the associative state's normal forces), moves every block along its mechanism by the exact rigid motion of
 a constant twist (:func:`.motion.screw`) and finds the contacts of the moved configuration. The size
 is adaptive: the fastest point of any block moves ``step`` times the median unit height; a step whose
-blocks overlap by more than the contact gap (or than before it) is halved. A step after which the configuration cannot
+blocks overlap by more than the contact gap (or than before it) is halved; while the mechanism changes so little
+over a step that following its first mechanism moved no point a gap from the trapezoid rule's path, the steps
+grow up to :data:`MAX_GROWTH` times (a grown step that fails is taken again at ``step``). A step after which the configuration cannot
 carry its dead load (the programme is unbounded) brackets the collapse: the bracket is halved until
 the fastest point would move less than :data:`COLLAPSE_RESOLUTION` of a step, and the last
 configuration that stands is the capacity. A failure seen from one configuration is forgotten once a
@@ -37,6 +39,12 @@ MAX_HALVINGS = 30
 LANDING_DISTANCE = 0.5
 #: A fall moves its fastest point this many steps at a time (halved where it would go into a block: it lands).
 FALL_STEPS = 5.0
+#: While the mechanism changes little over a step, the next steps grow by 1.5 up to this many times ``step``.
+MAX_GROWTH = 8.0
+#: "Little": following the step's first mechanism put no point further than this many gaps from where the mean of
+#: its first and last mechanisms would have (half the step times the largest change of a point's velocity: the
+#: error estimate of the trapezoid rule against the forward step taken).
+STEADY_DRIFT = 1.0
 
 
 class Controls(NamedTuple):
@@ -94,6 +102,17 @@ def allowed_overlap(ref: Reference, before: float) -> float:
     """How deep a step may leave a vertex in another block: the gap, or a little more than what a step too
     short to split had already left (a step is judged by what it adds)."""
     return ref.gap if before <= ref.gap else before + OVERLAP_GROWTH * ref.gap
+
+
+def shorter(scale: float) -> float:
+    """The step's share after a step of ``scale`` failed: half of it, or the step itself after a grown one."""
+    return 1.0 if scale > 1.0 else 0.5 * scale
+
+
+def drift(ref: Reference, before: np.ndarray, after: np.ndarray, dt: float) -> float:
+    """How far a step of ``dt`` along ``before`` put a point from where the mean of ``before`` and ``after`` (the
+    mechanisms at its two ends) would have [m]."""
+    return 0.5 * dt * fastest_point(ref, after - before)
 
 
 def fastest_point(ref: Reference, mechanism: np.ndarray) -> float:
@@ -157,14 +176,13 @@ def fall(ref: Reference, controls: Controls, pose: np.ndarray, t: float,
     travelled, shrink = 0.0, 1.0
     reach = LANDING_DISTANCE * ref.unit_height + ground_motion(ref, t)
     stride = FALL_STEPS * controls.step
-    blocks = np.zeros(0, dtype=np.int64)
     here = placed(ref, pose, intact)
+    falling = falling_motion(here.wall, ref.scales)
+    blocks = moving_blocks(falling)
     for _ in range(int(20 * reach / stride) + 100):  # room for the halvings where it touches down
-        falling = falling_motion(here.wall, ref.scales)
         speed = fastest_point(ref, falling)
-        if speed <= 0:
+        if speed <= 0:  # carried with associative joints, not with joints that slide without opening
             break
-        blocks = np.flatnonzero(np.abs(falling).max(axis=1) > 1e-6 * np.abs(falling).max())
         if travelled >= reach:
             return Outcome(True, t, f"{falling_text(blocks)} fell {travelled:.3g} m without landing", False)
         moved = placed(ref, pose_at(ref, here.pose, falling, shrink * stride / speed, t), here.intact)
@@ -177,16 +195,25 @@ def fall(ref: Reference, controls: Controls, pose: np.ndarray, t: float,
             continue
         here, travelled = moved, travelled + shrink * stride
         shrink = min(1.0, 1.5 * shrink)
-        try:
+        falling = falling_motion(here.wall, ref.scales)
+        if falling.any():
+            blocks = moving_blocks(falling)
+            continue
+        try:  # landed: the dead load is carried (falling_motion's programme is the unboundedness test)
             return solved(ref, here, controls, t)
         except DeadLoadNotCarried:
-            continue
+            break
         except mf.SolveError as error:
             return Outcome(False, None, f"the programme failed at {t:.6g} m while {falling_text(blocks)} fell: "
                                         f"{error}", False)
     return Outcome(False, None, f"at {t:.6g} m {falling_text(blocks) if blocks.size else 'a part'} kept falling in "
                                 f"short steps, {travelled:.3g} m in all, neither landing nor falling "
                                 f"{reach:.3g} m: no capacity is claimed", False)
+
+
+def moving_blocks(motion: np.ndarray) -> np.ndarray:
+    """The blocks a motion moves (beyond round-off of its largest component)."""
+    return np.flatnonzero(np.abs(motion).max(axis=1) > 1e-6 * np.abs(motion).max(initial=0.0))
 
 
 def ground_motion(ref: Reference, t: float) -> float:
@@ -204,7 +231,7 @@ def run(ref: Reference, controls: Controls, record, progress) -> Outcome:
     record(current)
     driven = settlement_driven(ref)
     failing: tuple[float, np.ndarray] | None = None  # a parameter (and pose) that does not stand: bracketed
-    shrink = 1.0  # the share of the step the last overlaps or failed solves allow
+    scale = 1.0  # the share of the step the last overlaps or failed solves allow, or its growth while steady
     halvings = 0
     try:
         for _ in range(controls.max_increments):
@@ -223,15 +250,18 @@ def run(ref: Reference, controls: Controls, record, progress) -> Outcome:
                 current, failing = landed, None
                 record(current)
                 continue
-            dt = min(shrink * controls.step / speed, controls.target - current.t)
+            dt = min(scale * controls.step / speed, controls.target - current.t)
             if failing is not None:
                 dt = min(dt, 0.5 * (failing[0] - current.t))
             pose = pose_at(ref, current.pose, current.state.motion, dt, current.t + dt)
             try:
                 trial = solved(ref, placed(ref, pose, current.intact), controls, current.t + dt)
             except DeadLoadNotCarried:
+                if scale > 1.0:  # a grown step that fails is taken again at the step: its growth was a guess
+                    scale = 1.0
+                    continue
                 failing = (current.t + dt, pose)  # from this configuration: a fall once it is this close
-                shrink *= 0.5
+                scale *= 0.5
                 continue
             except LiveLoadUnbounded:
                 return Outcome(False, None, f"at {current.t + dt:.6g} m the wall stands free of the moving supports: "
@@ -240,13 +270,14 @@ def run(ref: Reference, controls: Controls, record, progress) -> Outcome:
                 halvings += 1
                 if halvings > MAX_HALVINGS or dt <= resolution:
                     return Outcome(False, None, f"the programme failed at {current.t + dt:.6g} m: {error}", False)
-                shrink *= 0.5
+                scale = shorter(scale)
                 continue
             if trial.overlap > allowed_overlap(ref, current.overlap) and dt > resolution:
-                shrink *= 0.5  # the step was too long for its contacts: a vertex went into a block
+                scale = shorter(scale)  # the step was too long for its contacts: a vertex went into a block
                 continue
             halvings = 0
-            shrink = min(1.0, 1.5 * shrink)
+            steady = drift(ref, current.state.motion, trial.state.motion, dt) <= STEADY_DRIFT * ref.gap
+            scale = min(MAX_GROWTH if steady else 1.0, 1.5 * scale)
             failing = None  # a failure seen from the last configuration may be the long step's, not the wall's
             current = trial
             record(current)

@@ -33,14 +33,16 @@ def test_the_first_thrust_is_las_least_thrust():
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("thickness_ratio, within", [(0.15, 0.06), (0.2, 0.03)])
-def test_spread_at_collapse_and_thrust_against_fdem(thickness_ratio, within):
+@pytest.mark.parametrize("thickness_ratio, fdem_to, within", [(0.15, 0.17, 0.06), (0.2, 0.33, 0.03)])
+def test_spread_at_collapse_and_thrust_against_fdem(thickness_ratio, fdem_to, within):
+    """fdem runs to a spread of its own, past the fall: its spread at collapse moves with the loading rate its
+    target sets (t/R 0.15: 136.1-136.5 mm over 14 targets from 0.16 to 0.25 m, and 147.0 mm at one, 0.16806 m)."""
     arch = mt.arch_model(thickness_ratio)
     arch["block_young_modulus"] = ("block", np.full(arch.sizes["block"], 5e9), {"units": "Pa", "long_name": "E"})
     arch["block_poisson_ratio"] = ("block", np.full(arch.sizes["block"], 0.2), {"units": "1", "long_name": "nu"})
     incremental = mf.solve(arch, "la-incremental", {"settlement": 0.5})
     spread = float(incremental.settlement_capacity)
-    fdem = mf.solve(arch, "fdem", {"settlement": 1.3 * spread, "plateau_tolerance": 0.0})
+    fdem = mf.solve(arch, "fdem", {"settlement": fdem_to, "plateau_tolerance": 0.0})
     s, thrust = fdem.step_settlement.values, fdem.step_reaction.values
     peak = int(np.argmax(thrust))
     fallen = s[peak + np.flatnonzero(thrust[peak:] < 0.5 * thrust[peak])[0]]  # the thrust is gone: the arch fell

@@ -37,7 +37,7 @@ def reaction_gap(a, b, r0: float) -> float:
 
 DIFFERENT = pytest.mark.xfail(strict=True, reason="the rigid wall's reaction is the least admissible, fdem's the "
                                                   "elastic one (docs/la.md)")
-EARLY = pytest.mark.xfail(strict=True, reason="the pier falls at 67 mm here, at about 84 mm in fdem (docs/la.md)")
+EARLY = pytest.mark.xfail(strict=True, reason="the pier falls at 68 mm here, at about 84 mm in fdem (docs/la.md)")
 
 
 def fdem_fall(result) -> float:
