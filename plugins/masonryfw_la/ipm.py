@@ -36,6 +36,8 @@ import scipy.sparse as sp
 
 import masonryfw.plugin_api as mfp
 
+from . import elimination
+
 MAX_ITERATIONS = 100
 STEP_TO_BOUNDARY = 0.995  # fraction of the step to the boundary of s >= 0, y >= 0
 MAX_CORRECTORS = 2  # Gondzio centrality correctors per iteration
@@ -71,16 +73,19 @@ class NormalMatrix:
         self.G = constraints.tocsr()
         self.Gt = self.G.T.tocsr()
         self.n = self.G.shape[1]
-        self.pattern, pairs = lower_pattern(self.G)
-        self.pairs = pairs.T  # values = pairs @ d
+        self.elimination = elimination.paired_columns(self.G)
+        factored = self.G if self.elimination is None else elimination.reduced_rows(self.G, self.elimination)
+        self.pattern, pairs = lower_pattern(factored)
+        self.pairs = pairs.T  # values = pairs @ d (of the factored rows)
         self.diagonal = diagonal_slots(self.pattern)
         self.d = None
         self.factor = mfp.cholesky_factor(self.pattern)
 
     def factorise(self, d: np.ndarray) -> None:
-        """Factor ``M(d)`` with each diagonal entry raised by ``REGULARISATION`` of itself (more if needed)."""
+        """Factor ``M(d)`` (its Schur complement over the columns not eliminated, :mod:`.elimination`) with each
+        diagonal entry raised by ``REGULARISATION`` of itself (more if needed)."""
         self.d = d
-        values = self.pairs @ d
+        values = self.pairs @ (d if self.elimination is None else elimination.reduced_weights(d, self.elimination))
         diagonal = values[self.diagonal]
         floor = 1e-300 + 1e-30 * diagonal.max(initial=0.0)
         shift = REGULARISATION
@@ -95,15 +100,21 @@ class NormalMatrix:
     def product(self, v: np.ndarray) -> np.ndarray:
         return self.Gt @ (self.d * (self.G @ v))
 
+    def through_factor(self, rhs: np.ndarray) -> np.ndarray:
+        """``M^-1 rhs`` by the factor of the last :meth:`factorise` (its shift included)."""
+        if self.elimination is None:
+            return self.factor.solve(rhs)
+        return elimination.solve(self.factor, self.d, self.elimination, rhs)
+
     def solve(self, rhs: np.ndarray) -> np.ndarray:
         """``M^-1 rhs`` with iterative refinement against the unshifted ``M`` (for the starting point)."""
-        sol = self.factor.solve(rhs)
+        sol = self.through_factor(rhs)
         size = np.abs(rhs).max(initial=0.0)
         for _ in range(REFINEMENT_STEPS):
             residual = rhs - self.product(sol)
             if np.abs(residual).max(initial=0.0) <= 1e-15 * size:
                 break
-            sol += self.factor.solve(residual)
+            sol += self.through_factor(residual)
         return sol
 
 
@@ -186,13 +197,13 @@ class NewtonSystem:
         self.rp, self.ra, self.rd = rp, ra, rd
         self.d = y / (s + weight * y)
         normal.factorise(self.d)
-        self.q = normal.factor.solve(a)
+        self.q = normal.through_factor(a)
         self.aq = dot(a, self.q)
 
     def _through_factor(self, f1, f2, f3) -> tuple[np.ndarray, np.ndarray, float, np.ndarray]:
         """``(dx, dy, dlam, G dx)`` from one solve with the factor."""
         G, Gt, d = self.normal.G, self.normal.Gt, self.d
-        p = self.normal.factor.solve(Gt @ (d * f1) - f2)
+        p = self.normal.through_factor(Gt @ (d * f1) - f2)
         dlam = (f3 - dot(self.a, p)) / self.aq
         dx = p + self.q * dlam
         g_dx = G @ dx
