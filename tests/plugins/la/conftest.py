@@ -138,3 +138,22 @@ def walls():
     return Walls
 
 
+def first_nonassociative_lp(case: str):
+    """The first LP of the non-associative sequence on a bundled wall: capacities from the associative normal
+    forces (HiGHS's vertex)."""
+    from masonryfw_la import assembly, backends, nonassociative
+
+    model = mf.open_model(case)
+    wall = assembly.Wall.from_model(model)
+    scales = assembly.model_scales(model, wall)
+    kin = assembly.interface_kinematics(wall, scales)
+    lp = assembly.assemble(wall, scales, kin)
+    first = backends.solve_lp("highs", lp.cost, lp.constraints, lp.live, 1e-10)
+    normal = nonassociative.end_normal_forces(lp, first.y, wall.n_interface, scales)
+    return assembly.assemble(wall, scales, kin, normal_force=normal)
+
+
+@pytest.fixture
+def nonassociative_lp():
+    """:func:`first_nonassociative_lp`."""
+    return first_nonassociative_lp

@@ -129,24 +129,7 @@ def test_la_ipm_returns_a_stalled_iterate_only_at_the_acceptable_tolerance():
     assert float(lp.cost @ stalled.x) == pytest.approx(exact, rel=1e-9)
 
 
-def nonassociative_lp(name: str):
-    """The non-associative programme of a bundled wall, with the normal forces of its associative optimum."""
-    from masonryfw_la import assembly
-
-    model = mf.open_model(name)
-    wall = assembly.Wall.from_model(model)
-    scales = assembly.model_scales(model, wall)
-    kinematics = assembly.interface_kinematics(wall, scales)
-    first = assembly.assemble(wall, scales, kinematics)
-    forces = backends.solve_lp("highs", first.cost, first.constraints, first.live, 1e-10).y
-    normal = np.zeros(2 * wall.n_interface)
-    # the associative rows (N - mu T, N + mu T) of each dry end: the end's normal force is their sum
-    dry = first.dry_ends.size
-    normal[first.dry_ends] = forces[:dry] + forces[dry:2 * dry]
-    return assembly.assemble(wall, scales, kinematics, normal_force=normal)
-
-
-def test_la_ipm_eliminated_slip_columns_solve_the_whole_normal_matrix():
+def test_la_ipm_eliminated_slip_columns_solve_the_whole_normal_matrix(nonassociative_lp):
     """The slip bounds of a non-associative programme, eliminated from the normal matrix, against a direct sparse
     solve of the whole of it; with weights spanning twenty orders of magnitude, as near an optimum, backward stable
     (a residual at rounding level of ``|M| |x|``)."""
@@ -171,7 +154,7 @@ def test_la_ipm_eliminated_slip_columns_solve_the_whole_normal_matrix():
 
 
 @pytest.mark.parametrize("name", ["test-12c", "panel-3", "facade-1"])
-def test_la_ipm_nonassociative_programme_against_the_highs_vertex(name):
+def test_la_ipm_nonassociative_programme_against_the_highs_vertex(name, nonassociative_lp):
     """The programme whose slip columns the interior point eliminates: the same alpha as HiGHS's simplex."""
     lp = nonassociative_lp(name)
     exact = backends.solve_lp("highs", lp.cost, lp.constraints, lp.live, 1e-10).alpha_primal

@@ -99,27 +99,13 @@ def test_an_iteration_that_does_not_converge_says_so(walls, caplog):
     assert "did not converge" in caplog.text
 
 
-def first_nonassociative_lp(case: str):
-    """The first LP of the sequence on a bundled wall: capacities from the associative normal forces."""
-    from masonryfw_la import assembly, backends, nonassociative
-
-    model = mf.open_model(case)
-    wall = assembly.Wall.from_model(model)
-    scales = assembly.model_scales(model, wall)
-    kin = assembly.interface_kinematics(wall, scales)
-    lp = assembly.assemble(wall, scales, kin)
-    first = backends.solve_lp("highs", lp.cost, lp.constraints, lp.live, 1e-10)
-    normal = nonassociative.end_normal_forces(lp, first.y, wall.n_interface, scales)
-    return assembly.assemble(wall, scales, kin, normal_force=normal)
-
-
 @pytest.mark.parametrize("case", ["test-12c", "panel-1"])
-def test_the_regularised_lp_selects_the_least_squared_normal_forces(case, monkeypatch):
+def test_the_regularised_lp_selects_the_least_squared_normal_forces(case, monkeypatch, nonassociative_lp):
     """One regularised ipm solve gives the LP's alpha and the forces of the selection QP (a second
     formulation: HiGHS's LP, then Clarabel on the optimal face)."""
     from masonryfw_la import backends, ipm, nonassociative
 
-    lp = first_nonassociative_lp(case)
+    lp = nonassociative_lp(case)
     exact = backends.solve_lp("highs", lp.cost, lp.constraints, lp.live, 1e-10)
     monkeypatch.setattr(nonassociative, "SELECTION_TOLERANCE", 1e-10)
     selected = nonassociative.least_compression(lp, exact.alpha_primal, 1e-10)
