@@ -35,8 +35,9 @@ def test_the_first_thrust_is_las_least_thrust():
 @pytest.mark.slow
 @pytest.mark.parametrize("thickness_ratio, fdem_to, within", [(0.15, 0.17, 0.06), (0.2, 0.33, 0.03)])
 def test_spread_at_collapse_and_thrust_against_fdem(thickness_ratio, fdem_to, within):
-    """fdem runs to a spread of its own, past the fall: its spread at collapse moves with the loading rate its
-    target sets (t/R 0.15: 136.1-136.5 mm over 14 targets from 0.16 to 0.25 m, and 147.0 mm at one, 0.16806 m)."""
+    """fdem runs to a spread of its own, past the fall: its spread at collapse moves with its target, which sets
+    the length of its starting ramp (t/R 0.15: 136.1-136.5 mm over 14 targets from 0.16 to 0.25 m, and 147.0 mm
+    at one, 0.16806 m; docs/fdem.md)."""
     arch = mt.arch_model(thickness_ratio)
     arch["block_young_modulus"] = ("block", np.full(arch.sizes["block"], 5e9), {"units": "Pa", "long_name": "E"})
     arch["block_poisson_ratio"] = ("block", np.full(arch.sizes["block"], 0.2), {"units": "1", "long_name": "nu"})
