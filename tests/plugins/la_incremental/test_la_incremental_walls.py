@@ -2,8 +2,8 @@
 
 fdem is a second physics (explicit dynamics, penalty contacts, no limit analysis anywhere): where both
 are quasi-static, the reaction histories agree to a few percent of R0, the blocks end up moving the same
-way, and a wall that falls falls at about the same settlement. Five walls differ for reasons that are the models', not the code's (docs/la.md, "Displacement
-capacity"): they are expected to fail and do.
+way, and a wall that falls starts to fall at about the same settlement. Four walls differ for reasons that are the
+models', not the code's (docs/la.md, "Displacement capacity"): they are expected to fail and do.
 """
 from __future__ import annotations
 
@@ -37,15 +37,19 @@ def reaction_gap(a, b, r0: float) -> float:
 
 DIFFERENT = pytest.mark.xfail(strict=True, reason="the rigid wall's reaction is the least admissible, fdem's the "
                                                   "elastic one (docs/la.md)")
-EARLY = pytest.mark.xfail(strict=True, reason="the pier falls at 68 mm here, at about 84 mm in fdem (docs/la.md)")
 
 
 def fdem_fall(result) -> float:
-    """Where fdem's reaction falls below half of its largest (the wall fell onto the ground), NaN if it does not."""
-    reaction = result.step_reaction.values
-    peak = int(np.argmax(reaction))
-    below = np.flatnonzero(reaction[peak:] < 0.5 * reaction[peak])
-    return float(result.step_settlement.values[peak + below[0]]) if below.size else float("nan")
+    """Where fdem's wall starts to fall, NaN if it does not: from there on its kinetic energy stays above ten times
+    its quasi-static level (the median over the first half of the run). la-incremental's capacity is the last
+    configuration that stands, the start of the fall; fdem's reaction drops only once the part has fallen, a
+    dynamic fall's time later while the ground goes on settling (Panel 5: the energy leaves its level at
+    73-75 mm, the reaction halves at 85 mm)."""
+    settlement, energy = result.step_settlement.values, result.step_kinetic_energy.values
+    level = np.median(energy[settlement <= 0.5 * settlement.max()])
+    above_from_here = np.logical_and.accumulate((energy > 10.0 * level)[::-1])[::-1]
+    start = np.flatnonzero(above_from_here)
+    return float(settlement[start[0]]) if start.size else float("nan")
 
 
 @pytest.mark.parametrize("wall", [
@@ -55,7 +59,7 @@ def fdem_fall(result) -> float:
     pytest.param("panel-2", marks=[pytest.mark.slow, DIFFERENT]),
     pytest.param("panel-3", marks=pytest.mark.slow),
     pytest.param("panel-4", marks=[pytest.mark.slow, DIFFERENT]),
-    pytest.param("panel-5", marks=[pytest.mark.slow, EARLY]),
+    pytest.param("panel-5", marks=pytest.mark.slow),
     pytest.param("facade-1", marks=pytest.mark.slow),
     pytest.param("facade-2", marks=[pytest.mark.slow, DIFFERENT]),
     pytest.param("facade-3", marks=pytest.mark.slow),
