@@ -257,11 +257,9 @@ def run(ref: Reference, controls: Controls, record, progress) -> Outcome:
             try:
                 trial = solved(ref, placed(ref, pose, current.intact), controls, current.t + dt)
             except DeadLoadNotCarried:
-                if scale > 1.0:  # a grown step that fails is taken again at the step: its growth was a guess
-                    scale = 1.0
-                    continue
-                failing = (current.t + dt, pose)  # from this configuration: a fall once it is this close
-                scale *= 0.5
+                if scale <= 1.0:  # a grown step that fails is taken again at the step, not bracketed (a guess)
+                    failing = (current.t + dt, pose)  # from this configuration: a fall once it is this close
+                scale = shorter(scale)
                 continue
             except LiveLoadUnbounded:
                 return Outcome(False, None, f"at {current.t + dt:.6g} m the wall stands free of the moving supports: "
