@@ -20,8 +20,9 @@ OPTIONS = (
               "joints that open wider lose their contact", above=0.0, at_most=0.1),
     mfp.Option("flow", str, "nonassociative",
               "nonassociative: joints slide without opening, against the shear capacity of the normal forces of "
-              "the increment before (one of la's non-associative LPs per increment); associative: la's dilatant "
-              "joints, whose opening by mu |slip| lifts sliding blocks off their contacts after a few increments",
+              "the configuration's own associative state (la's first two non-associative LPs per increment); "
+              "associative: la's dilatant joints, whose opening by mu |slip| lifts sliding blocks off their "
+              "contacts after a few increments",
               ("nonassociative", "associative")),
     mfp.Option("increments", int, 5000, "the largest number of increments", above=0),
     mfp.Option("solver", str, "ipm", "la's LP backend for each increment (masonryfw solve --plugin la)", BACKENDS),
