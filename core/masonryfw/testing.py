@@ -216,7 +216,7 @@ class SolverConformance:
 
     def test_an_interruption_is_honoured(self):
         """A KeyboardInterrupt raised from the first, a middle and the last progress call. The calls are counted
-        on a second solve in this process: a first one may report one-time work (fdem's compilation) once."""
+        on a second solve in this process: a first one may report one-time work (a compilation) once."""
         counted: list[float] = []
         solve(self.conformance_model(), self.solver, self.options,
               progress=lambda fraction, message="": counted.append(fraction))
