@@ -26,6 +26,7 @@ __getattr__, __dir__, __all__ = lazy_loader.attach("masonryfw", submod_attrs={
     "locks": ["claim", "release"],
     "model": ["made_once"],
     "options": ["Option", "parse_option_pairs", "resolve_options", "unknown_name_message"],
+    "polyhedra": ["Contacts", "Polyhedra", "boxes", "face_normals_areas", "find_contacts", "plane_frame", "prisms", "volumes_centroids"],
     "progress": ["ProgressCallback", "interruptible", "no_progress", "progress_bar"],
     "provenance": ["core_version", "options_json", "solver_version"],
     "records": ["Comparator", "Estimate", "Plotter", "Solver", "Variant"],

@@ -1,0 +1,220 @@
+"""Rigid blocks in 3D: polyhedra, their volumes and centroids, and the planar contacts between them.
+
+A set of polyhedra is ragged like the 2D polygons: the vertices of every block one block after another
+(``block_node_count``), its faces one after another (``block_face_count``), each face the list of its block's
+own vertex numbers (``face_node_count``, ``face_nodes``), counter-clockwise seen from outside. z is up, x and
+y are the plan. A face is planar and simple and may be non-convex; a block is closed.
+
+Contacts are found from the faces alone (:func:`find_contacts`): two faces of different blocks touch where
+they lie in one plane (within ``tol``) facing each other, over the common part of their polygons (shapely's
+intersection in the plane). Each common polygon is an interface; its vertices are the contact points where a
+rigid-block programme puts its forces, so that torsion and bending about both axes of the interface come from
+where they are.
+"""
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+
+#: Two faces are parallel when their unit normals differ by less than this (rounded to it).
+NORMAL_TOLERANCE = 1e-7
+
+
+class Polyhedra(NamedTuple):
+    """Blocks as polyhedra: their vertices block after block, their faces as lists of the block's own vertex numbers
+    (counter-clockwise seen from outside)."""
+
+    vertices: np.ndarray  # (node, 3)
+    block_node_count: np.ndarray  # (block,)
+    block_face_count: np.ndarray  # (block,)
+    face_node_count: np.ndarray  # (face,)
+    face_nodes: np.ndarray  # (sum of face_node_count,) the face's vertices, numbered within its block
+
+    @property
+    def n_block(self) -> int:
+        return self.block_node_count.size
+
+    def face_block(self) -> np.ndarray:
+        """The block of every face."""
+        return np.repeat(np.arange(self.n_block), self.block_face_count)
+
+    def face_vertex_index(self) -> np.ndarray:
+        """Every face's vertices as rows of ``vertices`` (the ragged ``face_nodes`` made global)."""
+        first_node = np.concatenate([[0], np.cumsum(self.block_node_count)[:-1]])
+        return self.face_nodes + np.repeat(first_node[self.face_block()], self.face_node_count)
+
+
+class Contacts(NamedTuple):
+    """The planar interfaces between polyhedra; the normal points from side 0 into side 1."""
+
+    sides: np.ndarray  # (interface, 2) blocks
+    normal: np.ndarray  # (interface, 3) unit
+    tangent: np.ndarray  # (interface, 2, 3) two unit tangents, (tangent 0) x (tangent 1) = normal
+    point_count: np.ndarray  # (interface,) vertices of the common polygon
+    points: np.ndarray  # (sum of point_count, 3) its vertices, counter-clockwise about the normal
+    area: np.ndarray  # (interface,)
+
+    @property
+    def n_interface(self) -> int:
+        return self.sides.shape[0]
+
+    def point_interface(self) -> np.ndarray:
+        return np.repeat(np.arange(self.n_interface), self.point_count)
+
+
+def boxes(lower: np.ndarray, upper: np.ndarray) -> Polyhedra:
+    """Axis-aligned boxes from their lower and upper corners ``(block, 3)``."""
+    lower, upper = np.atleast_2d(lower).astype(float), np.atleast_2d(upper).astype(float)
+    corner = np.array([[i & 1, (i >> 1) & 1, (i >> 2) & 1] for i in range(8)])  # x fastest
+    vertices = lower[:, None, :] + corner[None] * (upper - lower)[:, None, :]
+    faces = np.array([[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]])
+    n = lower.shape[0]  # faces: bottom, top, front (y low), back, left (x low), right; outward counter-clockwise
+    return Polyhedra(vertices.reshape(-1, 3), np.full(n, 8), np.full(n, 6), np.full(6 * n, 4), np.tile(faces.ravel(), n))
+
+
+def prisms(node_x: np.ndarray, node_y: np.ndarray, block_node_count: np.ndarray, thickness: np.ndarray) -> Polyhedra:
+    """A wall of 2D polygons (counter-clockwise in x-y, y up) stood in the x-z plane, every block ``thickness`` deep
+    about y = 0: the 3D twin of a planar model (its y is 3D's z)."""
+    counts = np.asarray(block_node_count, dtype=np.int64)
+    first = np.concatenate([[0], np.cumsum(counts)[:-1]])
+    block = np.repeat(np.arange(counts.size), counts)
+    local = np.arange(counts.sum()) - first[block]  # each vertex's number within its polygon
+    count = counts[block]
+    half = 0.5 * np.asarray(thickness, dtype=float)[block]
+    vertices = np.empty((2 * count.size, 3))
+    vertices[2 * first[block] + local] = np.c_[node_x, -half, node_y]  # the front, y = -t/2, then the back
+    vertices[2 * first[block] + count + local] = np.c_[node_x, half, node_y]
+    following = (local + 1) % count
+    sides = np.c_[following, local, count + local, count + following]  # outward, one quad per edge
+    front = local  # counter-clockwise in x-z is clockwise seen from -y: the front's outward normal is -y
+    back = count + (count - 1 - local)
+    per_block = np.concatenate([front, back, sides.ravel()])
+    block_of = np.concatenate([block, block, np.repeat(block, 4)])
+    part = np.concatenate([np.zeros(count.size), np.ones(count.size), np.full(4 * count.size, 2)])
+    order = np.lexsort((np.arange(block_of.size), part, block_of))
+    face_counts = np.full(int((counts + 2).sum()), 4, dtype=np.int64)
+    first_face = np.cumsum(counts + 2) - (counts + 2)
+    face_counts[first_face] = face_counts[first_face + 1] = counts
+    return Polyhedra(vertices, 2 * counts, counts + 2, face_counts, per_block[order].astype(np.int64))
+
+
+def face_normals_areas(poly: Polyhedra) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Every face's unit outward normal (Newell's, right for non-convex faces), area and centroid."""
+    index = poly.face_vertex_index()
+    starts = np.concatenate([[0], np.cumsum(poly.face_node_count)[:-1]])
+    following = np.arange(index.size) + 1
+    following[starts + poly.face_node_count - 1] = starts
+    p, q = poly.vertices[index], poly.vertices[index[following]]
+    doubled = np.add.reduceat(np.cross(p, q), starts, axis=0)  # twice the vector area
+    length = np.linalg.norm(doubled, axis=1)
+    normal = doubled / np.where(length > 0, length, 1.0)[:, None]
+    anchor = np.repeat(p[starts], poly.face_node_count, axis=0)
+    fan = np.einsum("ij,ij->i", np.cross(p - anchor, q - anchor), np.repeat(normal, poly.face_node_count, axis=0))
+    doubled_area = np.add.reduceat(fan, starts)
+    centre = np.add.reduceat(fan[:, None] * (anchor + p + q), starts, axis=0) / 3.0
+    return normal, 0.5 * length, centre / np.where(doubled_area != 0, doubled_area, 1.0)[:, None]
+
+
+def volumes_centroids(poly: Polyhedra) -> tuple[np.ndarray, np.ndarray]:
+    """Every block's volume and centroid: the signed tetrahedra of its faces' fans with its first vertex."""
+    index = poly.face_vertex_index()
+    starts = np.concatenate([[0], np.cumsum(poly.face_node_count)[:-1]])
+    following = np.arange(index.size) + 1
+    following[starts + poly.face_node_count - 1] = starts
+    block_of_vertex = np.repeat(poly.face_block(), poly.face_node_count)
+    first_node = np.concatenate([[0], np.cumsum(poly.block_node_count)[:-1]])
+    origin = poly.vertices[first_node][block_of_vertex]
+    anchor = np.repeat(poly.vertices[index[starts]], poly.face_node_count, axis=0)
+    a, b, c = anchor - origin, poly.vertices[index] - origin, poly.vertices[index[following]] - origin
+    six_volume = np.einsum("ij,ij->i", a, np.cross(b, c))
+    volume = np.bincount(block_of_vertex, six_volume, minlength=poly.n_block) / 6.0
+    moment = np.stack([np.bincount(block_of_vertex, six_volume * (a + b + c)[:, k], minlength=poly.n_block)
+                       for k in range(3)], axis=1) / 24.0
+    return volume, poly.vertices[first_node] + moment / np.where(volume != 0, volume, 1.0)[:, None]
+
+
+def plane_frame(normal: np.ndarray) -> np.ndarray:
+    """``(n, 2, 3)``: two unit tangents of each unit normal, horizontal first (x for a horizontal plane), with
+    (tangent 0) x (tangent 1) = normal."""
+    up = np.array([0.0, 0.0, 1.0])
+    first = np.cross(up, normal)
+    size = np.linalg.norm(first, axis=1)
+    first = np.where(size[:, None] > NORMAL_TOLERANCE, first / np.where(size > 0, size, 1.0)[:, None],
+                     np.array([1.0, 0.0, 0.0]) * np.sign(normal[:, 2:3] + (normal[:, 2:3] == 0)))
+    return np.stack([first, np.cross(normal, first)], axis=1)
+
+
+def _canonical_planes(normal: np.ndarray, centre: np.ndarray, tol: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Each face's plane (one number for the faces in one plane within ``tol``, whichever way they face), the
+    plane's normal, and +1 / -1 as the face's outward normal is that normal or its opposite."""
+    leading = np.argmax(np.abs(normal) > NORMAL_TOLERANCE, axis=1)
+    sign = np.sign(normal[np.arange(normal.shape[0]), leading])
+    direction = normal * sign[:, None]
+    _, group = np.unique(np.round(direction / NORMAL_TOLERANCE).astype(np.int64), axis=0, return_inverse=True)
+    group = group.ravel()
+    offset = np.einsum("ij,ij->i", direction, centre)
+    order = np.lexsort((offset, group))
+    new_plane = np.ones(order.size, dtype=bool)
+    new_plane[1:] = (group[order][1:] != group[order][:-1]) | (np.diff(offset[order]) > tol)
+    plane = np.empty(order.size, dtype=np.int64)
+    plane[order] = np.cumsum(new_plane) - 1
+    return plane, direction, sign
+
+
+def find_contacts(poly: Polyhedra, tol: float) -> Contacts:
+    """The interfaces of ``poly`` (module docstring): faces of two blocks in one plane within ``tol`` facing each
+    other, over a common polygon whose extent in the plane exceeds ``tol`` both ways."""
+    import shapely
+
+    normal, _, centre = face_normals_areas(poly)
+    plane, direction, sign = _canonical_planes(normal, centre, tol)
+    block = poly.face_block()
+    frame = plane_frame(direction)
+    index = poly.face_vertex_index()
+    face_of_vertex = np.repeat(np.arange(block.size), poly.face_node_count)
+    uv = np.einsum("ij,ikj->ik", poly.vertices[index], frame[face_of_vertex])  # in-plane coordinates
+    starts = np.concatenate([[0], np.cumsum(poly.face_node_count)[:-1]])
+    low = np.minimum.reduceat(uv, starts, axis=0)
+    high = np.maximum.reduceat(uv, starts, axis=0)
+
+    plus, minus = np.flatnonzero(sign > 0), np.flatnonzero(sign < 0)
+    minus = minus[np.argsort(plane[minus], kind="stable")]
+    first = np.searchsorted(plane[minus], plane[plus], side="left")
+    last = np.searchsorted(plane[minus], plane[plus], side="right")
+    counts = last - first
+    a = np.repeat(plus, counts)
+    b = minus[np.repeat(last - counts.cumsum(), counts) + np.arange(counts.sum())] if counts.sum() else minus[:0]
+    overlap = np.minimum(high[a], high[b]) - np.maximum(low[a], low[b])
+    keep = (block[a] != block[b]) & (overlap > tol).all(axis=1)
+    a, b = a[keep], b[keep]
+    faces = np.unique(np.concatenate([a, b]))
+    polygon = np.empty(block.size, dtype=object)
+    polygon[faces] = [shapely.Polygon(uv[starts[f]:starts[f] + poly.face_node_count[f]]) for f in faces]
+    common = shapely.intersection(polygon[a], polygon[b])
+    parts, pair = shapely.get_parts(common, return_index=True)
+    parts = np.asarray(shapely.simplify(parts, 1e-6 * tol))
+    polygonal = shapely.get_type_id(parts) == 3
+    bounds = shapely.bounds(parts)
+    wide = polygonal & (bounds[:, 2] - bounds[:, 0] > tol) & (bounds[:, 3] - bounds[:, 1] > tol)
+    parts, pair = parts[wide], pair[wide]
+    return _contacts(parts, a[pair], b[pair], block, direction, frame, centre)
+
+
+def _contacts(parts, plus_face, minus_face, block, direction, frame, centre) -> Contacts:
+    """The interfaces of the common polygons ``parts`` of faces ``plus_face`` (side 0) and ``minus_face``."""
+    import shapely
+
+    rings = [np.asarray(shapely.geometry.polygon.orient(p, 1.0).exterior.coords)[:-1] for p in parts]
+    holes = [[np.asarray(r.coords)[:-1] for r in p.interiors] for p in parts]
+    uv = [np.concatenate([ring, *inner]) for ring, inner in zip(rings, holes)]
+    count = np.array([len(points) for points in uv], dtype=np.int64)
+    tangent = frame[plus_face]
+    normal = direction[plus_face]
+    level = 0.5 * (np.einsum("ij,ij->i", normal, centre[plus_face]) + np.einsum("ij,ij->i", normal, centre[minus_face]))
+    flat = np.concatenate(uv) if uv else np.zeros((0, 2))
+    owner = np.repeat(np.arange(count.size), count)
+    points = (level[owner, None] * normal[owner] + flat[:, :1] * tangent[owner, 0] + flat[:, 1:] * tangent[owner, 1])
+    area = np.asarray(shapely.area(parts), dtype=float) if len(parts) else np.zeros(0)
+    sides = np.c_[block[plus_face], block[minus_face]].astype(np.int64).reshape(-1, 2)
+    return Contacts(sides, normal.reshape(-1, 3), tangent.reshape(-1, 2, 3), count, points.reshape(-1, 3), area)
