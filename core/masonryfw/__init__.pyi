@@ -5,7 +5,15 @@ from .api import SolvePlan, compare, estimate, plot_table, render, solve, solve_
 from .builder import STAND_IN_GROUND, build, load_spec, load_wall
 from .checks import Problem, check
 from .damage import DAMAGE_LIMITS, Cracks, damage_category, widest_crack
-from .datasets import BUNDLED_NAMES, CASE_NAMES, DRAWN_NAMES, PROFILE_NAMES, bundled_cases, bundled_spec_path
+from .datasets import (
+    BUILDING_NAMES,
+    BUNDLED_NAMES,
+    CASE_NAMES,
+    DRAWN_NAMES,
+    PROFILE_NAMES,
+    bundled_cases,
+    bundled_spec_path,
+)
 from .describe import describe_model
 from .errors import Interrupted, MasonryError, ModelError, PluginError, SolveError, SpecError
 from .ground import ground_model, over_profile
@@ -28,7 +36,7 @@ __all__ = [
     # Models: from a spec, a drawing, a file or a bundled case
     "STAND_IN_GROUND", "build", "load_spec", "load_wall", "dump_toml",
     "open_model", "open_checked", "checked_model", "describe_model",
-    "BUNDLED_NAMES", "CASE_NAMES", "DRAWN_NAMES", "PROFILE_NAMES", "bundled_cases", "bundled_spec_path",
+    "BUILDING_NAMES", "BUNDLED_NAMES", "CASE_NAMES", "DRAWN_NAMES", "PROFILE_NAMES", "bundled_cases", "bundled_spec_path",
     "Profile", "model_profile", "settlement_profile", "ground_model", "over_profile",
     "detect_interfaces", "Problem", "check", "PlausibilityWarning", "plausibility",
     # Solving, comparing, drawing

@@ -19,6 +19,7 @@ from .errors import MasonryError, ModelError, PluginError, SolveError
 from .io import CONVENTIONS, add_history, content_sha256
 from .lazy import resolved as resolved_function
 from .model import checked_model, contents_digest, made_once
+from .model3d import require_space, space
 from .options import resolve_options
 from .progress import ProgressCallback, no_progress
 from .provenance import core_version, input_hash, options_json, plugin_version, record_version
@@ -35,6 +36,7 @@ from .semantics import (
     indicator_attrs,
     plastic_crack_indicator,
 )
+from .semantics3d import derived_variables_3d
 
 _VALID = "masonryfw_valid"  # encoding key: (kind, contents digest) of an input found valid
 
@@ -127,8 +129,8 @@ def _derive_comparable_fields(name: str, model: xr.Dataset, produced: xr.Dataset
             )
     if "block_rotation" not in produced:
         raise SolveError(f"solver {name} returned block_displacement without block_rotation (docs/format.md)")
-    derived = derived_variables(model, block_motion(produced), produced.attrs["rotations"],
-                                produced.attrs["flow_rule"])
+    derive = derived_variables_3d if space(model) == 3 else derived_variables
+    derived = derive(model, block_motion(produced), produced.attrs["rotations"], produced.attrs["flow_rule"])
     return produced.assign(derived)
 
 
@@ -194,6 +196,11 @@ def solve_plan(model: xr.Dataset, plugin: str, options: Mapping[str, Any] | None
     model = checked_model(model)
     item = lookup("solver", plugin)
     solver: Solver = item.record
+    if space(model) not in solver.spaces:
+        solves = " and ".join(f"{d}D" for d in solver.spaces)
+        raise SolveError(f"solver {solver.name} solves {solves} models; {model.attrs.get('title', 'this model')!r} "
+                         f"is {space(model)}D (masonryfw_space = {space(model)}): solve it with a solver that "
+                         f"declares {space(model)}D (masonryfw plugins)")
     resolved = resolve_options(f"solver {solver.name!r}", solver.options, dict(options or {}))
     return SolvePlan(model, item, resolved, _checked_estimate(solver, model, resolved))
 
@@ -257,6 +264,7 @@ def compare(
     """
     item = lookup("comparator", comparator)
     record: Comparator = item.record
+    require_space((a, b), record.spaces, f"comparator {record.name}")
     resolved = resolve_options(f"comparator {record.name!r}", record.options, dict(options or {}))
     for label, ds in (("A", a), ("B", b)):
         _require_valid_input(ds, f"result {label}", kind="result")
@@ -307,18 +315,20 @@ def render(
     Returns the figure.
     """
     record: Plotter = lookup("plotter", kind).record
-    resolved = resolve_options(f"plotter {record.name!r}", record.options, dict(options or {}))
     datasets = list(datasets)
+    require_space(datasets, record.spaces, f"the {record.name} plot")
+    resolved = resolve_options(f"plotter {record.name!r}", record.options, dict(options or {}))
     if ax is None:
         from matplotlib.figure import Figure
 
         width = max(FIGURE_SIZE[0], PANEL_WIDTH * len(datasets)) if record.side_by_side else FIGURE_SIZE[0]
         ax = Figure(figsize=size or (width, FIGURE_SIZE[1]), layout="constrained").add_subplot()
+    figure = ax.figure  # kept: a kind may put other axes in the place of ``ax`` (a 3D model's axonometry)
     _call_plugin("plotter", record.name, record.plot, datasets, ax, resolved)
     if size is not None:  # asked for: it wins over a size the kind chose for itself
-        ax.figure.set_size_inches(*size)
-        _fit_text(ax.figure)
-    return ax.figure
+        figure.set_size_inches(*size)
+        _fit_text(figure)
+    return figure
 
 
 #: The smallest share of its size a figure's text is scaled to, to fit a page asked for.
@@ -368,5 +378,7 @@ def plot_table(
         with_tables = sorted(name for name, item in by_name("plotter").items() if item.record.table is not None)
         raise PluginError(f"the {record.name} plot draws no curves to write as CSV; kinds with curves: "
                           f"{', '.join(with_tables) or 'none installed'}")
+    datasets = list(datasets)
+    require_space(datasets, record.spaces, f"the {record.name} plot")
     resolved = resolve_options(f"plotter {record.name!r}", record.options, dict(options or {}))
-    return _call_plugin("plotter", record.name, record.table, list(datasets), resolved)
+    return _call_plugin("plotter", record.name, record.table, datasets, resolved)

@@ -42,11 +42,13 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from . import blocks
+from .building import build_building, is_building
 from .errors import SpecError
 from .imported import build_drawn, is_drawn, parse_drawn_spec, resolved_drawing
 from .inputs import fits_in_memory
 from .material import Material
 from .model import checked_model
+from .model3d import twin
 from .outlined import build_outlined, is_outlined
 from .plausibility import warn_implausible
 from .profiles import SETTLEMENT_KEYS, Profile, read_profile, with_profile
@@ -160,7 +162,7 @@ class Wall:
         return POSITION_TOLERANCE * max(self.width, self.height)
 
 
-_TOP_KEYS = ("title", "description", "length_unit", "wall", "unit", "bond", "material",
+_TOP_KEYS = ("title", "description", "space", "length_unit", "wall", "unit", "bond", "material",
              "openings", "supports", "settlement", "loading")
 _OPENING_KEYS = ("x", "y", "width", "height", "lintel_bearing")
 _SUPPORT_KEYS = ("kind", "start", "end", "motion", "pivot", "rate")
@@ -406,11 +408,19 @@ def build(spec, *, validate: bool = True) -> xr.Dataset:
     Blocks come course by course, left to right (units and lintels), then the
     supports in spec order; interfaces, kinds and loads as every model gets them
     (:mod:`masonryfw.blocks`). Raises :class:`SpecError` naming the key at fault.
+    ``space = 3`` builds the wall one block thick in 3D (:func:`masonryfw.model3d.twin`).
     The model is returned checked (:func:`masonryfw.checked_model`), unless
     ``validate`` is False. Values outside the range of real masonry give a
     :class:`masonryfw.PlausibilityWarning` each (:mod:`masonryfw.plausibility`).
     """
     spec_dict, text, base_dir = read_spec(spec)
+    space = spec_dict.get("space", 2)
+    if space not in (2, 3) or isinstance(space, bool):
+        raise SpecError(f"space: must be 2 (the wall in its plane) or 3 (the wall one block thick in 3D), not {space!r}")
+    if is_building(spec_dict):
+        model = build_building(spec_dict, text)
+        warn_implausible(model)
+        return checked_model(model, repr(model.attrs["title"])) if validate else model
     if is_outlined(spec_dict):
         model = build_outlined(spec_dict, text, base_dir, validate)
     elif is_drawn(spec_dict):
@@ -418,6 +428,9 @@ def build(spec, *, validate: bool = True) -> xr.Dataset:
     else:
         model = _build_parametric(spec_dict, text, validate)
     warn_implausible(model)
+    if space == 3:
+        model = twin(model)
+        return checked_model(model, repr(model.attrs["title"])) if validate else model
     return model
 
 

@@ -37,9 +37,11 @@ from .geometry import (
     polygon_area_centroid,
     vertex_turns,
 )
+from .model3d import polygon_normals, polyhedra_of, space
 from .overlaps import overlapping_blocks, self_intersections
+from .polyhedra import volumes_centroids
 from .roles import moving_blocks, support_blocks
-from .schema import FORMAT_VERSION, KINDS, READABLE_VERSIONS, load_schema
+from .schema import FORMAT_VERSION, KINDS, KINDS_3D, READABLE_VERSIONS, load_schema
 
 if TYPE_CHECKING:  # annotations only
     import xarray as xr
@@ -77,13 +79,17 @@ def check(ds: xr.Dataset, kind: str | None = None, *, model_checked: bool = Fals
     if kind is None or not _version_is_known(ds, problems):
         return problems
     ds = upgrade(ds)
-    schema = load_schema(kind)
+    in_3d = kind in KINDS_3D and space(ds) == 3
+    schema = load_schema(KINDS_3D[kind] if in_3d else kind)
     if model_checked:
-        return _added_variable_problems(ds, schema, kind)
+        return _added_variable_problems(ds, schema, kind, "model3d" if in_3d else "model")
     problems += _attribute_problems(ds, schema, kind)
     problems += _dimension_problems(ds, schema)
     usable, structure = _variable_structure_problems(ds, schema)
     problems += structure
+    if in_3d:
+        return (problems + _value_problems(ds, schema, usable, None) + _polyhedron_problems(ds, usable)
+                + _support_problems(ds, usable, None) + _load_problems(ds, usable))
     model = _ModelGeometry.from_dataset(ds, usable, problems)
     problems += _value_problems(ds, schema, usable, model)
     if model is not None:
@@ -96,9 +102,9 @@ def check(ds: xr.Dataset, kind: str | None = None, *, model_checked: bool = Fals
     return problems
 
 
-def _added_variable_problems(ds, schema, kind) -> list[Problem]:
+def _added_variable_problems(ds, schema, kind, model_kind: str) -> list[Problem]:
     """The format layer for the variables a result adds to its (checked) model."""
-    model_variables = load_schema("model")["variables"]
+    model_variables = load_schema(model_kind)["variables"]
     added = {**schema, "variables": {n: v for n, v in schema["variables"].items() if n not in model_variables}}
     problems = _attribute_problems(ds, added, kind)
     usable, structure = _variable_structure_problems(ds, added)
@@ -581,6 +587,72 @@ def _support_problems(ds, usable, model) -> list[Problem]:
             *where(b),
         ))
     return problems
+
+
+_RAGGED_3D = (("block_node_count", "node"), ("block_face_count", "face"), ("face_node_count", "face_node"),
+              ("interface_node_count", "interface_node"))
+
+
+def _polyhedron_problems(ds, usable) -> list[Problem]:
+    """A 3D model's layout: the ragged counts add up, faces name their own block's vertices, every block is a
+    closed polyhedron with its faces outward (a positive volume), every interface joins two blocks over a
+    polygon of positive area."""
+    problems = [Problem(f"variable {name}", f"adds up to {int(ds[name].values.sum())}, but dimension {dim} has "
+                                            f"{ds.sizes.get(dim, 0)}")
+                for name, dim in _RAGGED_3D if name in usable and int(ds[name].values.sum()) != ds.sizes.get(dim, 0)]
+    layout = {"block_node_count", "block_face_count", "face_node_count", "face_nodes", "node_x", "node_y", "node_z"}
+    if problems or not layout <= usable:
+        return problems
+    poly = polyhedra_of(ds)
+    nodes_of_face = np.repeat(poly.block_node_count[poly.face_block()], poly.face_node_count)
+    for k in np.flatnonzero(poly.face_nodes >= nodes_of_face)[:1]:
+        face = int(np.searchsorted(np.cumsum(poly.face_node_count), k, side="right"))
+        problems.append(Problem(f"face {face}", f"names vertex {int(poly.face_nodes[k])} of block "
+                                                f"{int(poly.face_block()[face])}, which has {int(nodes_of_face[k])}"))
+    if problems:
+        return problems
+    unmatched = unmatched_edges(poly)
+    if unmatched.size:
+        face = int(np.searchsorted(np.cumsum(poly.face_node_count), unmatched[0], side="right"))
+        problems.append(Problem(f"block {int(poly.face_block()[face])}",
+                                f"face {face} has an edge no other face of the block runs the other way "
+                                f"({unmatched.size} such edges in the model): the block is not closed, or a face "
+                                "is not counter-clockwise seen from outside"))
+        return problems
+    volume, _ = volumes_centroids(poly)
+    for b in np.flatnonzero(~(volume > 0)):
+        problems.append(Problem(f"block {b}", f"has volume {volume[b]:.6g} m3: not a closed polyhedron with its "
+                                              "faces counter-clockwise seen from outside"))
+    if {"interface_blocks", "interface_node_count", "interface_node_x", "interface_node_y",
+            "interface_node_z"} <= usable and ds.sizes.get("interface", 0):
+        sides = ds["interface_blocks"].values.astype(np.int64).reshape(-1, 2)
+        wrong = ((sides < 0) | (sides >= volume.size)).any(axis=1) | (sides[:, 0] == sides[:, 1])
+        for i in np.flatnonzero(wrong):
+            problems.append(Problem(f"interface {i}", f"joins blocks {sides[i].tolist()}: two different blocks of "
+                                                      f"the {volume.size} are needed"))
+        _, area = contacts_area(ds)
+        for i in np.flatnonzero(~wrong & ~(area > 0)):
+            problems.append(Problem(f"interface {i}", "has a polygon of zero area"))
+    return problems
+
+
+def unmatched_edges(poly) -> np.ndarray:
+    """The positions in ``face_nodes`` of the face edges (a vertex to the next) that no other face runs back."""
+    index = poly.face_vertex_index()
+    following = index[next_node(poly.face_node_count)]
+    n = poly.vertices.shape[0]
+    forward = index * n + following
+    backward = following * n + index
+    order = np.sort(forward)
+    at = np.clip(np.searchsorted(order, backward), 0, max(order.size - 1, 0))
+    once = np.searchsorted(order, forward, side="right") - np.searchsorted(order, forward, side="left") == 1
+    return np.flatnonzero((order[at] != backward) | ~once) if order.size else np.zeros(0, dtype=np.int64)
+
+
+def contacts_area(ds):
+    """Normals and areas of a 3D model's interface polygons."""
+    points = np.c_[ds["interface_node_x"].values, ds["interface_node_y"].values, ds["interface_node_z"].values]
+    return polygon_normals(points.astype(float), ds["interface_node_count"].values.astype(np.int64))
 
 
 def _dof_labels(ds) -> np.ndarray:

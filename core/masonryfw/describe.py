@@ -6,6 +6,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from .geometry import block_bounds, node_block
+from .model3d import space
 from .profiles import Profile, model_profile
 from .roles import ROLE, masonry_blocks, support_blocks
 from .schema import flags
@@ -16,6 +17,8 @@ if TYPE_CHECKING:  # annotations only
 
 def describe_model(model: xr.Dataset) -> list[str]:
     """The lines that describe ``model`` (a checked model: its derived geometry is read)."""
+    if space(model) == 3:
+        return describe_model_3d(model)
     masonry = masonry_blocks(model.block_role.values)
     owner = node_block(model.block_node_count.values)
     x, y = model.node_x.values[masonry[owner]], model.node_y.values[masonry[owner]]
@@ -32,6 +35,34 @@ def describe_model(model: xr.Dataset) -> list[str]:
     notes = [f"  {note}" for note in str(model.attrs.get("laying_notes", "")).splitlines() if note]
     return lines + (["laid in its outline:", *notes] if notes else []) + ["supports:", *_support_lines(model), "loads:",
                                                                           *_load_lines(model)]
+
+
+def describe_model_3d(model: xr.Dataset) -> list[str]:
+    """A 3D model's lines: its counts, the extent of its masonry, its supports and the sums of its loads."""
+    role = model.block_role.values
+    masonry = masonry_blocks(role)
+    owner = np.repeat(np.arange(role.size), model.block_node_count.values)
+    points = np.c_[model.node_x.values, model.node_y.values, model.node_z.values][masonry[owner]]
+    lines = [f"title: {model.attrs.get('title', '')}", "space: 3D",
+             f"blocks: {model.sizes['block']} ({_counts(role, 'block_role')})",
+             f"interfaces: {model.sizes.get('interface', 0)} ({_counts(model.interface_kind.values, 'interface_kind')})"]
+    if points.size:
+        low, high = points.min(axis=0), points.max(axis=0)
+        lines.append("masonry: " + ", ".join(f"{c} {a:.6g}..{b:.6g} m" for c, a, b in zip("xyz", low, high))
+                     + f"; volume {model.block_volume.values[masonry].sum():.6g} m3")
+    supports = support_blocks(role)
+    moving = role == ROLE["moving_support"]
+    lines += ["supports:", f"  {int((supports & ~moving).sum())} fixed, {int(moving.sum())} moving (settlement "
+                           "direction per unit t over ux uy uz rx ry rz)"]
+    lines += [f"  block {b}: settlement direction ({', '.join(f'{d:.4g}' for d in model.settlement_direction.values[b])})"
+              for b in np.flatnonzero(moving)[:10]]
+    lines.append("loads:")
+    for name in ("dead_load", "live_load"):
+        for label, rows in (("masonry", ~supports), ("supports", supports)):
+            total = model[name].values[rows].sum(axis=0)
+            lines.append(f"  {name.replace('_', ' ')} on {label}: "
+                         + ", ".join(f"F{c} = {v:.6g} N" for c, v in zip("xyz", total)))
+    return lines
 
 
 #: Flags a count names only where some block has them (few walls have arches).

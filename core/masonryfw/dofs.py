@@ -23,19 +23,20 @@ MOTION_VARIABLES = ("block_displacement", "block_rotation")
 
 
 def _stacked(ds: xr.Dataset, planar: str, rotational: str) -> np.ndarray:
-    vector = np.zeros((ds.sizes["block"], 3))
-    vector[:, :2] = np.asarray(ds[planar].values, dtype=float)
-    vector[:, 2] = np.asarray(ds[rotational].values, dtype=float)
-    return vector
+    n = ds.sizes["block"]
+    return np.concatenate([np.asarray(ds[planar].values, dtype=float).reshape(n, -1),
+                           np.asarray(ds[rotational].values, dtype=float).reshape(n, -1)], axis=1)
 
 
 def block_loads(ds: xr.Dataset, which: str) -> np.ndarray:
-    """``(block, 3)`` = force x, force y [N], moment [N m] of the ``dead`` or ``live`` load."""
+    """``(block, 3)`` = force x, force y [N], moment [N m] of the ``dead`` or ``live`` load; ``(block, 6)`` = force
+    (x, y, z) and moment (x, y, z) of a 3D model's."""
     return _stacked(ds, *LOAD_VARIABLES[which])
 
 
 def block_motion(ds: xr.Dataset) -> np.ndarray:
-    """``(block, 3)`` = displacement x, y [m] of the centroid and rotation [rad] of a result."""
+    """``(block, 3)`` = displacement x, y [m] of the centroid and rotation [rad] of a result; ``(block, 6)`` of a
+    3D one."""
     return _stacked(ds, *MOTION_VARIABLES)
 
 

@@ -240,7 +240,7 @@ def interface_frame(interface_x, interface_y, side0, node_x, node_y, block_node_
     return length, nx, ny, ny, -nx
 
 
-#: Variables added by :func:`derive_geometry`: recomputed on every load, never
+#: Variables added by :func:`derive_planar_geometry`: recomputed on every load, never
 #: trusted from a file, and left out of the content hash.
 DERIVED_GEOMETRY_VARIABLES = (
     "block_area",
@@ -254,11 +254,9 @@ DERIVED_GEOMETRY_VARIABLES = (
 )
 
 
-def derive_geometry(ds: xr.Dataset) -> xr.Dataset:
-    """Return ``ds`` with block areas, centroids, interface lengths, normals and tangents.
-
-    Always recomputed from the vertices: values stored in a file are never trusted.
-    """
+def derive_planar_geometry(ds: xr.Dataset) -> xr.Dataset:
+    """Return the 2D model ``ds`` with block areas, centroids, interface lengths, normals and tangents
+    (:func:`masonryfw.derived.derive_geometry` for a model of either dimension)."""
     area, cx, cy = polygon_area_centroid(ds.node_x.values, ds.node_y.values, ds.block_node_count.values)
     out = ds.assign(
         block_area=("block", area, {"units": "m2", "long_name": "block area (derived)"}),

@@ -14,8 +14,9 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from . import blocks
+from .derived import derive_geometry
 from .errors import SpecError
-from .geometry import block_bounds, derive_geometry
+from .geometry import block_bounds
 from .material import Material
 from .profiles import Profile, node_motion, segment_count, with_profile
 from .roles import ROLE, masonry_blocks, support_blocks

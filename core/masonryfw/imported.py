@@ -54,7 +54,7 @@ if TYPE_CHECKING:  # annotations only
 LAYER_ROLES = ("unit", "lintel", "ignore")
 _BLOCK = re.compile(r"\bblock (\d+)\b")
 SELECTIONS = ("lowest", "leftmost", "rightmost")
-_TOP_KEYS = ("title", "description", "length_unit", "geometry", "wall", "material", "supports", "settlement",
+_TOP_KEYS = ("title", "description", "space", "length_unit", "geometry", "wall", "material", "supports", "settlement",
              "loading")
 #: The keys a drawn wall's ``[settlement]`` takes beside a profile's: which drawn blocks are the ground.
 GROUND_KEYS = ("ground_layer", "ground_select")

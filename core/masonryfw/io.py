@@ -26,9 +26,9 @@ import numpy as np
 import xarray as xr
 
 from . import locks, signals
+from .derived import DERIVED_VARIABLES
 from .dofs import upgrade
 from .errors import MasonryError, ModelError
-from .geometry import DERIVED_GEOMETRY_VARIABLES
 from .inputs import HDF5_SIGNATURE, file_kind, fits_in_memory, is_netcdf, regular_file, was_read
 from .schema import load_schema, variable_attrs
 from .version import __version__
@@ -114,7 +114,7 @@ def content_sha256(ds: xr.Dataset) -> str:
     digest = hashlib.sha256()
     _feed(digest, b"attributes")
     _feed_attrs(digest, {k: v for k, v in normal.attrs.items() if k != "history"})
-    names = sorted(str(n) for n in normal.variables if n not in DERIVED_GEOMETRY_VARIABLES)
+    names = sorted(str(n) for n in normal.variables if n not in DERIVED_VARIABLES)
     for name in names:
         variable = normal.variables[name]
         dtype_tag, data = _variable_bytes(np.asarray(variable.values))

@@ -13,9 +13,10 @@ import numpy as np
 import xarray as xr
 
 from .checks import check
+from .derived import DERIVED_VARIABLES, derive_geometry
 from .dofs import upgrade
 from .errors import ModelError
-from .geometry import DERIVED_GEOMETRY_VARIABLES, derive_geometry
+from .model3d import space
 from .schema import load_schema
 
 SPEC_SUFFIXES = (".toml",)
@@ -35,8 +36,8 @@ def model_part(ds: xr.Dataset) -> xr.Dataset:
     ds = upgrade(ds)
     if ds.attrs.get("masonryfw_format") != "result":
         return ds
-    schema = load_schema("model")
-    keep_vars = set(schema["variables"]) | set(DERIVED_GEOMETRY_VARIABLES)
+    schema = load_schema("model3d" if space(ds) == 3 else "model")
+    keep_vars = set(schema["variables"]) | set(DERIVED_VARIABLES)
     keep_attrs = set(schema["global_attributes"]) | set(_DESCRIPTIVE_ATTRIBUTES)
     model = ds.drop_vars([name for name in ds.variables if name not in keep_vars])
     model.attrs = {k: v for k, v in ds.attrs.items() if k in keep_attrs}
@@ -60,7 +61,8 @@ def contents_digest(ds: xr.Dataset, names=None) -> str:
 
 
 def _fingerprint(ds: xr.Dataset) -> str:
-    return contents_digest(ds, [*load_schema("model")["variables"], *DERIVED_GEOMETRY_VARIABLES])
+    return contents_digest(ds, [*load_schema("model3d" if space(ds) == 3 else "model")["variables"],
+                                *DERIVED_VARIABLES])
 
 
 def checked_digest(ds: xr.Dataset) -> str | None:
@@ -102,7 +104,7 @@ def checked_model(ds: xr.Dataset, where: str = "") -> xr.Dataset:
     model = model_part(ds)
     if is_checked(model):
         return model
-    stored = [v for v in DERIVED_GEOMETRY_VARIABLES if v in model.variables]
+    stored = [v for v in DERIVED_VARIABLES if v in model.variables]
     model = model.drop_vars(stored)
     problems = check(model, kind="model")
     if problems:

@@ -43,7 +43,7 @@ if TYPE_CHECKING:  # annotations only
     import xarray as xr
     from shapely.geometry import Polygon
 
-_TOP_KEYS = ("title", "description", "length_unit", "geometry", "wall", "unit", "bond", "heads", "openings",
+_TOP_KEYS = ("title", "description", "space", "length_unit", "geometry", "wall", "unit", "bond", "heads", "openings",
              "material", "supports", "settlement", "loading")
 _GEOMETRY_KEYS = ("dxf", "polygons", "drawing_unit", "chord_tolerance", "outline_layer", "openings_layer")
 _WALL_KEYS = ("width", "height", "thickness", "gable_height", "outline")

@@ -32,6 +32,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from .geometry import block_bounds
+from .model3d import space
 from .profiles import model_profile
 from .roles import masonry_blocks
 
@@ -91,9 +92,7 @@ def plausibility(model: xr.Dataset) -> list[str]:
                                                 (GRAVITY, "a density in kg/m3 was given; its weight in N/m3 is")])
         messages.append(f"material.unit_weight (block_unit_weight) = {weight:.6g} N/m3: masonry weighs "
                         f"{UNIT_WEIGHT[0] / 1e3:g}-{UNIT_WEIGHT[1] / 1e3:g} kN/m3{advice}")
-    xmin, xmax, ymin, ymax = block_bounds(model.node_x.values, model.node_y.values, model.block_node_count.values)
-    unit_sizes = {"length": float(np.median((xmax - xmin)[masonry])),
-                  "height": float(np.median((ymax - ymin)[masonry]))}
+    unit_sizes, extent = (_sizes_3d if space(model) == 3 else _sizes)(model, masonry)
     metres = "; probably metres were meant: remove length_unit = \"mm\" (it scales every length by 0.001)" \
         if length_unit == "mm" else ""
     for side, size in unit_sizes.items():
@@ -102,8 +101,6 @@ def plausibility(model: xr.Dataset) -> list[str]:
             advice = metres if size < UNIT_SIZE[0] and metres else ""
             messages.append(f"{where} = {size:.6g} m: masonry units are {UNIT_SIZE[0] * 1e3:g} mm to "
                             f"{UNIT_SIZE[1]:g} m{advice}")
-    extent = {"width": float(xmax[masonry].max() - xmin[masonry].min()),
-              "height": float(ymax[masonry].max() - ymin[masonry].min())}
     for side, size in extent.items():
         where = "the drawing" if drawn else f"wall.{side}"
         measured = f"{where}: the masonry is {size:.6g} m {'wide' if side == 'width' else 'high'}"
@@ -123,6 +120,28 @@ def plausibility(model: xr.Dataset) -> list[str]:
             messages.append(f"material.young_modulus (block_young_modulus) = {young:.6g} Pa: masonry has "
                             f"{YOUNG_MODULUS[0] / 1e9:g}-{YOUNG_MODULUS[1] / 1e9:g} GPa{advice}")
     return messages
+
+
+def _sizes(model: xr.Dataset, masonry: np.ndarray) -> tuple[dict[str, float], dict[str, float]]:
+    """The median unit's length and height, and the masonry's width and height, of a 2D model [m]."""
+    xmin, xmax, ymin, ymax = block_bounds(model.node_x.values, model.node_y.values, model.block_node_count.values)
+    return ({"length": float(np.median((xmax - xmin)[masonry])), "height": float(np.median((ymax - ymin)[masonry]))},
+            {"width": float(xmax[masonry].max() - xmin[masonry].min()),
+             "height": float(ymax[masonry].max() - ymin[masonry].min())})
+
+
+def _sizes_3d(model: xr.Dataset, masonry: np.ndarray) -> tuple[dict[str, float], dict[str, float]]:
+    """The same of a 3D model: a unit's length its longer side in plan, the width the longer side of the plan."""
+    owner = np.repeat(np.arange(masonry.size), model.block_node_count.values)
+    points = np.c_[model.node_x.values, model.node_y.values, model.node_z.values]
+    low = np.full((masonry.size, 3), np.inf)
+    high = np.full((masonry.size, 3), -np.inf)
+    np.minimum.at(low, owner, points)
+    np.maximum.at(high, owner, points)
+    size = (high - low)[masonry]
+    span = high[masonry].max(axis=0) - low[masonry].min(axis=0)
+    return ({"length": float(np.median(size[:, :2].max(axis=1))), "height": float(np.median(size[:, 2]))},
+            {"width": float(span[:2].max()), "height": float(span[2])})
 
 
 def _friction(model: xr.Dataset) -> list[str]:

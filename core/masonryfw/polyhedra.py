@@ -17,6 +17,8 @@ from typing import NamedTuple
 
 import numpy as np
 
+from .geometry import block_offsets, next_node
+
 #: Two faces are parallel when their unit normals differ by less than this (rounded to it).
 NORMAL_TOLERANCE = 1e-7
 
@@ -41,7 +43,7 @@ class Polyhedra(NamedTuple):
 
     def face_vertex_index(self) -> np.ndarray:
         """Every face's vertices as rows of ``vertices`` (the ragged ``face_nodes`` made global)."""
-        first_node = np.concatenate([[0], np.cumsum(self.block_node_count)[:-1]])
+        first_node = block_offsets(self.block_node_count)[:-1]
         return self.face_nodes + np.repeat(first_node[self.face_block()], self.face_node_count)
 
 
@@ -77,7 +79,7 @@ def prisms(node_x: np.ndarray, node_y: np.ndarray, block_node_count: np.ndarray,
     """A wall of 2D polygons (counter-clockwise in x-y, y up) stood in the x-z plane, every block ``thickness`` deep
     about y = 0: the 3D twin of a planar model (its y is 3D's z)."""
     counts = np.asarray(block_node_count, dtype=np.int64)
-    first = np.concatenate([[0], np.cumsum(counts)[:-1]])
+    first = block_offsets(counts)[:-1]
     block = np.repeat(np.arange(counts.size), counts)
     local = np.arange(counts.sum()) - first[block]  # each vertex's number within its polygon
     count = counts[block]
@@ -102,10 +104,8 @@ def prisms(node_x: np.ndarray, node_y: np.ndarray, block_node_count: np.ndarray,
 def face_normals_areas(poly: Polyhedra) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Every face's unit outward normal (Newell's, right for non-convex faces), area and centroid."""
     index = poly.face_vertex_index()
-    starts = np.concatenate([[0], np.cumsum(poly.face_node_count)[:-1]])
-    following = np.arange(index.size) + 1
-    following[starts + poly.face_node_count - 1] = starts
-    p, q = poly.vertices[index], poly.vertices[index[following]]
+    starts = block_offsets(poly.face_node_count)[:-1]
+    p, q = poly.vertices[index], poly.vertices[index[next_node(poly.face_node_count)]]
     doubled = np.add.reduceat(np.cross(p, q), starts, axis=0)  # twice the vector area
     length = np.linalg.norm(doubled, axis=1)
     normal = doubled / np.where(length > 0, length, 1.0)[:, None]
@@ -119,11 +119,10 @@ def face_normals_areas(poly: Polyhedra) -> tuple[np.ndarray, np.ndarray, np.ndar
 def volumes_centroids(poly: Polyhedra) -> tuple[np.ndarray, np.ndarray]:
     """Every block's volume and centroid: the signed tetrahedra of its faces' fans with its first vertex."""
     index = poly.face_vertex_index()
-    starts = np.concatenate([[0], np.cumsum(poly.face_node_count)[:-1]])
-    following = np.arange(index.size) + 1
-    following[starts + poly.face_node_count - 1] = starts
+    starts = block_offsets(poly.face_node_count)[:-1]
+    following = next_node(poly.face_node_count)
     block_of_vertex = np.repeat(poly.face_block(), poly.face_node_count)
-    first_node = np.concatenate([[0], np.cumsum(poly.block_node_count)[:-1]])
+    first_node = block_offsets(poly.block_node_count)[:-1]
     origin = poly.vertices[first_node][block_of_vertex]
     anchor = np.repeat(poly.vertices[index[starts]], poly.face_node_count, axis=0)
     a, b, c = anchor - origin, poly.vertices[index] - origin, poly.vertices[index[following]] - origin
@@ -174,7 +173,7 @@ def find_contacts(poly: Polyhedra, tol: float) -> Contacts:
     index = poly.face_vertex_index()
     face_of_vertex = np.repeat(np.arange(block.size), poly.face_node_count)
     uv = np.einsum("ij,ikj->ik", poly.vertices[index], frame[face_of_vertex])  # in-plane coordinates
-    starts = np.concatenate([[0], np.cumsum(poly.face_node_count)[:-1]])
+    starts = block_offsets(poly.face_node_count)[:-1]
     low = np.minimum.reduceat(uv, starts, axis=0)
     high = np.maximum.reduceat(uv, starts, axis=0)
 

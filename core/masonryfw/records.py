@@ -53,6 +53,9 @@ class Solver:
     computed with the attribute ``interrupted = 1``; with nothing to return it
     lets the ``KeyboardInterrupt`` propagate.
 
+    ``spaces``: the model dimensions it solves (2D walls, 3D models: ``masonryfw_space``); the core refuses
+    any other before the solve starts.
+
     ``estimate`` (optional): ``estimate(model, options) -> Estimate``, cheap (counts,
     no factorisation, no time stepping). The core refuses a run whose memory does
     not fit before it starts, and the CLI prints the estimate of a run longer than a
@@ -67,6 +70,7 @@ class Solver:
     variants: tuple[Variant, ...] = field(default_factory=tuple)
     gallery: bool = True
     estimate: Callable[[xr.Dataset, Mapping[str, Any]], Estimate] | None = None
+    spaces: tuple[int, ...] = (2,)
 
 
 @dataclass(frozen=True)
@@ -78,6 +82,8 @@ class Comparator:
     compare: Callable[[xr.Dataset, xr.Dataset, Mapping[str, Any]], xr.Dataset]
     version: str | None = None
     options: tuple[Option, ...] = field(default_factory=tuple)
+    #: The dimensions of the results it compares (as :class:`Solver`'s).
+    spaces: tuple[int, ...] = (2,)
 
 
 @dataclass(frozen=True)
@@ -99,3 +105,5 @@ class Plotter:
     #: The numbers behind the curves, ``table(datasets, options) -> (header, rows)`` (``plot --format csv``);
     #: None for a kind that draws no curves.
     table: Callable[[Sequence[xr.Dataset], Mapping[str, Any]], tuple[list[str], list[list]]] | None = None
+    #: The dimensions of the models and results it draws (as :class:`Solver`'s).
+    spaces: tuple[int, ...] = (2,)

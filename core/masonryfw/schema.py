@@ -16,12 +16,14 @@ FORMAT_VERSION = 2
 #: Versions this code reads: older ones are upgraded in memory on reading (:func:`masonryfw.dofs.upgrade`).
 READABLE_VERSIONS = (1, 2)
 KINDS = ("model", "result", "comparison", "sweep", "diagnosis")
+#: The schemas of a model and a result in 3D (``masonryfw_space = 3``; their ``masonryfw_format`` stays the kind).
+KINDS_3D = {"model": "model3d", "result": "result3d"}
 
 
 @cache
 def load_schema(kind: str, version: int = FORMAT_VERSION) -> dict:
     """The schema of a dataset kind, with ``extends`` resolved (a result holds the model's variables)."""
-    if kind not in KINDS:
+    if kind not in KINDS and kind not in KINDS_3D.values():
         raise ModelError(f"unknown dataset kind {kind!r}; expected one of {', '.join(KINDS)}")
     path = resources.files("masonryfw.schemas").joinpath(f"{kind}-{version}.json")
     if not path.is_file():

@@ -11,8 +11,8 @@ from typing import TYPE_CHECKING
 from .builder import build
 from .checks import check
 from .datasets import BUNDLED_NAMES, bundled_spec_path
+from .derived import DERIVED_VARIABLES, derive_geometry
 from .errors import MasonryError, ModelError
-from .geometry import DERIVED_GEOMETRY_VARIABLES, derive_geometry
 from .imported import is_drawn, parse_drawn_spec, resolved_drawing
 from .io import open_dataset
 from .model import checked_model, model_part
@@ -96,4 +96,4 @@ def open_model(path_or_name: str | os.PathLike, *, validate: bool = True) -> xr.
     if validate:
         return checked_model(ds, str(path_or_name))
     model = model_part(ds)
-    return derive_geometry(model.drop_vars([v for v in DERIVED_GEOMETRY_VARIABLES if v in model.variables]))
+    return derive_geometry(model.drop_vars([v for v in DERIVED_VARIABLES if v in model.variables]))

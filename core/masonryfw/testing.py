@@ -38,10 +38,12 @@ import pytest
 
 from . import blocks
 from .api import estimate, solve
+from .builder import build
 from .checks import check
-from .errors import PluginError
+from .errors import PluginError, SolveError
 from .material import Material
 from .model import checked_model
+from .model3d import twin
 from .registry import get_solver
 from .roles import ROLE, support_blocks
 from .schema import load_schema
@@ -144,6 +146,19 @@ def arch_model(thickness_ratio: float, voussoirs: int = 40, radius: float = 1.0,
     return checked_model(ds, "arch")
 
 
+def corner_building() -> xr.Dataset:
+    """A small building in 3D (:mod:`masonryfw.building`): two walls toothed at a right-angle corner, 1.44 and 1.2 m
+    long and 0.96 m high in 0.24 x 0.12 m units, a door in the first, over a trough whose axis runs at 30 degrees
+    to x."""
+    walls = [{"name": "a", "start": [0.0, 0.0], "end": [1.44, 0.0], "height": 0.96, "thickness": 0.12,
+              "openings": [{"x": 0.48, "y": 0.0, "width": 0.48, "height": 0.6}]},
+             {"name": "b", "start": [1.44, 0.0], "end": [1.44, 1.2], "height": 0.96, "thickness": 0.12}]
+    return build({"title": "corner", "building": {"unit": {"length": 0.24, "height": 0.12}, "walls": walls},
+                  "material": {"unit_weight": 20000.0, "friction_angle": 30.0},
+                  "settlement": {"profile": "gaussian", "width": 0.6, "axis_angle": 30.0, "center_x": 1.4,
+                                 "center_y": 0.2}})
+
+
 def permuted(model: xr.Dataset, block_order: np.ndarray, interface_order: np.ndarray) -> xr.Dataset:
     """The same model with its blocks and interfaces listed in another order (a checked model)."""
     counts = model.block_node_count.values.astype(np.int64)
@@ -237,6 +252,25 @@ class SolverConformance:
             assert int(result.attrs.get("interrupted", 0)) == 1, (
                 f"{self.solver} swallowed a KeyboardInterrupt at progress call {at} and returned as if complete")
             assert check(result) == []
+
+    def test_the_dimensions_it_declares_are_the_ones_it_solves(self, solved):
+        """2D, 3D or both (``Solver.spaces``): the conformance model stood one block thick in 3D
+        (:func:`masonryfw.model3d.twin`) is solved and checked when 3D is declared (or, for options the solver
+        does not support in 3D, refused with a SolveError that says 3D), refused before the run (a SolveError
+        naming the solver) when it is not."""
+        spaces = get_solver(self.solver).spaces
+        assert spaces and set(spaces) <= {2, 3}, f"{self.solver} declares spaces {spaces}: 2, 3 or both"
+        in_3d = twin(self.conformance_model())
+        if 3 in spaces:
+            try:
+                result = solve(in_3d, self.solver, self.options)
+            except SolveError as refusal:
+                assert "3D" in str(refusal), f"{self.solver} declares 3D but refused without saying why: {refusal}"
+                return
+            assert check(result) == []
+        else:
+            with pytest.raises(SolveError, match=f"solver {self.solver} solves 2D models"):
+                solve(in_3d, self.solver, self.options)
 
     def test_an_estimate_is_finite_and_positive(self):
         expected = estimate(self.conformance_model(), self.solver, self.options)

@@ -21,6 +21,7 @@ from matplotlib.patches import Patch
 import masonryfw as mf
 import masonryfw.plugin_api as mfp
 
+from . import axonometric
 from .figure_parts import (
     SUPPORT_COLOUR,
     block_vertices,
@@ -68,7 +69,8 @@ def dominant_pieces(ds: xr.Dataset, geo: xr.Dataset) -> Pieces:
     if "macro_block" not in ds or not masonry.any():
         return Pieces(number, 0, 0)
     labels, inverse = np.unique(ds.macro_block.values[masonry], return_inverse=True)
-    area = np.bincount(inverse, weights=np.abs(geo.block_area.values[masonry]))
+    size = geo.block_volume.values if "block_volume" in geo else np.abs(geo.block_area.values)  # 3D: volumes
+    area = np.bincount(inverse, weights=size[masonry])
     order = np.argsort(-area, kind="stable")
     big = order[area[order] >= DOMINANT_SHARE * area.sum()][:MOST_NUMBERED]
     rank = np.zeros(labels.size, dtype=np.int64)
@@ -169,6 +171,8 @@ def draw_model(datasets: Sequence[xr.Dataset], ax, options: Mapping[str, Any]) -
     """A model as imported: blocks by role (supports hatched, a moving one with an arrow along its
     settlement direction), interfaces coloured by kind, block numbers on request."""
     ds = single_result(datasets, "model")
+    if mfp.space(ds) == 3:
+        return axonometric.draw_model_3d(ds, ax, ROLE_COLOURS)
     geo = ds if "block_centroid_x" in ds else mfp.derive_geometry(ds)
     names = {value: name for name, value in mfp.ROLE.items()}
     roles = np.array([names[int(r)] for r in geo.block_role.values])
@@ -234,6 +238,9 @@ def draw_mechanism(datasets: Sequence[xr.Dataset], ax, options: Mapping[str, Any
     require_variables(ds, ["block_displacement"], "mechanism", "block displacements (la, fdem, jmm or jmm-limit)")
     ds = mf.at_threshold(ds, options["threshold"])
     geo = mfp.derive_geometry(ds)
+    if mfp.space(ds) == 3:
+        pieces = dominant_pieces(ds, geo)
+        return axonometric.draw_mechanism_3d(ds, ax, options, pieces, piece_colours(geo, pieces))
     u = mfp.block_motion(ds)
     amplification = mechanism_amplification(ds, options)
     scale = line_scale(geo)

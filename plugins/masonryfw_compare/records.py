@@ -35,10 +35,10 @@ COMPARATOR = mfp.Comparator(
 
 
 def _plotter(name: str, summary: str, options: tuple = (), table: bool = False,
-             side_by_side: bool = False, module: str = "block_plots") -> mfp.Plotter:
+             side_by_side: bool = False, module: str = "block_plots", spaces: tuple[int, ...] = (2,)) -> mfp.Plotter:
     return mfp.Plotter(name, summary, mfp.lazy(f"masonryfw_compare.{module}:draw_{name}"), options=options,
                       table=mfp.lazy(f"masonryfw_compare.{module}:{name}_table") if table else None,
-                      side_by_side=side_by_side)
+                      side_by_side=side_by_side, spaces=spaces)
 
 
 PLOTTERS = {
@@ -48,10 +48,12 @@ PLOTTERS = {
                  (mfp.Option("numbers", bool, False, "write every block's number at its centroid"),
                   mfp.Option("font_size", float, 5.0, "size of the block numbers [pt]", above=0.0),
                   mfp.Option("interfaces", str, "auto", "draw the interfaces coloured by kind: yes, no, or auto (a "
-                             f"model of at most {MODEL_INTERFACES_UP_TO} blocks)", ("auto", "yes", "no")))),
+                             f"model of at most {MODEL_INTERFACES_UP_TO} blocks)", ("auto", "yes", "no"))),
+                 spaces=(2, 3)),
         _plotter("mechanism", "amplified deformed wall, alpha and the reaction in the title, the dominant "
-                 "macro-blocks numbered, cracks on the blocks' faces, the widest crack marked with the damage category",
-                 (AMPLIFICATION_OPTION, THRESHOLD_OPTION)),
+                 "macro-blocks numbered, cracks on the blocks' faces, the widest crack marked with the damage category "
+                 "(3D: in axonometry, the cracked interfaces outlined)",
+                 (AMPLIFICATION_OPTION, THRESHOLD_OPTION), spaces=(2, 3)),
         _plotter("cracks", "joints that open, slide or both, in colours; the widest crack marked with the damage "
                  "category", (THRESHOLD_OPTION,
                               mfp.Option("widths", bool, False, "draw each cracked joint as wide as its opening "

@@ -239,6 +239,7 @@ def report_html(paths: Sequence[str], command: str, progress: Callable[[float, s
     document."""
     step = progress or (lambda fraction, message: None)
     opened = [mf.open_checked(p) for p in paths]
+    mfp.require_space(opened, (2,), "masonryfw report")
     for path, ds in zip(paths, opened):
         if ds.attrs.get("masonryfw_format") not in ("result", "diagnosis"):
             raise mf.MasonryError(f"{path}: not a result or diagnosis file (masonryfw_format = "

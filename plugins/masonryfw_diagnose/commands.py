@@ -153,6 +153,7 @@ def diagnose_command(wall: str, cracks: str, cracks_layer: str | None, levelling
     if verify_with:
         mf.get_solver(verify_with)
     model = wall_model(wall)
+    mfp.require_space([model], (2,), "masonryfw diagnose")
     sigma = None if sigma_mm is None else 1e-3 * sigma_mm
     diagnosis = prepare(model, survey, families, segment, solver, solver_options, tolerance, sigma)
     share = 1 if scheduler else workers  # a cluster's size is its own

@@ -35,5 +35,6 @@ def masonryfw_solvers():
             options=OPTIONS,
             variants=VARIANTS,
             estimate=mfp.lazy("masonryfw_la.estimate:estimate"),
+            spaces=(2, 3),
         )
     ]

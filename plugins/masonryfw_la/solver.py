@@ -21,6 +21,10 @@ from . import assembly, backends, limit, nonassociative, topology
 
 def solve(model: xr.Dataset, options: Mapping[str, Any], progress=mfp.no_progress) -> xr.Dataset:
     """Collapse multiplier, mechanism and contact forces of ``model`` (checked, options resolved by the core)."""
+    if mfp.space(model) == 3:
+        from . import space3
+
+        return space3.solve(model, options, progress)
     clock = time.perf_counter()
     progress(0.0, "la: assembling the kinematic programme")
     wall = assembly.Wall.from_model(model)

@@ -21,10 +21,13 @@ strength are refused, not ignored.
 """
 from __future__ import annotations
 
-from typing import NamedTuple
+import time
+from collections.abc import Mapping
+from typing import Any, NamedTuple
 
 import numpy as np
 import scipy.sparse as sp
+import xarray as xr
 
 import masonryfw as mf
 import masonryfw.plugin_api as mfp
@@ -75,51 +78,20 @@ class Scales3D(NamedTuple):
         return np.array([self.length] * 3 + [self.length / self.block] * 3)
 
 
-def planar_twin(model, sides_tol: float = 1e-6) -> Blocks3D:
-    """The 3D twin of a planar model (derived geometry): every polygon stood in the x-z plane its thickness deep
-    (:func:`masonryfw.plugin_api.prisms`), 2D's ``(x, y, rz)`` as 3D's ``(x, z, -ry)``; a support is held (or
-    moved) out of the plane too, a unit is free in all six. ``sides_tol``: contact tolerance, a share of ``L``."""
+def blocks_of(model) -> Blocks3D:
+    """The arrays of a checked 3D model (derived geometry). Joints with cohesion or tensile strength are refused."""
     bonded = np.flatnonzero((model.interface_cohesion.values > 0) | (model.interface_tensile_strength.values > 0))
     if bonded.size:
         raise mf.SolveError(f"la in 3D: interface {bonded[0]} has cohesion or tensile strength "
                             f"({mfp.listed(bonded)} in all): only dry joints in 3D so far")
-    counts = model.block_node_count.values
-    poly = mfp.prisms(model.node_x.values, model.node_y.values, counts, model.block_thickness.values)
-    volume, centroid = mfp.volumes_centroids(poly)
-    scale = mfp.model_scale(model.node_x.values, model.node_y.values)
-    contacts = mfp.find_contacts(poly, sides_tol * scale)
-    planar = [0, 2, 4]  # 2D's x, y, rz in 3D's (ux, uy, uz, rx, ry, rz)
-    sign = np.array([1.0, 1.0, -1.0])
-
-    def lifted(values: np.ndarray) -> np.ndarray:
-        out = np.zeros((values.shape[0], 6))
-        out[:, planar] = values * sign
-        return out
-
-    role = model.block_role.values
-    support = mfp.support_blocks(role)
-    fixed = np.zeros((role.size, 6), dtype=bool)
-    fixed[:, planar] = model.block_fixed.values != 0
-    fixed[support] = True
-    friction = _twin_friction(model, contacts.sides)
-    return Blocks3D(centroid, volume, role, fixed, lifted(model.settlement_direction.values.astype(float)),
-                    lifted(mfp.block_loads(model, "dead")), lifted(mfp.block_loads(model, "live")), contacts,
-                    friction, scale)
-
-
-def _twin_friction(model, sides: np.ndarray) -> np.ndarray:
-    """The friction of the model's interface between the same two blocks (the smallest where it has several);
-    contacts the model does not have (support on support) take the median."""
-    mu = model.interface_friction.values.astype(float)
-    n = model.sizes["block"]
-    pairs = np.sort(model.interface_blocks.values.astype(np.int64), axis=1)
-    keys = pairs[:, 0] * n + pairs[:, 1]
-    by_key = {}
-    for key, value in zip(keys.tolist(), mu.tolist()):
-        by_key[key] = min(value, by_key.get(key, np.inf))
-    wanted = np.sort(sides, axis=1)
-    median = float(np.median(mu)) if mu.size else 0.0
-    return np.array([by_key.get(int(a * n + b), median) for a, b in wanted])
+    centroid = np.c_[model.block_centroid_x.values, model.block_centroid_y.values, model.block_centroid_z.values]
+    poly = mfp.polyhedra_of(model)
+    scale = float(np.linalg.norm(poly.vertices.max(axis=0) - poly.vertices.min(axis=0))) if poly.vertices.size else 1.0
+    return Blocks3D(centroid, model.block_volume.values, model.block_role.values, model.block_fixed.values != 0,
+                    model.settlement_direction.values.astype(float),
+                    np.c_[model.dead_load.values, model.dead_moment.values].astype(float),
+                    np.c_[model.live_load.values, model.live_moment.values].astype(float),
+                    mfp.contacts_of(model), model.interface_friction.values.astype(float), scale)
 
 
 def scales_of(blocks: Blocks3D) -> Scales3D:
@@ -240,3 +212,52 @@ def limit_state_3d(blocks: Blocks3D, sides: int = PYRAMID_SIDES, solver: str = "
     y[active_rows] = sol.y
     point_force = np.einsum("pj,pjd->pd", y.reshape(-1, per_point), axis) * scales.force
     return LimitState3D(float(sol.alpha_primal), motion, point_force, active, sol)
+
+
+def settlement_reaction(blocks: Blocks3D, state: LimitState3D) -> float:
+    """The settlement reaction at collapse [N]: the wrench the masonry exerts on every moving support, weighted by
+    the support's motion per unit t (as in 2D, :func:`masonryfw.plugin_api.settlement_reaction`)."""
+    contacts = blocks.contacts
+    owner = contacts.point_interface()
+    wrench = np.zeros((blocks.n_block, 6))
+    for side, sign in ((1, 1.0), (0, -1.0)):  # point_force acts on side 1, its opposite on side 0
+        block = contacts.sides[owner, side]
+        force = sign * state.point_force
+        np.add.at(wrench, block, np.c_[force, np.cross(contacts.points - blocks.centroid[block], force)])
+    moving = blocks.role == mfp.ROLE["moving_support"]
+    return float((wrench[moving] * blocks.direction[moving]).sum())
+
+
+def solve(model: xr.Dataset, options: Mapping[str, Any], progress=mfp.no_progress) -> xr.Dataset:
+    """``la`` on a 3D model: the collapse multiplier, the mechanism and the forces at the interfaces' vertices."""
+    if options["flow"] != "associative":
+        raise mf.SolveError("la in 3D: flow = nonassociative is not supported in 3D yet (associative joints only)")
+    clock = time.perf_counter()
+    progress(0.0, "la: assembling the 3D programme")
+    blocks = blocks_of(model)
+    sides = int(options["pyramid_sides"])
+    progress(0.2, f"la: solving in 3D ({'the cone' if sides == 0 else f'a pyramid of {sides} sides'})")
+    state = limit_state_3d(blocks, sides, options["solver"], options["tolerance"])
+    axis = ("block", "axis")
+    data = {
+        "collapse_multiplier": ((), state.alpha, mfp.variable_attrs("collapse_multiplier", "result3d")),
+        "block_displacement": (axis, state.motion[:, :3], mfp.variable_attrs("block_displacement", "result3d")),
+        "block_rotation": (axis, state.motion[:, 3:], mfp.variable_attrs("block_rotation", "result3d")),
+        "interface_normal_force": ("interface", np.bincount(
+            blocks.contacts.point_interface(), np.einsum("pd,pd->p", state.point_force,
+                                                         blocks.contacts.normal[blocks.contacts.point_interface()]),
+            minlength=blocks.contacts.n_interface), mfp.variable_attrs("interface_normal_force", "result3d")),
+        "lp_status": ((), state.solution.status, {"long_name": "status of the programme", "units": "1"}),
+        "lp_iterations": ((), np.int64(state.solution.iterations), {"long_name": "iterations of the backend",
+                                                                    "units": "1"}),
+    }
+    for k, c in enumerate("xyz"):
+        data[f"interface_point_force_{c}"] = ("interface_node", state.point_force[:, k],
+                                              mfp.variable_attrs(f"interface_point_force_{c}", "result3d"))
+    if (blocks.role == mfp.ROLE["moving_support"]).any():
+        data["moving_support_reaction"] = ((), settlement_reaction(blocks, state),
+                                           mfp.variable_attrs("moving_support_reaction", "result3d"))
+    progress(1.0, f"la: alpha = {state.alpha:.6g}")
+    return xr.Dataset(data, attrs={"rotations": "small", "flow_rule": "associative", "la_backend": options["solver"],
+                                   "la_pyramid_sides": sides, "la_time_s": time.perf_counter() - clock,
+                                   "la_alpha_dual": float(state.solution.alpha_dual)})

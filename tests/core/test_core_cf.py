@@ -11,6 +11,7 @@ import json
 import pytest
 
 import masonryfw as mf
+import masonryfw.plugin_api as mfp
 import masonryfw.testing as mt
 
 runner = pytest.importorskip("compliance_checker.runner")
@@ -50,10 +51,13 @@ def written(tmp_path_factory):
     records = [run_point(plan.spec, [(("material", "friction_angle"), value)], "la", plan.options,
                          str(folder / "store"), {}) for value in (20, 25)]
     files["sweep"] = mf.save(combine(plan, records, folder, str(folder / "store")), folder / "sweep.nc")
+    in_3d = mf.checked_model(mfp.twin(model))
+    files["3D model"] = mf.save(in_3d, folder / "model3d.nc")
+    files["3D la"] = mf.save(mf.solve(in_3d, "la"), folder / "la3d.nc")
     return files
 
 
 @pytest.mark.parametrize("kind", ["model", "la", "fdem", "jmm", "jmm-limit", "statics", "comparison", "sweep",
-                                  "drawn model", "fdem tilt", "jmm tilt", "jmm-limit tilt"])
+                                  "drawn model", "fdem tilt", "jmm tilt", "jmm-limit tilt", "3D model", "3D la"])
 def test_cf_checker_finds_no_error(written, tmp_path, kind):
     assert cf_errors(written[kind], tmp_path) == []

@@ -12,6 +12,7 @@ import xarray as xr
 
 import masonryfw
 import masonryfw.plugin_api
+import masonryfw.testing
 from masonryfw import io as mio
 from masonryfw.errors import ModelError
 
@@ -101,8 +102,14 @@ def test_derived_variable_list_matches_derive_geometry():
         interface_x=(("interface", "end"), np.array([[1.0, 1.0]])),
         interface_y=(("interface", "end"), np.array([[0.0, 1.0]])),
     )
-    added = set(masonryfw.plugin_api.derive_geometry(ds).variables) - set(ds.variables)
-    assert added == set(masonryfw.plugin_api.DERIVED_GEOMETRY_VARIABLES)
+    mfp = masonryfw.plugin_api
+    added = set(mfp.derive_geometry(ds).variables) - set(ds.variables)
+    in_3d = mfp.twin(masonryfw.testing.small_settlement_wall())
+    added_3d = set(mfp.derive_geometry(in_3d).variables) - set(in_3d.variables)
+    assert added == set(mfp.DERIVED_GEOMETRY_VARIABLES)
+    assert added | added_3d == set(mfp.DERIVED_VARIABLES)
+    assert added_3d == {"block_volume", "block_centroid_x", "block_centroid_y", "block_centroid_z", "interface_area",
+                        "interface_normal_x", "interface_normal_y", "interface_normal_z"}
 
 
 # ------------------------------------------------------------------ reading errors

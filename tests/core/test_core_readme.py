@@ -88,7 +88,7 @@ def test_the_conformance_kit_of_the_tour_passes_for_the_tour_plugin(tmp_path):
                           env={**os.environ, "PYTHONPATH": str(tmp_path / "site")}, capture_output=True, text=True,
                           timeout=300, cwd=tmp_path)
     assert done.returncode == 0, done.stdout + done.stderr
-    assert re.search(r"\b9 passed", done.stdout), done.stdout
+    assert re.search(r"\b10 passed", done.stdout), done.stdout
 
 
 def test_the_trough_of_the_tour_builds_under_the_tour_wall(tmp_path):
@@ -101,8 +101,19 @@ def test_the_trough_of_the_tour_builds_under_the_tour_wall(tmp_path):
     assert (model.block_role.values == mfp.flags("block_role")["moving_support"]).sum() >= 5
 
 
-def test_the_tour_ends_with_a_report_and_its_last_step_runs_as_written(tmp_path):
-    step = README[README.index("**5. Hand it over.**"):README.index("## Where to read more")]
+def test_the_buildings_step_of_the_tour_runs_as_written(tmp_path):
+    step = README[README.index("**6. Buildings in 3D.**"):README.index("## Where to read more")]
+    commands = [line.strip().split("#")[0].split() for line in step.splitlines() if line.startswith("    masonryfw ")]
+    assert [c[:2] for c in commands] == [["masonryfw", "info"], ["masonryfw", "solve"], ["masonryfw", "plot"]]
+    for words in commands:
+        done = subprocess.run([sys.executable, "-m", "masonryfw", *words[1:]], cwd=tmp_path, capture_output=True,
+                              text=True, timeout=300)
+        assert done.returncode == 0, (words, done.stderr)
+    assert (tmp_path / "house.png").stat().st_size > 10_000
+
+
+def test_the_hand_over_step_ends_with_a_report_and_runs_as_written(tmp_path):
+    step = README[README.index("**5. Hand it over.**"):README.index("**6. Buildings in 3D.**")]
     commands = [line.strip() for line in step.splitlines() if line.startswith("    masonryfw ")]
     assert commands[-1].startswith("masonryfw report ")
     for command in commands:

@@ -7,11 +7,17 @@ import pytest
 
 import masonryfw as mf
 import masonryfw.plugin_api as mfp
+import masonryfw.testing as mt
 from masonryfw_la import space3
 
 ROLE = mfp.flags("block_role")
 WALLS = ("test-12c", "test-8c", "panel-1", "panel-2", "panel-3", "panel-4", "panel-5", "facade-1", "facade-2",
          "facade-3", "facade-1-trough", "tunnel-facade")
+
+
+def twin_blocks(model) -> space3.Blocks3D:
+    """The arrays of the checked 3D twin of a planar model."""
+    return space3.blocks_of(mf.checked_model(mfp.twin(model)))
 
 
 def boxes_on_a_base(lower, upper, mu, live_force=(0.0, 0.0, 0.0), live_moment=(0.0, 0.0, 0.0),
@@ -124,15 +130,17 @@ def static_residuals(blocks: space3.Blocks3D, state: space3.LimitState3D) -> tup
 
 
 @pytest.mark.parametrize("sides", [8, 0])
-@pytest.mark.parametrize("case", ["tilted stack", "twisted stack", "panel-5", "facade-2"])
+@pytest.mark.parametrize("case", ["tilted stack", "twisted stack", "panel-5", "facade-2", "corner building"])
 def test_the_forces_satisfy_every_blocks_six_equilibrium_equations_and_the_cone(case, sides):
     if case.endswith("stack"):
         lower = [[-1, -1, -0.2], [-0.5, -0.4, 0], [-0.1, -0.3, 0.4], [-0.3, -0.35, 0.8]]
         upper = [[1, 1, 0], [0.5, 0.4, 0.4], [0.7, 0.3, 0.8], [0.5, 0.35, 1.0]]
         load = {"live_force": (0.6, 0.3, 0.0)} if case == "tilted stack" else {"live_moment": (0.0, 0.0, 1.0)}
         blocks = boxes_on_a_base(lower, upper, 0.6, **load)
+    elif case == "corner building":
+        blocks = space3.blocks_of(mt.corner_building())
     else:
-        blocks = space3.planar_twin(mf.open_model(case))
+        blocks = twin_blocks(mf.open_model(case))
     state = space3.limit_state_3d(blocks, sides=sides)
     residual, excess, weight = static_residuals(blocks, state)
     moment_scale = weight * blocks.scale
@@ -150,7 +158,7 @@ def test_every_bundled_wall_built_one_block_thick_in_3d_gives_the_planar_alpha(n
     model = mf.open_model(name)
     wall = masonryfw_la.Wall.from_model(model)
     planar = masonryfw_la.limit_state(wall, masonryfw_la.wall_scales(model, wall)).alpha
-    state = space3.limit_state_3d(space3.planar_twin(model))
+    state = space3.limit_state_3d(twin_blocks(model))
     assert state.alpha == pytest.approx(planar, rel=1e-6)
     assert np.abs(state.motion[:, [1, 3, 5]]).max() < 1e-6 * np.abs(state.motion[:, [0, 2]]).max()
 
@@ -159,8 +167,8 @@ def test_the_same_wall_in_mm_and_in_m_and_in_another_block_order(walls):
     """A running-bond wall on a settling support, in m and in mm, and its blocks listed backwards."""
     rects = np.vstack([[(0.0, -0.1, 0.48, 0.0), (0.48, -0.1, 1.2, 0.0)], walls.running_bond(5, 1.2, 0.3, 0.1)])
     roles = [ROLE["fixed_support"], ROLE["moving_support"]] + [ROLE["unit"]] * (len(rects) - 2)
-    alphas = [space3.limit_state_3d(space3.planar_twin(walls.rect_model(r, o, loading="settlement",
-                                                                        length_unit=unit))).alpha
+    alphas = [space3.limit_state_3d(twin_blocks(walls.rect_model(r, o, loading="settlement",
+                                                                 length_unit=unit))).alpha
               for r, o, unit in ((rects, roles, 1.0), (rects, roles, 1000.0), (rects[::-1], roles[::-1], 1.0))]
     assert alphas[1] == pytest.approx(alphas[0], rel=1e-9)
     assert alphas[2] == pytest.approx(alphas[0], rel=1e-9)
@@ -170,6 +178,6 @@ def test_joints_with_cohesion_and_too_few_sides_are_refused(walls):
     rects = [(-1.0, -0.2, 2.0, 0.0), (0.0, 0.0, 0.4, 1.0)]
     cohesive = walls.rect_model(rects, [ROLE["fixed_support"], ROLE["unit"]], cohesion=1e4)
     with pytest.raises(mf.SolveError, match="interface 0 has cohesion"):
-        space3.planar_twin(cohesive)
+        twin_blocks(cohesive)
     with pytest.raises(mf.SolveError, match="at least 3 sides"):
         space3.limit_state_3d(single_box(1.0, 1.0, 0.5, 0.5, live_force=(1.0, 0.0, 0.0)), sides=2)

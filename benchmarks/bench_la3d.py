@@ -1,0 +1,77 @@
+"""Benchmark of la in 3D: time against the block count, the friction pyramid against the cone, and the house.
+
+- The running-bond settlement walls of about 300, 1,000 and 2,400 units (the paper's material) built one block
+  thick in 3D (``space = 3``): the build (contacts found from the faces, the checks) and la's solve with a
+  pyramid of 8 sides (the default), of 4, and with the cone (Clarabel), against the planar la of the same
+  wall; alpha's difference from the planar one.
+- The bundled ``house-tunnel`` (a two-storey house over a tunnel, 1,126 blocks): build and solve.
+
+Whole ``mf.build`` / ``mf.solve`` calls, one run each (the median of three for the house), this process.
+Run from the benchmarks folder: ``python bench_la3d.py``. Writes the ``la3d`` section of docs/benchmarks.md.
+"""
+from __future__ import annotations
+
+import os
+import statistics
+import sys
+import time
+
+from _report import command_line, write_section
+
+import masonryfw as mf
+
+sys.path.insert(0, os.path.dirname(__file__))
+from _walls import running_bond_spec  # noqa: E402
+
+SIZES = ((12, 25), (22, 45), (36, 67))  # courses x units per course: about 300, 1,000 and 2,400 units
+FRICTION = ((8, "pyramid, 8 sides"), (4, "pyramid, 4 sides"), (0, "cone"))
+
+
+def timed(function, *args):
+    start = time.perf_counter()
+    value = function(*args)
+    return time.perf_counter() - start, value
+
+
+def walls() -> list[str]:
+    rows = ["| blocks | interfaces (3D) | build 3D | planar la | " + " | ".join(f"la 3D, {name}" for _, name in FRICTION)
+            + " | largest alpha difference from planar |", "|---|---|---|---|" + "---|" * len(FRICTION) + "---|"]
+    for courses, per_course in SIZES:
+        spec = running_bond_spec(courses, per_course)
+        planar_seconds, planar = timed(mf.solve, mf.build(mf.dump_toml(spec)), "la")
+        build_seconds, model = timed(mf.build, mf.dump_toml({**spec, "space": 3}))
+        cells, difference = [], 0.0
+        for sides, _ in FRICTION:
+            seconds, result = timed(mf.solve, model, "la", {"pyramid_sides": sides})
+            alpha, reference = float(result.collapse_multiplier), float(planar.collapse_multiplier)
+            difference = max(difference, abs(alpha - reference) / reference)
+            cells.append(f"{seconds:.2f} s ({int(result.lp_iterations)} its)")
+        rows.append(f"| {model.sizes['block']:,} | {model.sizes['interface']:,} | {build_seconds:.2f} s | "
+                    f"{planar_seconds:.2f} s | {' | '.join(cells)} | {difference:.1e} |")
+        print(rows[-1], flush=True)
+    return rows
+
+
+def house() -> list[str]:
+    builds, solves = [], []
+    for _ in range(3):
+        seconds, model = timed(mf.open_model, "house-tunnel")
+        builds.append(seconds)
+        seconds, result = timed(mf.solve, model, "la")
+        solves.append(seconds)
+    numbers = {n.name: n.value for n in mf.key_numbers(result)}
+    return [f"house-tunnel: {model.sizes['block']:,} blocks, {model.sizes['interface']:,} interfaces; built and "
+            f"checked in {statistics.median(builds):.2f} s, solved in {statistics.median(solves):.2f} s (medians of "
+            f"3; alpha {numbers['alpha']:.4f}, {int(numbers['cracked_joints'])} cracked interfaces, "
+            f"{int(numbers['macro_blocks'])} macro-blocks)."]
+
+
+def main() -> None:
+    command_line(__doc__).parse_args()
+    body = ["The running-bond walls one block thick in 3D against the planar la (one run each):", "", *walls(), "",
+            *house()]
+    write_section("la3d", "la in 3D: time against size, the pyramid against the cone, a house", "\n".join(body))
+
+
+if __name__ == "__main__":
+    main()

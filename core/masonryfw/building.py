@@ -1,0 +1,386 @@
+"""Buildings in 3D from a spec's ``[building]`` table: walls on base lines in plan, laid course by course, toothed
+at their corners, with openings, lintels, floor loads and the ground cut into segments that follow a
+settlement profile in plan (docs/buildings.md).
+
+A wall runs from ``start`` to ``end`` (its base line, the middle of its thickness), ``height`` high in whole
+courses. Units are boxes of the wall's thickness, ``unit.length`` long and ``unit.height`` high, in running
+bond (every other course shifted by half a unit). Where two walls meet end to end at a right angle, the
+corner is toothed: in even courses the wall listed first runs through the corner to the other's outer face
+and the other stops at its inner face; in odd courses the other way round. An opening takes its courses
+(its sill and head moved onto the nearest bed joints, said in ``laying_notes``) and a lintel one course high
+bears ``lintel_bearing`` into the masonry on either side. Floors are line loads [N/m] on the course at their
+height. Every wall stands on support blocks ``support_depth`` deep, cut into segments ``segment`` long under
+its first course; a segment follows the settlement profile at its two ends (settles by its mean rate and
+turns about the horizontal axis across the wall with the slope between them).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import xarray as xr
+
+from . import polyhedra
+from .errors import SpecError
+from .model3d import model_from_polyhedra
+from .profiles import SETTLEMENT_KEYS, Profile, node_motion, read_profile
+from .roles import ROLE
+from .spec import LENGTH_UNITS, SpecTable, read_material
+
+BUILDING_KEYS = ("unit", "walls", "floors", "support_depth", "segment")
+WALL_KEYS = ("name", "start", "end", "height", "thickness", "openings")
+OPENING_KEYS = ("x", "y", "width", "height", "lintel_bearing")
+FLOOR_KEYS = ("walls", "height", "load")
+#: A 3D profile's keys: the 2D ones, its axis in plan through a point instead of ``center``.
+SETTLEMENT_3D_KEYS = tuple(k for k in SETTLEMENT_KEYS if k != "center") + ("axis_angle", "center_x", "center_y")
+TOP_KEYS = ("title", "description", "space", "length_unit", "building", "material", "settlement")
+#: A piece of a unit shorter than this share of the unit length joins its neighbour.
+SLIVER = 0.25
+KIND = {"bed": 0, "head": 1, "support": 2, "other": 3}
+
+
+@dataclass(frozen=True)
+class Wall:
+    name: str
+    start: np.ndarray  # (2,) [m]
+    end: np.ndarray
+    height: float
+    thickness: float
+    openings: tuple[tuple[float, float, float, float, float], ...]  # x, y, width, height, lintel bearing
+
+    @property
+    def length(self) -> float:
+        return float(np.linalg.norm(self.end - self.start))
+
+    @property
+    def along(self) -> np.ndarray:
+        return (self.end - self.start) / self.length
+
+    @property
+    def across(self) -> np.ndarray:
+        """The left normal: (along, across, z) is right-handed."""
+        return np.array([-self.along[1], self.along[0]])
+
+
+def is_building(spec: dict) -> bool:
+    return "building" in spec
+
+
+def read_walls(building: SpecTable, unit_length: float, unit_height: float) -> list[Wall]:
+    raw = building.raw("walls")
+    if not isinstance(raw, list) or not raw:
+        raise SpecError(f"spec key {building.key('walls')!r} must be a list of tables [[building.walls]]")
+    walls = []
+    for i, table in enumerate(raw):
+        wall = SpecTable(table, f"{building.key('walls')}[{i}]", WALL_KEYS, building.scale)
+        start, end = np.array(wall.point("start")), np.array(wall.point("end"))
+        if np.linalg.norm(end - start) <= 1e-9 * (1.0 + np.linalg.norm(start)):
+            raise SpecError(f"spec keys {wall.key('start')!r} and {wall.key('end')!r}: the wall has no length")
+        height = wall.number("height", length=True, positive=True)
+        courses = height / unit_height
+        if abs(courses - round(courses)) > 1e-6 * courses:
+            raise SpecError(f"spec key {wall.key('height')!r} = {wall.raw('height')!r}: not whole courses of "
+                            f"{unit_height / building.scale:g} ({courses:.4g} courses)")
+        thickness = wall.number("thickness", length=True, positive=True)
+        walls.append(Wall(wall.text("name", f"wall {i}"), start, end, round(courses) * unit_height, thickness,
+                          read_openings(wall, unit_length)))
+    names = [w.name for w in walls]
+    if len(set(names)) != len(names):
+        raise SpecError(f"spec key {building.key('walls')!r}: two walls are named {next(n for n in names if names.count(n) > 1)!r}")
+    return walls
+
+
+def read_openings(wall: SpecTable, unit_length: float) -> tuple[tuple[float, float, float, float, float], ...]:
+    raw = wall.raw("openings", [])
+    if not isinstance(raw, list):
+        raise SpecError(f"spec key {wall.key('openings')!r} must be a list of tables")
+    openings = []
+    for i, table in enumerate(raw):
+        opening = SpecTable(table, f"{wall.key('openings')}[{i}]", OPENING_KEYS, wall.scale)
+        openings.append((opening.number("x", length=True, minimum=0.0), opening.number("y", length=True, minimum=0.0),
+                         opening.number("width", length=True, positive=True),
+                         opening.number("height", length=True, positive=True),
+                         opening.number("lintel_bearing", 0.5 * unit_length / wall.scale, length=True, minimum=0.0)))
+    return tuple(openings)
+
+
+def corners(walls: list[Wall], tol: float) -> dict[tuple[int, int], tuple[int, int]]:
+    """``{(wall, end): (other wall, its end)}`` for walls meeting end to end (end 0: start, 1: end); a right angle
+    is required, and a wall's end on another wall's middle (a T) is refused for now."""
+    ends = [(w, e, (wall.start, wall.end)[e]) for w, wall in enumerate(walls) for e in (0, 1)]
+    found: dict[tuple[int, int], tuple[int, int]] = {}
+    for a, (wa, ea, pa) in enumerate(ends):
+        for wb, eb, pb in ends[a + 1:]:
+            if wb != wa and np.linalg.norm(pa - pb) <= tol:
+                if (wa, ea) in found or (wb, eb) in found:
+                    raise SpecError(f"walls {walls[wa].name!r} and {walls[wb].name!r}: more than two walls meet at "
+                                    f"({pa[0]:.6g}, {pa[1]:.6g}); corners of two walls only so far")
+                cosine = abs(float(walls[wa].along @ walls[wb].along))
+                if cosine > 1e-6:
+                    raise SpecError(f"walls {walls[wa].name!r} and {walls[wb].name!r} meet at "
+                                    f"{math.degrees(math.acos(min(cosine, 1.0))):.4g} degrees: only right-angle "
+                                    "corners are toothed so far")
+                found[(wa, ea)], found[(wb, eb)] = (wb, eb), (wa, ea)
+    for w, wall in enumerate(walls):
+        for e, point in ((0, wall.start), (1, wall.end)):
+            if (w, e) in found:
+                continue
+            for v, other in enumerate(walls):
+                offset = float((point - other.start) @ other.along)
+                if v != w and abs(float((point - other.start) @ other.across)) <= tol and 0 < offset < other.length:
+                    raise SpecError(f"wall {wall.name!r} ends on the middle of wall {other.name!r} (a T-junction): "
+                                    "T-junctions are not laid yet; end the walls at corners")
+    return found
+
+
+def course_extent(walls: list[Wall], found: dict, courses: list[int], w: int, course: int) -> tuple[float, float]:
+    """The wall's extent along its base line in ``course``: through a corner it owns in this course (to the
+    other wall's outer face), short of one it does not (to the other's inner face); its end where it is free
+    (or the other wall has no such course)."""
+    wall = walls[w]
+    extent = [0.0, wall.length]
+    for e, sign in ((0, -1.0), (1, 1.0)):
+        if (w, e) not in found or course >= courses[found[(w, e)][0]]:
+            continue
+        other = found[(w, e)][0]
+        owner = min(w, other) if course % 2 == 0 else max(w, other)
+        extent[e] += sign * (0.5 if owner == w else -0.5) * walls[other].thickness
+    return extent[0], extent[1]
+
+
+def pieces(a: float, b: float, origin: float, unit_length: float) -> list[tuple[float, float]]:
+    """``[a, b]`` cut at ``origin + m * unit_length``, a sliver under :data:`SLIVER` of a unit joined to its
+    neighbour."""
+    if b - a <= 1e-9 * unit_length:
+        return []
+    first = origin + math.ceil((a - origin) / unit_length + 1e-9) * unit_length
+    cuts = [a, *np.arange(first, b - 1e-9 * unit_length, unit_length).tolist(), b]
+    parts = [(p, q) for p, q in zip(cuts[:-1], cuts[1:]) if q - p > 1e-9 * unit_length]
+    if len(parts) > 1 and parts[0][1] - parts[0][0] < SLIVER * unit_length:
+        parts[:2] = [(parts[0][0], parts[1][1])]
+    if len(parts) > 1 and parts[-1][1] - parts[-1][0] < SLIVER * unit_length:
+        parts[-2:] = [(parts[-2][0], parts[-1][1])]
+    return parts
+
+
+def whole_at_end(parts: list[tuple[float, float]], unit_length: float) -> list[tuple[float, float]]:
+    """``parts`` with a whole unit last (the quoin of a corner the course runs through) and the rest of the last
+    two in the piece before it (a closer; one longer piece when the closer would be a sliver)."""
+    if len(parts) < 2 or parts[-1][1] - parts[-1][0] >= unit_length * (1 - 1e-9):
+        return parts
+    start, end = parts[-2][0], parts[-1][1]
+    if end - start - unit_length < SLIVER * unit_length:
+        return parts[:-2] + [(start, end)]
+    return parts[:-2] + [(start, end - unit_length), (end - unit_length, end)]
+
+
+@dataclass
+class Laid:
+    """Boxes in walls' frames as they are laid: wall, along [s0, s1], course (z0, z1), role, extra dead load."""
+
+    wall: list[int]
+    s0: list[float]
+    s1: list[float]
+    z0: list[float]
+    z1: list[float]
+    role: list[int]
+    load: list[float]  # a floor's line load times the length [N], down
+
+    def add(self, wall, s0, s1, z0, z1, role, load=0.0):
+        for name, value in zip(("wall", "s0", "s1", "z0", "z1", "role", "load"), (wall, s0, s1, z0, z1, role, load)):
+            getattr(self, name).append(value)
+
+
+def lay_masonry(walls: list[Wall], found: dict, unit_length: float, unit_height: float, notes: list[str]) -> Laid:
+    """Every wall's courses: units in running bond between its course extents, openings left out, a lintel
+    over each opening (module docstring)."""
+    courses = [round(wall.height / unit_height) for wall in walls]
+    laid = Laid([], [], [], [], [], [], [])
+    for w, wall in enumerate(walls):
+        gaps: dict[int, list[tuple[float, float]]] = {}  # course: the ranges the openings leave open
+        lintels: dict[int, list[tuple[float, float]]] = {}  # course: the ranges of the lintels
+        for number, (x, y, width, height, bearing) in enumerate(wall.openings):
+            k0, k1 = round(y / unit_height), round((y + height) / unit_height)
+            if abs(k0 * unit_height - y) > 1e-9 or abs(k1 * unit_height - y - height) > 1e-9:
+                notes.append(f"wall {wall.name!r} opening {number}: sill and head moved onto bed joints "
+                             f"(y {k0 * unit_height:.4g} m, height {(k1 - k0) * unit_height:.4g} m)")
+            if k1 <= k0 or x + width > wall.length or k1 > courses[w]:
+                raise SpecError(f"wall {wall.name!r} opening {number}: x {x:g}, y {y:g}, width {width:g}, height "
+                                f"{height:g} m does not fit in the wall ({wall.length:.6g} m long, {wall.height:.6g} "
+                                "m high, at least a course high)")
+            for k in range(k0, k1):
+                gaps.setdefault(k, []).append((x, x + width))
+            if k1 < courses[w]:
+                lintels.setdefault(k1, []).append((max(x - bearing, 0.0), min(x + width + bearing, wall.length)))
+        origin = course_extent(walls, found, courses, w, 0)[0]  # the bond starts with a full unit there
+        for k in range(courses[w]):
+            a, b = course_extent(walls, found, courses, w, k)
+            cut = sorted(gaps.get(k, []) + lintels.get(k, []))
+            if any(q > p + 1e-9 * unit_length for (_, q), (p, _) in zip(cut[:-1], cut[1:])):
+                raise SpecError(f"wall {wall.name!r}: two openings (or an opening and a lintel over another) overlap "
+                                f"in course {k} ({k * unit_height:.4g} to {(k + 1) * unit_height:.4g} m); move them "
+                                "apart by a unit or more")
+            for p, q in zip([a] + [end for _, end in cut], [start for start, _ in cut] + [b]):
+                parts = pieces(p, q, origin + (k % 2) * 0.5 * unit_length, unit_length)
+                if q > wall.length + 1e-9 * unit_length:  # through a corner: a whole unit there, a closer before it
+                    parts = whole_at_end(parts, unit_length)
+                for s0, s1 in parts:
+                    laid.add(w, s0, s1, k * unit_height, (k + 1) * unit_height, ROLE["unit"])
+            for s0, s1 in lintels.get(k, []):
+                laid.add(w, s0, s1, k * unit_height, (k + 1) * unit_height, ROLE["lintel"])
+    return laid
+
+
+def oriented_boxes(walls: list[Wall], laid_wall, s0, s1, z0, z1) -> polyhedra.Polyhedra:
+    """Boxes ``[s0, s1]`` along their walls' base lines, the walls' thickness across, ``[z0, z1]`` high."""
+    w = np.asarray(laid_wall)
+    start = np.array([wall.start for wall in walls])[w]
+    along = np.array([wall.along for wall in walls])[w]
+    across = np.array([wall.across for wall in walls])[w]
+    half = 0.5 * np.array([wall.thickness for wall in walls])[w]
+    corner = np.array([[i & 1, (i >> 1) & 1, (i >> 2) & 1] for i in range(8)])
+    s = np.where(corner[None, :, 0] == 1, np.asarray(s1)[:, None], np.asarray(s0)[:, None])
+    q = np.where(corner[None, :, 1] == 1, half[:, None], -half[:, None])
+    z = np.where(corner[None, :, 2] == 1, np.asarray(z1)[:, None], np.asarray(z0)[:, None])
+    plan = start[:, None, :] + s[..., None] * along[:, None, :] + q[..., None] * across[:, None, :]
+    vertices = np.concatenate([plan, z[..., None]], axis=2).reshape(-1, 3)
+    template = polyhedra.boxes(np.zeros((1, 3)), np.ones((1, 3)))
+    n = w.size
+    return polyhedra.Polyhedra(vertices, np.full(n, 8), np.full(n, 6), np.full(6 * n, 4),
+                               np.tile(template.face_nodes, n))
+
+
+def profile_in_plan(table: SpecTable, unit_length: float) -> tuple[Profile, np.ndarray, np.ndarray]:
+    """The ``[settlement]`` profile over the coordinate across its axis in plan, the axis's point and the unit
+    vector its coordinate runs along: ``axis_angle`` degrees from x (90: the axis along y, the profile along
+    x) through (``center_x``, ``center_y``)."""
+    angle = math.radians(table.number("axis_angle", 90.0))
+    point = np.array([table.number("center_x", 0.0, length=True), table.number("center_y", 0.0, length=True)])
+    plain = {k: v for k, v in table.table.items() if k not in ("axis_angle", "center_x", "center_y")}
+    if plain.get("profile") in ("gaussian", "tunnel"):
+        plain["center"] = 0.0
+    profile = read_profile(SpecTable(plain, table.path, SETTLEMENT_KEYS, table.scale), 0.0, 1.0, unit_length)
+    return profile, point, np.array([math.sin(angle), -math.cos(angle)])
+
+
+def segment_motion(profile: Profile, point: np.ndarray, direction: np.ndarray, ends: np.ndarray, along: np.ndarray,
+                   across: np.ndarray, depth: float) -> np.ndarray:
+    """``(segment, 6)``: a ground segment's motion per unit t at its centroid, ``depth`` below the middle of its top
+    edge from ``ends[:, 0]`` to ``ends[:, 1]`` (plan): the top edge follows the ground at both ends as in 2D
+    (:func:`masonryfw.profiles.node_motion`: down linear between them, across the horizontal mean of theirs,
+    turned about the wall's horizontal axis ``across``)."""
+    down, horizontal = node_motion(profile, (ends - point) @ direction)  # (segment, 2) each
+    length = np.linalg.norm(ends[:, 1] - ends[:, 0], axis=1)
+    theta = (down[:, 1] - down[:, 0]) / length  # about ``across``: (along x across) = z
+    top = np.c_[horizontal.mean(axis=1)[:, None] * direction, -down.mean(axis=1)]
+    motion = np.zeros((ends.shape[0], 6))
+    motion[:, :2] = top[:, :2] - (theta * 0.5 * depth)[:, None] * along
+    motion[:, 2] = top[:, 2]
+    motion[:, 3:5] = theta[:, None] * across
+    return motion + 0.0
+
+
+def build_building(spec: dict, text: str) -> xr.Dataset:
+    """The 3D model of a spec with a ``[building]`` table (module docstring); a :class:`SpecError` names the key."""
+    top = SpecTable(spec, "", TOP_KEYS)
+    top.scale = LENGTH_UNITS[top.choice("length_unit", tuple(LENGTH_UNITS), "m")]
+    if top.raw("space", 3) != 3:
+        raise SpecError(f"spec key 'space' = {top.raw('space')!r}: a [building] is 3D (space = 3, or leave it out)")
+    building = top.sub("building", BUILDING_KEYS)
+    unit = building.sub("unit", ("length", "height"))
+    unit_length = unit.number("length", length=True, positive=True)
+    unit_height = unit.number("height", length=True, positive=True)
+    walls = read_walls(building, unit_length, unit_height)
+    material = read_material(top)
+    if not top.has("settlement"):
+        raise SpecError("spec table 'settlement' is missing: a building stands on ground that moves by a profile "
+                        "in plan ([settlement] with profile, axis_angle, center_x, center_y)")
+    settlement = top.sub("settlement", SETTLEMENT_3D_KEYS)
+    profile, point, direction = profile_in_plan(settlement, unit_length)
+    depth = building.number("support_depth", unit_height / top.scale, length=True, positive=True)
+    segment = building.number("segment", profile.segment / top.scale, length=True, positive=True)
+    tol = 1e-6 * max(w.length for w in walls)
+    found = corners(walls, tol)
+    notes: list[str] = []
+    laid = lay_masonry(walls, found, unit_length, unit_height, notes)
+    add_floors(building, walls, laid, unit_height)
+    courses = [round(w.height / unit_height) for w in walls]
+    n_masonry = len(laid.wall)
+    ground: list[tuple[int, float, float]] = []
+    for w, _wall in enumerate(walls):
+        a, b = course_extent(walls, found, courses, w, 0)
+        cuts = np.linspace(a, b, max(1, round((b - a) / segment)) + 1)
+        ground += [(w, p, q) for p, q in zip(cuts[:-1], cuts[1:])]
+    for w, p, q in ground:
+        laid.add(w, p, q, -depth, 0.0, ROLE["fixed_support"])
+    poly = oriented_boxes(walls, laid.wall, laid.s0, laid.s1, laid.z0, laid.z1)
+    volume, _ = polyhedra.volumes_centroids(poly)
+    contacts = polyhedra.find_contacts(poly, tol)
+    return _dataset(walls, laid, n_masonry, poly, volume, contacts, material, (profile, point, direction, depth),
+                    {"title": top.text("title"), "source_spec": text, **({"laying_notes": "\n".join(notes)} if notes else {}),
+                     **({"comment": top.text("description")} if top.has("description") else {})})
+
+
+def add_floors(building: SpecTable, walls: list[Wall], laid: Laid, unit_height: float) -> None:
+    """Each ``[[building.floors]]`` line load [N/m] on the named walls' course whose top is nearest its height."""
+    names = {wall.name: w for w, wall in enumerate(walls)}
+    for i, table in enumerate(building.raw("floors", [])):
+        floor = SpecTable(table, f"{building.key('floors')}[{i}]", FLOOR_KEYS, building.scale)
+        on = floor.raw("walls")
+        if not isinstance(on, list) or not on or any(name not in names for name in on):
+            raise SpecError(f"spec key {floor.key('walls')!r} = {on!r}: must list walls by name ({', '.join(names)})")
+        top_course = round(floor.number("height", length=True, positive=True) / unit_height) - 1
+        load = floor.number("load", minimum=0.0)
+        hit = False
+        for b, (w, z0) in enumerate(zip(laid.wall, laid.z0)):
+            if walls[w].name in on and round(z0 / unit_height) == top_course:
+                laid.load[b] += load * (laid.s1[b] - laid.s0[b])
+                hit = True
+        if not hit:
+            raise SpecError(f"spec key {floor.key('height')!r} = {floor.raw('height')!r}: no course of the walls "
+                            f"{', '.join(on)} ends there")
+
+
+def _dataset(walls, laid, n_masonry, poly, volume, contacts, material, ground_profile, attrs) -> xr.Dataset:
+    profile, point, direction, depth = ground_profile
+    n = len(laid.wall)
+    role = np.array(laid.role, dtype=np.int8)
+    weight = np.where(np.arange(n) < n_masonry, material.unit_weight * volume, 0.0) + np.array(laid.load)
+    wall = np.array(laid.wall)
+    starts = np.array([w.start for w in walls])[wall]
+    along = np.array([w.along for w in walls])[wall]
+    across = np.array([w.across for w in walls])[wall]
+    ends = starts[:, None, :] + np.stack([np.array(laid.s0), np.array(laid.s1)], axis=1)[..., None] * along[:, None, :]
+    ground = np.arange(n) >= n_masonry
+    motion = np.zeros((n, 6))
+    motion[ground] = segment_motion(profile, point, direction, ends[ground], along[ground], across[ground], depth)
+    moving = ground & (np.abs(motion).max(axis=1) > 0)
+    role[moving] = ROLE["moving_support"]
+    motion[~moving] = 0.0
+    footprint = (np.array(laid.s1) - np.array(laid.s0)) * np.array([w.thickness for w in walls])[wall]
+    share = weight[:n_masonry].sum() * footprint / footprint[ground].sum()
+    dead = np.zeros((n, 3))
+    live = np.zeros((n, 3))
+    dead[:, 2] = -weight
+    dead[moving, 2] = share[moving]  # the paper's convention: up the weight it carries uniformly, the same down live
+    live[moving, 2] = -share[moving]
+    fixed = np.zeros((n, 6), dtype=np.int8)
+    fixed[ground & ~moving] = 1
+    normal_z = np.abs(contacts.normal[:, 2])
+    support = ground[contacts.sides].any(axis=1)
+    kind = np.where(support, KIND["support"], np.where(normal_z > 0.5, KIND["bed"], KIND["head"])).astype(np.int8)
+    m = contacts.n_interface
+    arrays = {"block_role": role, "block_unit_weight": np.where(ground, 0.0, material.unit_weight),
+              "interface_kind": kind, "interface_friction": np.full(m, material.friction),
+              "interface_cohesion": np.full(m, material.cohesion),
+              "interface_tensile_strength": np.full(m, material.tensile_strength),
+              "dead_load": dead, "dead_moment": np.zeros((n, 3)), "live_load": live, "live_moment": np.zeros((n, 3)),
+              "block_fixed": fixed, "settlement_direction": motion}
+    if profile.target is not None:
+        arrays["settlement_target"] = np.float64(profile.target)
+    for name in ("young_modulus", "poisson_ratio"):
+        value = getattr(material, name)
+        if value is not None:
+            arrays[f"block_{name}"] = np.full(n, value)
+    return model_from_polyhedra(poly, contacts, arrays, attrs)

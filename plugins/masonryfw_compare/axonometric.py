@@ -1,0 +1,144 @@
+"""3D models and results drawn in axonometry (matplotlib's 3D axes): the model by role, the mechanism amplified
+with its macro-blocks coloured and its cracked interfaces outlined. What the ``model`` and ``mechanism`` kinds
+draw for a 3D dataset."""
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import Any
+
+import numpy as np
+import xarray as xr
+from matplotlib.lines import Line2D
+from matplotlib.patches import Patch
+
+import masonryfw as mf
+import masonryfw.plugin_api as mfp
+
+from .figure_parts import SUPPORT_COLOUR, title_of
+
+#: The view: elevation and azimuth [degrees] (the front, y = 0, seen from the south-west, from above).
+VIEW = (22.0, -58.0)
+#: The largest vertex motion of a mechanism is drawn as this share of the model's size by default.
+DRAWN_MOTION_SHARE = 0.05
+CRACK_COLOUR = "k"
+
+
+def axes_3d(ax):
+    """A 3D axes in the place of ``ax`` (the figure :func:`masonryfw.render` made is a 2D one)."""
+    figure, where = ax.figure, ax.get_subplotspec()
+    ax.remove()
+    return figure.add_subplot(where, projection="3d")
+
+
+def faces(geo: xr.Dataset, points: np.ndarray) -> tuple[list[np.ndarray], np.ndarray]:
+    """Every block face as a polygon of ``points`` (the blocks' vertices, moved or not), and its block."""
+    poly = mfp.polyhedra_of(geo)
+    index = poly.face_vertex_index()
+    split = np.cumsum(poly.face_node_count)[:-1]
+    return np.split(points[index], split), poly.face_block()
+
+
+def moved_points(geo: xr.Dataset, u: np.ndarray, amplification: float) -> np.ndarray:
+    """The blocks' vertices moved by ``amplification`` times the mechanism ``u`` (block, 6), linearised."""
+    owner = np.repeat(np.arange(geo.sizes["block"]), geo.block_node_count.values)
+    points = np.c_[geo.node_x.values, geo.node_y.values, geo.node_z.values]
+    centre = np.c_[geo.block_centroid_x.values, geo.block_centroid_y.values, geo.block_centroid_z.values][owner]
+    motion = u[owner, :3] + np.cross(u[owner, 3:], points - centre)
+    return points + amplification * motion
+
+
+def default_amplification(geo: xr.Dataset, u: np.ndarray) -> float:
+    largest = float(np.linalg.norm(moved_points(geo, u, 1.0) - moved_points(geo, u, 0.0), axis=1).max(initial=0.0))
+    size = float(np.ptp(np.c_[geo.node_x.values, geo.node_y.values, geo.node_z.values], axis=0).max())
+    return DRAWN_MOTION_SHARE * size / largest if largest > 0 else 1.0
+
+
+def finish_3d(ax, ds: xr.Dataset, points: np.ndarray) -> None:
+    """Equal scales on the three axes fitted to ``points``, the view, labels and the title."""
+    low, high = points.min(axis=0), points.max(axis=0)
+    centre, half = 0.5 * (low + high), 0.5 * float((high - low).max())
+    for setter, c in zip((ax.set_xlim, ax.set_ylim, ax.set_zlim), centre):
+        setter(c - half, c + half)
+    ax.set_box_aspect((1, 1, 1))
+    ax.view_init(*VIEW)
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("y [m]")
+    ax.set_zlabel("z [m]")
+    headline = mf.headline_text(ds) if "solver" in ds.attrs else ""
+    ax.set_title(title_of(ds) + (f"\n{headline}" if headline else ""), fontsize="medium")
+
+
+def draw_model_3d(ds: xr.Dataset, ax, colours: Mapping[str, str]) -> None:
+    """The blocks by role (``colours``: role name to colour), the moving supports in their colour."""
+    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+
+    ax = axes_3d(ax)
+    geo = mfp.derive_geometry(ds)
+    names = {value: name for name, value in mfp.ROLE.items()}
+    role = [names[int(r)] for r in geo.block_role.values]
+    points = np.c_[geo.node_x.values, geo.node_y.values, geo.node_z.values]
+    polygons, block = faces(geo, points)
+    ax.add_collection3d(Poly3DCollection(polygons, facecolors=[colours[role[b]] for b in block], edgecolors="0.35",
+                                         linewidths=0.2))
+    present = sorted(set(role), key=list(colours).index)
+    ax.legend(handles=[Patch(facecolor=colours[r], edgecolor="0.35", label=r.replace("_", " ")) for r in present],
+              loc="upper left", bbox_to_anchor=(1.02, 1.0), fontsize="small", frameon=False)
+    finish_3d(ax, ds, points)
+
+
+def draw_mechanism_3d(ds: xr.Dataset, ax, options: Mapping[str, Any], pieces, piece_colours) -> None:
+    """The blocks moved by the amplified mechanism relative to the largest macro-block, coloured by macro-block
+    (``piece_colours`` per block), the supports grey, the cracked interfaces outlined on side 0's face."""
+    from mpl_toolkits.mplot3d.art3d import Line3DCollection, Poly3DCollection
+
+    ax = axes_3d(ax)
+    ax.computed_zorder = False  # the cracked interfaces over the blocks, whose faces are sorted among themselves
+    geo = mfp.derive_geometry(ds)
+    u = relative_to_largest(geo, mfp.block_motion(ds), pieces)
+    amplification = options["amplification"] or default_amplification(geo, u)
+    points = moved_points(geo, u, amplification)
+    polygons, block = faces(geo, points)
+    support = mfp.support_blocks(geo.block_role.values)
+    colours = [SUPPORT_COLOUR if support[b] else piece_colours[b] for b in block]
+    ax.add_collection3d(Poly3DCollection(polygons, facecolors=colours, edgecolors="0.3", linewidths=0.15, zorder=1))
+    handles = [Patch(facecolor=piece_colours[np.flatnonzero(pieces.number == k)[0]], edgecolor="0.3",
+                     label=f"macro-block ({k})") for k in range(1, pieces.dominant + 1)]
+    if pieces.small:
+        handles.append(Patch(facecolor=piece_colours[np.flatnonzero((pieces.number == 0) & ~support)[0]],
+                             edgecolor="0.3", label=f"small pieces ({pieces.small})"))
+    if "crack_indicator" in ds:
+        cracked = mf.cracked_joints(ds, options["threshold"])
+        outlines = cracked_outlines(geo, u, amplification, cracked)
+        ax.add_collection3d(Line3DCollection(outlines, colors=CRACK_COLOUR, linewidths=0.9, zorder=2))
+        handles.append(Line2D([], [], color=CRACK_COLOUR, lw=1.5, label=f"cracked interfaces ({int(cracked.sum())}), "
+                                                                       "seen through the masonry"))
+    reference = "macro-block (1)" if pieces.dominant else "the ground"
+    ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.02, 1.0), fontsize="small", frameon=False,
+              title=f"motion relative to {reference}, x {amplification:.3g}", title_fontsize="small")
+    finish_3d(ax, ds, points)
+
+
+def relative_to_largest(geo: xr.Dataset, u: np.ndarray, pieces) -> np.ndarray:
+    """``u`` (block, 6) less the rigid motion of the largest macro-block (its blocks then stand still): a building
+    settles with the ground by far more than its parts move against each other, and the drawing is of the
+    latter."""
+    largest = np.flatnonzero(pieces.number == 1)
+    if largest.size == 0:
+        return u
+    reference = largest[0]
+    centre = np.c_[geo.block_centroid_x.values, geo.block_centroid_y.values, geo.block_centroid_z.values]
+    rigid = np.c_[u[reference, :3] + np.cross(u[reference, 3:], centre - centre[reference]),
+                  np.broadcast_to(u[reference, 3:], (u.shape[0], 3))]
+    return u - rigid
+
+
+def cracked_outlines(geo: xr.Dataset, u: np.ndarray, amplification: float, cracked: np.ndarray) -> list[np.ndarray]:
+    """The polygon of every cracked interface, closed, carried by its side-0 block's amplified motion."""
+    count = geo.interface_node_count.values.astype(np.int64)
+    points = np.c_[geo.interface_node_x.values, geo.interface_node_y.values, geo.interface_node_z.values]
+    owner = np.repeat(np.arange(count.size), count)
+    side0 = geo.interface_blocks.values[owner, 0].astype(np.int64)
+    centre = np.c_[geo.block_centroid_x.values, geo.block_centroid_y.values, geo.block_centroid_z.values][side0]
+    moved = points + amplification * (u[side0, :3] + np.cross(u[side0, 3:], points - centre))
+    polygons = np.split(moved, np.cumsum(count)[:-1])
+    return [np.vstack([p, p[:1]]) for p, crack in zip(polygons, cracked) if crack]

@@ -1,0 +1,143 @@
+"""Buildings from a spec's ``[building]`` table: laid once, toothed at the corners, the same wall as in 2D."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import masonryfw as mf
+import masonryfw.plugin_api as mfp
+
+ROLE = mfp.flags("block_role")
+MATERIAL = {"unit_weight": 20000.0, "friction_angle": 30.0}
+UNIT = {"length": 0.24, "height": 0.12}
+
+
+def wall(name, start, end, openings=(), height=1.2, thickness=0.12):
+    return {"name": name, "start": list(start), "end": list(end), "height": height, "thickness": thickness,
+            "openings": [dict(o) for o in openings]}
+
+
+def house_spec(**settlement):
+    """A 2.4 x 1.8 m house of four walls 1.2 m high (ten courses), a door and a window, a floor on two walls,
+    over a tunnel whose axis runs at 60 degrees to x."""
+    walls = [wall("south", (0, 0), (2.4, 0), [{"x": 0.96, "y": 0.0, "width": 0.48, "height": 0.72}]),
+             wall("east", (2.4, 0), (2.4, 1.8), [{"x": 0.6, "y": 0.48, "width": 0.48, "height": 0.36}]),
+             wall("north", (2.4, 1.8), (0, 1.8)), wall("west", (0, 1.8), (0, 0))]
+    return {"title": "A small house", "building": {"unit": UNIT, "walls": walls,
+                                                   "floors": [{"walls": ["south", "north"], "height": 1.2,
+                                                               "load": 2000.0}]},
+            "material": MATERIAL,
+            "settlement": settlement or {"profile": "tunnel", "volume_loss": 2.0, "diameter": 3.0, "depth": 6.0,
+                                         "axis_angle": 60.0, "center_x": 2.0, "center_y": 0.5}}
+
+
+@pytest.fixture(scope="module")
+def house():
+    return mf.build(house_spec())
+
+
+def box_bounds(model):
+    owner = np.repeat(np.arange(model.sizes["block"]), model.block_node_count.values)
+    points = np.c_[model.node_x.values, model.node_y.values, model.node_z.values]
+    low = np.full((model.sizes["block"], 3), np.inf)
+    high = np.full((model.sizes["block"], 3), -np.inf)
+    np.minimum.at(low, owner, points)
+    np.maximum.at(high, owner, points)
+    return low, high
+
+
+def test_the_house_is_laid_once_over_its_walls_less_its_openings(house):
+    """Its masonry fills the walls' footprint (centre lines 2.4 x 1.8 m, 0.12 m thick: 2 t (a + b) in plan) times
+    1.2 m, less the door and the window, exactly; no two blocks overlap (the walls run along x and y: boxes)."""
+    masonry = mfp.masonry_blocks(house.block_role.values)
+    t = 0.12
+    expected = 2 * t * (2.4 + 1.8) * 1.2 - t * (0.48 * 0.72 + 0.48 * 0.36)
+    assert house.block_volume.values[masonry].sum() == pytest.approx(expected, rel=1e-12)
+    low, high = box_bounds(house)
+    common = np.clip(np.minimum(high[:, None], high[None]) - np.maximum(low[:, None], low[None]), 0, None).prod(-1)
+    np.fill_diagonal(common, 0.0)
+    assert common.max() < 1e-12
+
+
+def test_the_corners_are_toothed_course_by_course(house):
+    """The block filling each corner's square alternates between the two walls from course to course."""
+    low, high = box_bounds(house)
+    masonry = mfp.masonry_blocks(house.block_role.values)
+    centre = 0.5 * (low + high)
+    for corner in ((2.4, 0.0), (2.4, 1.8), (0.0, 1.8), (0.0, 0.0)):
+        owners = []
+        for course in range(10):
+            z = (course + 0.5) * 0.12
+            inside = (masonry & (low[:, 0] <= corner[0] - 0.05) & (high[:, 0] >= corner[0] + 0.05)
+                      & (low[:, 1] <= corner[1] - 0.05) & (high[:, 1] >= corner[1] + 0.05)
+                      & (np.abs(centre[:, 2] - z) < 0.01))
+            assert inside.sum() == 1, (corner, course)
+            block = int(np.flatnonzero(inside)[0])
+            owners.append("x" if high[block, 0] - low[block, 0] > high[block, 1] - low[block, 1] else "y")
+        assert all(a != b for a, b in zip(owners[:-1], owners[1:])), (corner, owners)
+
+
+def test_openings_have_lintels_and_floors_load_their_course(house):
+    assert int((house.block_role.values == ROLE["lintel"]).sum()) == 2
+    masonry = mfp.masonry_blocks(house.block_role.values)
+    weight = 20000.0 * house.block_volume.values[masonry].sum()
+    # the top course is odd: the later-listed wall of each corner runs through it; south stops short of both its
+    # corners (2.4 - 0.12 m), north runs through its corner with east and stops short of west's (2.4 m)
+    floors = 2000.0 * ((2.4 - 0.12) + 2.4)
+    assert -house.dead_load.values[masonry, 2].sum() == pytest.approx(weight + floors, rel=1e-12)
+
+
+def test_a_straight_building_wall_is_the_planar_wall():
+    """The same wall over the same trough from a 2D spec (2D builder, 2D programme) and as a building of one wall
+    (3D builder, 3D programme): the same support motions, alpha and settlement reaction."""
+    planar = mf.build({"title": "wall", "wall": {"width": 2.4, "height": 1.2, "thickness": 0.12}, "unit": UNIT,
+                       "bond": {"pattern": "running", "first_course": "full"}, "material": MATERIAL,
+                       "settlement": {"profile": "gaussian", "width": 0.8, "center": 1.9, "segment": 0.06},
+                       "loading": {"type": "settlement"}})
+    building = mf.build({"title": "wall", "building": {"unit": UNIT, "segment": 0.06,
+                                                       "walls": [wall("w", (0, 0), (2.4, 0))]},
+                         "material": MATERIAL, "settlement": {"profile": "gaussian", "width": 0.8, "center_x": 1.9}})
+    assert building.sizes["block"] == planar.sizes["block"]
+    moving = planar.block_role.values == ROLE["moving_support"]
+    np.testing.assert_allclose(building.settlement_direction.values[moving][:, [0, 2, 4]],
+                               planar.settlement_direction.values[moving] * [1, 1, -1], atol=1e-12)
+    a, b = mf.solve(planar, "la"), mf.solve(building, "la")
+    assert float(b.collapse_multiplier) == pytest.approx(float(a.collapse_multiplier), rel=1e-7)
+    assert float(b.moving_support_reaction) == pytest.approx(float(a.moving_support_reaction), rel=1e-7)
+
+
+def test_a_wall_along_y_is_the_wall_along_x_turned():
+    """The same one-wall building along y with the trough's axis turned with it: the same alpha."""
+    along_x = {"profile": "gaussian", "width": 0.8, "center_x": 1.9, "axis_angle": 90.0}
+    along_y = {"profile": "gaussian", "width": 0.8, "center_y": 1.9, "axis_angle": 180.0}
+    alphas = [float(mf.solve(mf.build({"title": "w", "building": {"unit": UNIT, "walls": [wall("w", (0, 0), end)]},
+                                       "material": MATERIAL, "settlement": profile}), "la").collapse_multiplier)
+              for end, profile in (((2.4, 0), along_x), ((0, 2.4), along_y))]
+    assert alphas[1] == pytest.approx(alphas[0], rel=1e-7)
+
+
+@pytest.mark.parametrize("change, message", [
+    (lambda s: s["building"]["walls"][1].update(start=[1.2, 0.0], end=[1.2, 1.8]),
+     "wall 'east' ends on the middle of wall 'south'"),
+    (lambda s: s["building"]["walls"][1].update(end=[3.4, 1.8]), "meet at 60.95 degrees"),
+    (lambda s: s["building"]["walls"][0].update(height=1.25), "not whole courses"),
+    (lambda s: s["building"]["walls"][0]["openings"][0].update(x=2.2), "does not fit in the wall"),
+    (lambda s: s["building"]["floors"][0].update(walls=["attic"]), "must list walls by name"),
+    (lambda s: s["building"]["walls"][0]["openings"].append({"x": 1.2, "y": 0.72, "width": 0.48, "height": 0.24}),
+     "wall 'south': two openings \\(or an opening and a lintel over another\\) overlap in course 6"),
+    (lambda s: s.pop("settlement"), "spec table 'settlement' is missing"),
+    (lambda s: s.update(space=2), "a \\[building\\] is 3D"),
+    (lambda s: s["building"]["walls"][0].update(colour="red"), "unknown spec key 'building.walls\\[0\\].colour'"),
+])
+def test_a_bad_building_spec_names_the_key_or_the_walls(change, message):
+    spec = house_spec()
+    change(spec)
+    with pytest.raises(mf.SpecError, match=message):
+        mf.build(spec)
+
+
+def test_an_opening_off_the_bed_joints_is_moved_onto_them_and_said():
+    spec = house_spec()
+    spec["building"]["walls"][2]["openings"] = [{"x": 0.72, "y": 0.5, "width": 0.48, "height": 0.3}]
+    notes = mf.build(spec).attrs["laying_notes"]
+    assert "wall 'north' opening 0: sill and head moved onto bed joints (y 0.48 m, height 0.36 m)" in notes

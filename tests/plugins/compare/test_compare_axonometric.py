@@ -1,0 +1,74 @@
+"""3D models and results drawn in axonometry: what the model and mechanism kinds put on the figure."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from mpl_toolkits.mplot3d.art3d import Line3DCollection, Poly3DCollection
+
+import masonryfw as mf
+import masonryfw.plugin_api as mfp
+import masonryfw.testing as mt
+
+
+@pytest.fixture(scope="module")
+def corner():
+    """The kit's corner building and its la result."""
+    model = mt.corner_building()
+    return model, mf.solve(model, "la")
+
+
+def only_axes(figure):
+    """The figure's one axes, a 3D one, after the figure is drawn (3D collections project on drawing)."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    FigureCanvasAgg(figure).draw()
+    assert len(figure.axes) == 1 and figure.axes[0].name == "3d"
+    return figure.axes[0]
+
+
+def test_the_model_is_every_face_of_every_block(corner):
+    model, _ = corner
+    ax = only_axes(mf.render([model], "model"))
+    drawn = [c for c in ax.collections if isinstance(c, Poly3DCollection)]
+    assert len(drawn) == 1 and len(drawn[0].get_paths()) == int(model.block_face_count.values.sum())
+    assert [t.get_text() for t in ax.get_legend().get_texts()] == ["unit", "lintel", "moving support"]
+    assert "corner - model" in ax.get_title()
+
+
+def test_the_mechanism_outlines_every_cracked_interface(corner):
+    _, result = corner
+    ax = only_axes(mf.render([result], "mechanism"))
+    lines = [c for c in ax.collections if isinstance(c, Line3DCollection)]
+    cracked = int(mf.cracked_joints(result).sum())
+    assert cracked > 0 and len(lines) == 1 and len(lines[0].get_segments()) == cracked
+    legend = [t.get_text() for t in ax.get_legend().get_texts()]
+    assert f"cracked interfaces ({cracked}), seen through the masonry" in legend
+    assert "alpha = " in ax.get_title()
+
+
+def test_the_drawing_moves_blocks_relative_to_the_largest_macro_block(corner):
+    """The drawn motion is relative to the largest macro-block's first block (which stands still); the relative
+    motion between any two blocks is the mechanism's."""
+    from masonryfw_compare.axonometric import moved_points, relative_to_largest
+    from masonryfw_compare.block_plots import dominant_pieces
+
+    _, result = corner
+    geo = mfp.derive_geometry(result)
+    pieces = dominant_pieces(result, geo)
+    u = relative_to_largest(geo, mfp.block_motion(result), pieces)
+    first = np.flatnonzero(pieces.number == 1)[0]
+    vertex_block = np.repeat(np.arange(geo.sizes["block"]), geo.block_node_count.values)
+    drawn = moved_points(geo, u, 1.0) - moved_points(geo, u, 0.0)
+    assert np.abs(drawn[vertex_block == first]).max() < 1e-12
+    whole = mfp.block_motion(result)
+    actual = moved_points(geo, whole, 1.0) - moved_points(geo, whole, 0.0)
+    points = np.c_[geo.node_x.values, geo.node_y.values, geo.node_z.values]
+    centre = np.array([geo[f"block_centroid_{c}"].values[first] for c in "xyz"])
+    rigid = whole[first, :3] + np.cross(whole[first, 3:], points - centre)  # the reference block's motion, everywhere
+    np.testing.assert_allclose(actual - drawn, rigid, atol=1e-9 * np.abs(actual).max())
+
+
+@pytest.mark.parametrize("kind", ["cracks", "forces", "history", "ltsm"])
+def test_the_kinds_that_draw_2d_only_say_so(corner, kind):
+    with pytest.raises(mf.ModelError, match=f"the {kind} plot handles 2D models and results"):
+        mf.render([corner[1]], kind)
