@@ -48,7 +48,6 @@ def export_command(result: str, file_format: str, output: str | None) -> None:
     from .export import export_vtk  # imported here: the CLI starts without meshio
 
     dataset = mf.open_dataset(result)
-    mfp.require_space([dataset], (2,), "masonryfw export")
     for path in export_vtk(dataset, Path(output) if output else Path(result).with_suffix(".vtu")):
         click.echo(f"wrote {path}")
 

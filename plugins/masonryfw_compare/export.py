@@ -11,6 +11,12 @@ geometry and a multiblock index that opens them together:
 | ``wall_qp.vtu`` | one vertex per quadrature point | point: ``qp_failure`` (0 elastic, 1 tensile, 2 shear, 3 both) |
 | ``wall.vtm`` | VTK multiblock index of the files above | |
 
+A 3D result (``masonryfw_space = 3``) writes its blocks as the polygons of their faces (cell data per face:
+``face_index``, ``block_index``, ``block_role``, ``macro_block``, ``centroid_displacement`` (ux, uy, uz),
+``rotation`` (rx, ry, rz); point: ``displacement``) and its interfaces as their polygons (cell:
+``interface_index``, ``interface_kind``, ``interface_state``, ``crack_indicator``, ``interface_normal_force``;
+point: ``interface_opening``, ``interface_slip``, ``interface_point_force``).
+
 Blocks are grouped into cell blocks by vertex count, so the cell order can
 differ from the block order: ``block_index`` maps each cell back. Each block
 has its own vertices (the CF ragged layout), so per-vertex data is exact.
@@ -70,7 +76,9 @@ def _as_vtk(values: np.ndarray) -> np.ndarray:
 
 
 def blocks_mesh(ds: xr.Dataset):
-    """Blocks as polygons with their role, macro-block and motion."""
+    """Blocks as polygons with their role, macro-block and motion (a 3D model's: :func:`blocks_mesh_3d`)."""
+    if mfp.space(ds) == 3:
+        return blocks_mesh_3d(ds)
     meshio = _meshio()
     geo = mfp.derive_geometry(ds)
     counts = geo.block_node_count.values.astype(np.int64)
@@ -91,8 +99,59 @@ def blocks_mesh(ds: xr.Dataset):
     return meshio.Mesh(_points(geo.node_x.values, geo.node_y.values), cells, point_data=point_data, cell_data=cell_data)
 
 
+def blocks_mesh_3d(ds: xr.Dataset):
+    """A 3D model's blocks as the polygons of their faces (a surface per block: ParaView draws it; cells carry their
+    block's index, role, macro-block and motion), the rigid motion at every vertex as ``displacement``."""
+    meshio = _meshio()
+    geo = mfp.derive_geometry(ds)
+    poly = mfp.polyhedra_of(geo)
+    index = poly.face_vertex_index()
+    counts = poly.face_node_count
+    connectivity = np.full((counts.size, int(counts.max(initial=0))), -1, dtype=np.int64)
+    rows = np.repeat(np.arange(counts.size), counts)
+    connectivity[rows, np.arange(index.size) - np.repeat(mfp.block_offsets(counts)[:-1], counts)] = index
+    cells, order = _grouped_cells(connectivity, counts)
+    block = poly.face_block()
+    cell_data = {"face_index": _split(np.arange(counts.size, dtype=np.int32), order),
+                 "block_index": _split(block.astype(np.int32), order),
+                 "block_role": _split(_as_vtk(geo.block_role.values[block]), order)}
+    point_data = {}
+    if "macro_block" in ds:
+        cell_data["macro_block"] = _split(_as_vtk(ds.macro_block.values[block]), order)
+    if "block_displacement" in ds:
+        u = mfp.block_motion(ds)
+        cell_data["centroid_displacement"] = _split(u[block, :3], order)
+        cell_data["rotation"] = _split(u[block, 3:], order)
+        owner = np.repeat(np.arange(geo.sizes["block"]), geo.block_node_count.values)
+        centre = np.c_[geo.block_centroid_x.values, geo.block_centroid_y.values, geo.block_centroid_z.values][owner]
+        point_data["displacement"] = u[owner, :3] + np.cross(u[owner, 3:], poly.vertices - centre)
+    return meshio.Mesh(poly.vertices, cells, point_data=point_data, cell_data=cell_data)
+
+
+def joints_mesh_3d(ds: xr.Dataset):
+    """A 3D model's interfaces as their polygons; per-vertex variables (opening, slip, the force on side 1) on
+    their vertices, the interface's kind, state, crack indicator and normal force on the cell."""
+    meshio = _meshio()
+    count = ds.interface_node_count.values.astype(np.int64)
+    points = np.c_[ds.interface_node_x.values, ds.interface_node_y.values, ds.interface_node_z.values]
+    connectivity = np.full((count.size, int(count.max(initial=0))), -1, dtype=np.int64)
+    rows = np.repeat(np.arange(count.size), count)
+    connectivity[rows, np.arange(rows.size) - np.repeat(mfp.block_offsets(count)[:-1], count)] = np.arange(rows.size)
+    cells, order = _grouped_cells(connectivity, count)
+    cell_data = {"interface_index": _split(np.arange(count.size, dtype=np.int32), order)}
+    cell_data.update({name: _split(_as_vtk(ds[name].values), order)
+                      for name in (*JOINT_CELL_VARIABLES, "interface_normal_force") if name in ds})
+    point_data = {name: _as_vtk(ds[name].values) for name in ("interface_opening", "interface_slip") if name in ds}
+    if "interface_point_force_x" in ds:
+        point_data["interface_point_force"] = np.c_[ds.interface_point_force_x.values, ds.interface_point_force_y.values,
+                                                    ds.interface_point_force_z.values]
+    return meshio.Mesh(points, cells, point_data=point_data, cell_data=cell_data)
+
+
 def joints_mesh(ds: xr.Dataset):
-    """Interfaces as lines; per-end variables on their two end points."""
+    """Interfaces as lines; per-end variables on their two end points (a 3D model's: :func:`joints_mesh_3d`)."""
+    if mfp.space(ds) == 3:
+        return joints_mesh_3d(ds)
     meshio = _meshio()
     n = ds.sizes["interface"]
     cell_data = {"interface_index": [np.arange(n, dtype=np.int32)]}

@@ -110,7 +110,8 @@ def test_what_handles_2d_only_refuses_a_3d_model_before_it_starts(in_3d):
 def test_the_command_line_says_so_without_a_traceback(in_3d, tmp_path):
     path = mf.save(in_3d[0], tmp_path / "wall3d.nc")
     refused(cli(["solve", path, "--plugin", "fdem", "-o", tmp_path / "f.nc"], tmp_path), "solver fdem solves 2D models")
-    refused(cli(["export", path, "-o", tmp_path / "e.vtu"], tmp_path), "masonryfw export handles 2D")
+    result = mf.save(mf.solve(in_3d[0], "la"), tmp_path / "wall3d.la.nc")
+    refused(cli(["report", result, "-o", tmp_path / "r.html"], tmp_path), "masonryfw report handles 2D")
 
 
 @pytest.mark.parametrize("name", ["test-12c", "panel-5", "facade-2"])

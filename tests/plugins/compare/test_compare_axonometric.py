@@ -72,3 +72,25 @@ def test_the_drawing_moves_blocks_relative_to_the_largest_macro_block(corner):
 def test_the_kinds_that_draw_2d_only_say_so(corner, kind):
     with pytest.raises(mf.ModelError, match=f"the {kind} plot handles 2D models and results"):
         mf.render([corner[1]], kind)
+
+
+def test_a_3d_result_exports_its_faces_and_interfaces_to_vtk(corner, tmp_path):
+    """Every face a quad carrying its block; the vertices' displacement the blocks' rigid motion; every interface a
+    polygon with its crack indicator and the forces at its vertices."""
+    import meshio
+
+    from masonryfw_compare.export import export_vtk
+
+    model, result = corner
+    written = export_vtk(result, tmp_path / "corner.vtu")
+    assert [p.name for p in written] == ["corner.vtu", "corner_joints.vtu", "corner.vtm"]
+    blocks, joints = meshio.read(written[0]), meshio.read(written[1])
+    assert [(c.type, len(c.data)) for c in blocks.cells] == [("quad", int(model.block_face_count.values.sum()))]
+    u = np.c_[result.block_displacement.values, result.block_rotation.values]
+    owner = np.repeat(np.arange(model.sizes["block"]), model.block_node_count.values)
+    centre = np.c_[result.block_centroid_x.values, result.block_centroid_y.values, result.block_centroid_z.values]
+    expected = u[owner, :3] + np.cross(u[owner, 3:], blocks.points - centre[owner])
+    np.testing.assert_allclose(blocks.point_data["displacement"], expected, atol=1e-12)
+    assert len(joints.cells[0].data) == model.sizes["interface"]
+    np.testing.assert_array_equal(joints.cell_data["crack_indicator"][0], result.crack_indicator.values)
+    np.testing.assert_allclose(joints.point_data["interface_point_force"][:, 2], result.interface_point_force_z.values)
