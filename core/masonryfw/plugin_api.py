@@ -28,7 +28,7 @@ __getattr__, __dir__, __all__ = lazy_loader.attach("masonryfw", submod_attrs={
     "model": ["made_once"],
     "model3d": ["contacts_of", "polyhedra_of", "require_space", "space", "twin"],
     "options": ["Option", "parse_option_pairs", "resolve_options", "unknown_name_message"],
-    "polyhedra": ["Contacts", "Polyhedra", "boxes", "face_normals_areas", "find_contacts", "plane_frame", "prisms", "volumes_centroids"],
+    "polyhedra": ["Contacts", "Polyhedra", "boxes", "face_normals_areas", "find_contacts", "plane_frame", "prisms", "second_moments", "volumes_centroids"],
     "progress": ["ProgressCallback", "interruptible", "no_progress", "progress_bar"],
     "provenance": ["core_version", "options_json", "solver_version"],
     "records": ["Comparator", "Estimate", "Plotter", "Solver", "Variant"],

@@ -133,6 +133,27 @@ def volumes_centroids(poly: Polyhedra) -> tuple[np.ndarray, np.ndarray]:
     return volume, poly.vertices[first_node] + moment / np.where(volume != 0, volume, 1.0)[:, None]
 
 
+def second_moments(poly: Polyhedra) -> np.ndarray:
+    """``(block, 3, 3)``: every block's ``int (p - c)(p - c)^T dV`` about its centroid ``c``, from the signed
+    tetrahedra of its faces' fans (a tetrahedron's is ``V / 20 (sum v v^T + (sum v)(sum v)^T)``)."""
+    volume, centroid = volumes_centroids(poly)
+    index = poly.face_vertex_index()
+    following = next_node(poly.face_node_count)
+    starts = block_offsets(poly.face_node_count)[:-1]
+    block_of_vertex = np.repeat(poly.face_block(), poly.face_node_count)
+    origin = poly.vertices[block_offsets(poly.block_node_count)[:-1]][block_of_vertex] - centroid[block_of_vertex]
+    anchor = np.repeat(poly.vertices[index[starts]], poly.face_node_count, axis=0) - centroid[block_of_vertex]
+    b = poly.vertices[index] - centroid[block_of_vertex]
+    c = poly.vertices[index[following]] - centroid[block_of_vertex]
+    six_volume = np.einsum("ij,ij->i", anchor - origin, np.cross(b - origin, c - origin))
+    corners = (origin, anchor, b, c)
+    total = sum(corners)
+    tensor = sum(np.einsum("pi,pj->pij", v, v) for v in corners) + np.einsum("pi,pj->pij", total, total)
+    moments = np.zeros((poly.n_block, 3, 3))
+    np.add.at(moments, block_of_vertex, (six_volume / 120.0)[:, None, None] * tensor)
+    return moments
+
+
 def plane_frame(normal: np.ndarray) -> np.ndarray:
     """``(n, 2, 3)``: two unit tangents of each unit normal, horizontal first (x for a horizontal plane), with
     (tangent 0) x (tangent 1) = normal."""

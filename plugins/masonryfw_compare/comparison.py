@@ -26,13 +26,19 @@ import xarray as xr
 import masonryfw as mf
 import masonryfw.plugin_api as mfp
 
-from . import scores
+from . import comparison3d, scores
+from .result_scores import multiplier_values, partition_scores
 from .shapes import distance_to_points, distance_to_segments, segment_samples
 
-# Model variables that must be present to tell two models apart and to score them.
+# Model variables that must be present to tell two models apart and to score them, in 2D and in 3D.
 GEOMETRY_VARIABLES = (
     "node_x", "node_y", "block_node_count", "block_role",
     "interface_blocks", "interface_x", "interface_y",
+)
+GEOMETRY_VARIABLES_3D = (
+    "node_x", "node_y", "node_z", "block_node_count", "block_face_count", "face_node_count", "face_nodes",
+    "block_role", "interface_blocks", "interface_node_count", "interface_node_x", "interface_node_y",
+    "interface_node_z",
 )
 
 
@@ -63,8 +69,11 @@ def ensure_same_model(a: xr.Dataset, b: xr.Dataset) -> None:
     Compares the block, node and interface counts, then every model variable
     both results hold (geometry, roles, materials, loads, supports) value by value.
     """
+    in_3d = mfp.space(a) == 3
+    if mfp.space(b) != mfp.space(a):
+        raise _different_models(a, b, f"a {mfp.space(a)}D and a {mfp.space(b)}D model")
     for which, ds in (("a", a), ("b", b)):
-        missing = [n for n in GEOMETRY_VARIABLES if n not in ds]
+        missing = [n for n in (GEOMETRY_VARIABLES_3D if in_3d else GEOMETRY_VARIABLES) if n not in ds]
         if missing:
             raise mf.ModelError(f"result {which} has no {', '.join(missing)}: it holds no model to compare")
     for dim in ("block", "node", "interface"):
@@ -73,7 +82,7 @@ def ensure_same_model(a: xr.Dataset, b: xr.Dataset) -> None:
                 a, b, f"{a.sizes.get(dim, 0)} vs {b.sizes.get(dim, 0)} {dim}s "
                 f"({a.attrs.get('title', '?')!r} vs {b.attrs.get('title', '?')!r})",
             )
-    for name in mfp.load_schema("model")["variables"]:
+    for name in mfp.load_schema("model3d" if in_3d else "model")["variables"]:
         if name not in a or name not in b:
             continue
         va, vb = np.asarray(a[name].values), np.asarray(b[name].values)
@@ -97,13 +106,6 @@ def interface_scores(a: xr.Dataset, b: xr.Dataset, length: np.ndarray) -> dict:
     out["crack_overlap"] = scores.weighted_overlap(ca, cb, length)
     out["crack_spearman"] = scores.spearman(ca, cb)
     return out
-
-
-def partition_scores(a: xr.Dataset, b: xr.Dataset, masonry: np.ndarray) -> dict:
-    """Adjusted Rand index of the macro-block partitions of the masonry blocks."""
-    if "macro_block" not in a or "macro_block" not in b:
-        return {}
-    return {"macro_block_ari": scores.adjusted_rand_index(a.macro_block.values[masonry], b.macro_block.values[masonry])}
 
 
 def mechanism_scores(a: xr.Dataset, b: xr.Dataset, geo: xr.Dataset, masonry: np.ndarray) -> dict:
@@ -172,16 +174,6 @@ def locus_scores(a: xr.Dataset, b: xr.Dataset, size: float) -> dict:
     }
 
 
-def multiplier_values(a: xr.Dataset, b: xr.Dataset) -> dict:
-    """Both collapse multipliers, side by side, when both results are limit analyses."""
-    if "collapse_multiplier" not in a or "collapse_multiplier" not in b:
-        return {}
-    return {
-        "collapse_multiplier_a": float(a.collapse_multiplier.values),
-        "collapse_multiplier_b": float(b.collapse_multiplier.values),
-    }
-
-
 def comparison_variables(values: Mapping[str, float | int | None]) -> xr.Dataset:
     """One scalar variable per computable score (None = not computable, left out), attributes from the schema.
 
@@ -204,6 +196,8 @@ def compare(a: xr.Dataset, b: xr.Dataset, options: Mapping[str, Any]) -> xr.Data
     (:func:`masonryfw.at_threshold`); returns the score variables."""
     ensure_same_model(a, b)
     a, b = mf.at_threshold(a, options["threshold"]), mf.at_threshold(b, options["threshold"])
+    if mfp.space(a) == 3:
+        return comparison_variables(comparison3d.scores_3d(a, b))
     geo = mfp.derive_geometry(a[list(GEOMETRY_VARIABLES)])
     masonry = mfp.masonry_blocks(geo.block_role.values)
     size = mfp.model_scale(geo.node_x.values, geo.node_y.values)

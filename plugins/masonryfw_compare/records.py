@@ -31,6 +31,7 @@ COMPARATOR = mfp.Comparator(
     "mechanism cosine, failure-locus distance",
     compare=mfp.lazy("masonryfw_compare.comparison:compare"),
     options=COMPARE_OPTIONS,
+    spaces=(2, 3),
 )
 
 

@@ -82,3 +82,18 @@ def test_faces_that_only_touch_along_a_line_or_within_the_tolerance_are_no_conta
     contacts = mfp.find_contacts(poly, 1e-6)
     pairs = {tuple(sorted(s)) for s in contacts.sides.tolist()}
     assert (0, 1) not in pairs and (0, 2) not in pairs and (3, 4) not in pairs
+
+
+def test_second_moments_of_a_non_convex_prism_add_up_from_its_boxes():
+    """The L-shaped prism against its two boxes moved to its centroid (the parallel-axis theorem)."""
+    x, y = np.array([0.0, 2.0, 2.0, 1.0, 1.0, 0.0]), np.array([0.0, 0.0, 1.0, 1.0, 2.0, 2.0])
+    prism = mfp.prisms(x, y, np.array([6]), np.array([0.4]))
+    parts = mfp.boxes([[0, -0.2, 0], [0, -0.2, 1]], [[2, 0.2, 1], [1, 0.2, 2]])
+    volume, centre = mfp.volumes_centroids(parts)
+    whole = (volume[:, None] * centre).sum(axis=0) / volume.sum()
+    arm = centre - whole
+    expected = (mfp.second_moments(parts) + volume[:, None, None] * np.einsum("bi,bj->bij", arm, arm)).sum(axis=0)
+    np.testing.assert_allclose(mfp.second_moments(prism)[0], expected, atol=1e-14)
+    box = mfp.boxes([[1, 2, 3]], [[1.5, 2.4, 4]])
+    np.testing.assert_allclose(mfp.second_moments(box)[0], np.diag(0.2 * np.array([0.5, 0.4, 1.0]) ** 2 / 12),
+                               atol=1e-15)

@@ -94,3 +94,57 @@ def test_a_3d_result_exports_its_faces_and_interfaces_to_vtk(corner, tmp_path):
     assert len(joints.cells[0].data) == model.sizes["interface"]
     np.testing.assert_array_equal(joints.cell_data["crack_indicator"][0], result.crack_indicator.values)
     np.testing.assert_allclose(joints.point_data["interface_point_force"][:, 2], result.interface_point_force_z.values)
+
+
+def test_the_3d_mechanism_cosine_is_the_l2_product_of_the_rigid_fields(corner):
+    """Against Gauss quadrature over every box (2 x 2 x 2 points: exact for the quadratic integrand) of two
+    random rigid-block fields."""
+    from masonryfw_compare.comparison3d import inertia, rigid_field_cosine_3d
+
+    model, _ = corner
+    rng = np.random.default_rng(3)
+    u_a, u_b = rng.normal(size=(2, model.sizes["block"], 6))
+    points = np.c_[model.node_x.values, model.node_y.values, model.node_z.values].reshape(-1, 8, 3)
+    low, high = points.min(axis=1), points.max(axis=1)  # the walls run along x and y: every block is a box
+    gauss = 0.5 + np.array([-0.5, 0.5]) / np.sqrt(3.0)
+    grid = np.stack(np.meshgrid(gauss, gauss, gauss, indexing="ij"), axis=-1).reshape(-1, 3)
+    volume = np.prod(high - low, axis=1)
+    sample = low[:, None] + grid[None] * (high - low)[:, None]  # (block, 8, 3)
+    centre = np.c_[model.block_centroid_x.values, model.block_centroid_y.values, model.block_centroid_z.values]
+
+    def field(u):
+        return u[:, None, :3] + np.cross(u[:, None, 3:], sample - centre[:, None])
+
+    def inner(p, q):
+        return float(np.sum(volume[:, None] / 8.0 * np.einsum("bsi,bsi->bs", field(p), field(q))))
+
+    expected = inner(u_a, u_b) / np.sqrt(inner(u_a, u_a) * inner(u_b, u_b))
+    tensor = inertia(mfp.polyhedra_of(model))
+    assert rigid_field_cosine_3d(u_a, u_b, model.block_volume.values, tensor) == pytest.approx(expected, rel=1e-12)
+
+
+def test_the_3d_locus_distance_is_between_the_cracked_interfaces_centroids(corner):
+    from masonryfw_compare.comparison3d import locus_scores_3d
+
+    model, _ = corner
+    count = model.interface_node_count.values
+    points = np.c_[model.interface_node_x.values, model.interface_node_y.values, model.interface_node_z.values]
+    centre = np.add.reduceat(points, np.r_[0, np.cumsum(count)[:-1]], axis=0) / count[:, None]
+    a, b = np.zeros(model.sizes["interface"], dtype=bool), np.zeros(model.sizes["interface"], dtype=bool)
+    a[3], b[[10, 40]] = True, True
+    size = 7.0
+    got = locus_scores_3d(model, a, b, size)
+    to_b = min(np.linalg.norm(centre[3] - centre[10]), np.linalg.norm(centre[3] - centre[40])) / size
+    area = model.interface_area.values[[10, 40]]
+    to_a = np.average(np.linalg.norm(centre[[10, 40]] - centre[3], axis=1), weights=area) / size
+    assert got["locus_distance_a_to_b"] == pytest.approx(to_b) and got["locus_distance_b_to_a"] == pytest.approx(to_a)
+
+
+def test_a_3d_result_against_itself_scores_perfectly_and_against_another_model_is_refused(corner):
+    model, result = corner
+    same = mf.compare(result, result)
+    assert float(same.crack_f1) == 1.0 and float(same.macro_block_ari) == 1.0
+    assert float(same.mechanism_cosine) == pytest.approx(1.0) and float(same.locus_distance) == 0.0
+    other = mf.solve(mf.checked_model(mfp.twin(mf.open_model("test-12c"))), "la")
+    with pytest.raises(mf.ModelError, match="cannot compare results of different models"):
+        mf.compare(result, other)
