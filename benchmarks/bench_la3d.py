@@ -2,7 +2,7 @@
 
 - The running-bond settlement walls of about 300, 1,000 and 2,400 units (the paper's material) built one block
   thick in 3D (``space = 3``): the build (contacts found from the faces, the checks) and la's solve with a
-  pyramid of 8 sides (the default), of 4, and with the cone (Clarabel), against the planar la of the same
+  pyramid of 8 sides, of 4, and with the cone (Clarabel, the default), against the planar la of the same
   wall; alpha's difference from the planar one.
 - The bundled ``house-tunnel`` (a two-storey house over a tunnel, 1,126 blocks): build and solve.
 
@@ -24,7 +24,7 @@ sys.path.insert(0, os.path.dirname(__file__))
 from _walls import running_bond_spec  # noqa: E402
 
 SIZES = ((12, 25), (22, 45), (36, 67))  # courses x units per course: about 300, 1,000 and 2,400 units
-FRICTION = ((8, "pyramid, 8 sides"), (4, "pyramid, 4 sides"), (0, "cone"))
+FRICTION = ((8, "pyramid, 8 sides"), (4, "pyramid, 4 sides"), (0, "cone (default)"))
 
 
 def timed(function, *args):

@@ -50,7 +50,8 @@ def test_a_squat_block_slides_at_mu_in_the_pyramids_directions(degrees):
     """A 1 x 1 x 0.5 box on a tilting plane (live load tan(theta) W sideways) slides at tan(theta) = mu = 0.5 in
     every direction the eight-sided pyramid holds exactly: along, across and diagonally to the joint."""
     angle = np.radians(degrees)
-    state = space3.limit_state_3d(single_box(1.0, 1.0, 0.5, 0.5, live_force=(np.cos(angle), np.sin(angle), 0.0)))
+    state = space3.limit_state_3d(single_box(1.0, 1.0, 0.5, 0.5, live_force=(np.cos(angle), np.sin(angle), 0.0)),
+                                  sides=8)
     assert state.alpha == pytest.approx(0.5, rel=1e-8)
     motion = state.motion[1]
     assert np.abs(motion[3:]).max() < 1e-7 * np.abs(motion[:3]).max()  # it slides, it does not turn
@@ -78,11 +79,13 @@ def test_a_slender_block_overturns_at_its_width_over_its_height_both_ways(degree
     assert turning.argmax() == (1 if degrees in (0.0, 180.0) else 0)  # about the base edge across the load
 
 
-def test_a_block_twisted_on_its_support_turns_at_the_friction_of_its_corners():
+@pytest.mark.parametrize("sides", [8, 0])
+def test_a_block_twisted_on_its_support_turns_at_the_friction_of_its_corners(sides):
     """A 1 x 1 x 0.5 box under a moment about z: its four base corners carry W / 4 each, at a / sqrt(2) from the
-    axis, sliding across their radius (a direction of the eight-sided pyramid): M = mu W a / sqrt(2)."""
+    axis, sliding across their radius (a direction of the eight-sided pyramid, and of the cone): M = mu W a /
+    sqrt(2)."""
     mu = 0.6
-    state = space3.limit_state_3d(single_box(1.0, 1.0, 0.5, mu, live_moment=(0.0, 0.0, 1.0)))
+    state = space3.limit_state_3d(single_box(1.0, 1.0, 0.5, mu, live_moment=(0.0, 0.0, 1.0)), sides=sides)
     assert state.alpha == pytest.approx(mu / np.sqrt(2.0), rel=1e-8)
     motion = state.motion[1]
     assert np.abs(motion[[0, 1, 3, 4]]).max() < 1e-7 * abs(motion[5])  # it turns about its vertical axis
