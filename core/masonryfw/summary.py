@@ -397,10 +397,12 @@ def result_options(result: xr.Dataset) -> dict:
 
 
 def result_label(result: xr.Dataset) -> str:
-    """``solver`` plus the backend it chose when its options name one, e.g. ``la (highs)``."""
+    """``solver`` plus the method it says it ran (its ``method`` attribute), else the backend its options name,
+    e.g. ``la (highs)``."""
     name = str(result.attrs.get("solver", result.attrs.get("plugin", "?")))
     options = result_options(result)
-    detail = [str(options[k]) for k in ("solver", "backend") if k in options]
+    detail = ([str(result.attrs["method"])] if "method" in result.attrs
+              else [str(options[k]) for k in ("solver", "backend") if k in options])
     return f"{name} ({', '.join(detail)})" if detail else name
 
 

@@ -18,6 +18,7 @@ import platform
 from collections.abc import Callable, Sequence
 from importlib import metadata
 
+import numpy as np
 import xarray as xr
 
 import masonryfw as mf
@@ -84,21 +85,31 @@ def _table(header: Sequence[str], rows: Sequence[mfp.Row], table_id: str, column
 
 def _model_of(result: xr.Dataset) -> xr.Dataset:
     """The model variables of a result, titled as the model (drawn as a model, not as a result)."""
-    names = [n for n in result.data_vars if n in mfp.load_schema("model")["variables"]]
-    return xr.Dataset({n: result[n] for n in names}, attrs={"title": result.attrs.get("title", "")})
+    in_3d = mfp.space(result) == 3
+    names = [n for n in result.data_vars if n in mfp.load_schema("model3d" if in_3d else "model")["variables"]]
+    attrs = {"title": result.attrs.get("title", ""), **({"masonryfw_space": 3} if in_3d else {})}
+    return xr.Dataset({n: result[n] for n in names}, attrs=attrs)
+
+
+def _masonry_span(first: xr.Dataset, masonry: np.ndarray) -> str:
+    """The masonry's extent: width x height of a wall, x by y by z of a 3D model."""
+    if mfp.space(first) == 3:
+        owner = np.repeat(np.arange(masonry.size), first.block_node_count.values)
+        points = np.c_[first.node_x.values, first.node_y.values, first.node_z.values][masonry[owner]]
+        return " x ".join(f"{v:.4g} m" for v in np.ptp(points, axis=0)) + " (x, y, z)"
+    xmin, xmax, ymin, ymax = mfp.block_bounds(first.node_x, first.node_y, first.block_node_count)
+    return f"{xmax[masonry].max() - xmin[masonry].min():.4g} m x {ymax[masonry].max() - ymin[masonry].min():.4g} m"
 
 
 def _model_section(first: xr.Dataset) -> str:
-    geo = mfp.derive_geometry(first)
     roles = first.block_role.values
     masonry = mfp.masonry_blocks(roles)
-    xmin, xmax, ymin, ymax = mfp.block_bounds(geo.node_x, geo.node_y, geo.block_node_count)
-    size = f"{xmax[masonry].max() - xmin[masonry].min():.4g} m x {ymax[masonry].max() - ymin[masonry].min():.4g} m"
     facts = (f"{int(masonry.sum())} masonry blocks, {int(mfp.support_blocks(roles).sum())} supports, "
-             f"{first.sizes.get('interface', 0)} interfaces; the masonry spans {size}.")
-    parts = ["<h2>The wall</h2>", f"<p>{html.escape(facts)}</p>",
-             _figure([_model_of(first)], "model",
-                     "The model: blocks by role (supports hatched, a settling one with an arrow), joints by kind.")]
+             f"{first.sizes.get('interface', 0)} interfaces; the masonry spans {_masonry_span(first, masonry)}.")
+    caption = ("The model in axonometry: blocks by role." if mfp.space(first) == 3 else
+               "The model: blocks by role (supports hatched, a settling one with an arrow), joints by kind.")
+    parts = [f"<h2>The {'building' if mfp.space(first) == 3 else 'wall'}</h2>", f"<p>{html.escape(facts)}</p>",
+             _figure([_model_of(first)], "model", caption)]
     if first.attrs.get("source_drawing"):
         parts.append(f"<p>Drawing: <code>{html.escape(str(first.attrs['source_drawing']))}</code>, sha256 "
                      f"<code>{html.escape(str(first.attrs.get('source_drawing_sha256', '?')))}</code></p>")
@@ -170,12 +181,12 @@ def _agreement_section(datasets: Sequence[xr.Dataset], letters: Sequence[str]) -
     pairs = list(itertools.combinations(range(len(datasets)), 2))
     comparisons = [mf.compare(datasets[i], datasets[j], "crack") for i, j in pairs]
     columns = [f"{letters[i]}-{letters[j]}" for i, j in pairs]
+    side_by_side = [] if mfp.space(datasets[0]) == 3 else [  # the compare kind draws 2D
+        _figure(datasets, "compare", "The results side by side, each later one with its scores against the first.")]
     return ["<h2>Agreement</h2>",
             "<p>Every pair scored by the <code>crack</code> comparator (the first of a pair is its reference): "
             "do the two results crack the same joints, break into the same pieces, move the same way?</p>",
-            _table(["score", *columns], mfp.score_rows(comparisons), "agreement", columns),
-            _figure(datasets, "compare", "The results side by side, each later one with its scores against the "
-                    "first.")]
+            _table(["score", *columns], mfp.score_rows(comparisons), "agreement", columns), *side_by_side]
 
 
 def _versions() -> dict[str, str]:
@@ -239,7 +250,6 @@ def report_html(paths: Sequence[str], command: str, progress: Callable[[float, s
     document."""
     step = progress or (lambda fraction, message: None)
     opened = [mf.open_checked(p) for p in paths]
-    mfp.require_space(opened, (2,), "masonryfw report")
     for path, ds in zip(paths, opened):
         if ds.attrs.get("masonryfw_format") not in ("result", "diagnosis"):
             raise mf.MasonryError(f"{path}: not a result or diagnosis file (masonryfw_format = "

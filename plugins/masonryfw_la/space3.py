@@ -259,6 +259,8 @@ def solve(model: xr.Dataset, options: Mapping[str, Any], progress=mfp.no_progres
         data["moving_support_reaction"] = ((), settlement_reaction(blocks, state),
                                            mfp.variable_attrs("moving_support_reaction", "result3d"))
     progress(1.0, f"la: alpha = {state.alpha:.6g}")
-    return xr.Dataset(data, attrs={"rotations": "small", "flow_rule": "associative", "la_backend": options["solver"],
+    method = "cone, clarabel" if sides == 0 else f"pyramid of {sides} sides, {options['solver']}"
+    return xr.Dataset(data, attrs={"rotations": "small", "flow_rule": "associative", "method": method,
+                                   "la_backend": "clarabel" if sides == 0 else options["solver"],
                                    "la_pyramid_sides": sides, "la_time_s": time.perf_counter() - clock,
                                    "la_alpha_dual": float(state.solution.alpha_dual)})

@@ -108,8 +108,10 @@ def test_what_handles_2d_only_refuses_a_3d_model_before_it_starts(in_3d):
 def test_the_command_line_says_so_without_a_traceback(in_3d, tmp_path):
     path = mf.save(in_3d[0], tmp_path / "wall3d.nc")
     refused(cli(["solve", path, "--plugin", "fdem", "-o", tmp_path / "f.nc"], tmp_path), "solver fdem solves 2D models")
-    result = mf.save(mf.solve(in_3d[0], "la"), tmp_path / "wall3d.la.nc")
-    refused(cli(["report", result, "-o", tmp_path / "r.html"], tmp_path), "masonryfw report handles 2D")
+    cracks = tmp_path / "cracks.csv"
+    cracks.write_text("crack,x,y\nc1,0.5,0.1\nc1,0.6,0.3\n")
+    refused(cli(["diagnose", path, "--cracks", cracks, "-o", tmp_path / "d.nc"], tmp_path),
+            "masonryfw diagnose handles 2D")
 
 
 @pytest.mark.parametrize("name", ["test-12c", "panel-5", "facade-2"])

@@ -148,3 +148,17 @@ def test_a_3d_result_against_itself_scores_perfectly_and_against_another_model_i
     other = mf.solve(mf.checked_model(mfp.twin(mf.open_model("test-12c"))), "la")
     with pytest.raises(mf.ModelError, match="cannot compare results of different models"):
         mf.compare(result, other)
+
+
+def test_the_report_of_two_3d_results(corner, tmp_path):
+    """The building in axonometry, its spec, the key numbers, each mechanism, and the agreement table of the cone
+    against the 8-sided pyramid, labelled with the method each ran."""
+    from masonryfw_compare.report import report_html
+
+    model, cone = corner
+    paths = [str(mf.save(cone, tmp_path / "cone.nc")),
+             str(mf.save(mf.solve(model, "la", {"pyramid_sides": 8}), tmp_path / "pyramid.nc"))]
+    text = report_html(paths, "masonryfw report cone.nc pyramid.nc")
+    assert "<h2>The building</h2>" in text and text.count("<img ") == 3
+    assert "A: la (cone, clarabel)" in text and "B: la (pyramid of 8 sides, ipm)" in text
+    assert "<h2>Agreement</h2>" in text and 'id="agreement"' in text
