@@ -29,8 +29,9 @@ Every quantity is linear in t, so a history's LTSM is its value at t = 1 times e
 """
 from __future__ import annotations
 
+import json
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -66,6 +67,7 @@ class Part:
     horizontal_strain: float  # eps_h, tension positive
     bending_strain: float  # eps_br = eps_b + eps_h
     diagonal_strain: float  # eps_dr
+    wall: str = ""  # a building's wall the part belongs to (its coordinates are along that wall's base line)
 
     @property
     def strain(self) -> float:
@@ -190,10 +192,61 @@ def assess(model: xr.Dataset, settlement: float) -> Assessment | None:
     profile = model_profile(model)
     if profile is None:
         return None
+    if "building_walls" in model.attrs:
+        return assess_building(model, profile, settlement)
     x_a, x_b, height = wall_extent(model)
     slope, settled = greenfield_screen(profile, x_a, x_b)
     return Assessment(settlement, abs(settlement) * slope, abs(settlement) * settled,
                       tuple(ltsm_parts(profile, x_a, x_b, height)))
+
+
+def assess_building(model: xr.Dataset, profile: Profile, settlement: float) -> Assessment:
+    """Stages 1 and 2 of every wall of a building (its ``building_walls``) over the greenfield profile in plan
+    (``settlement_axis``): each wall's line cut from the greenfield surface (:func:`wall_profile`), its own
+    length and height; the building's largest slope, settlement and strain are its worst wall's."""
+    axis = json.loads(model.attrs["settlement_axis"])
+    point, direction = np.array(axis["point"]), np.array(axis["direction"])
+    slopes, settled, parts = [0.0], [0.0], []
+    for wall in json.loads(model.attrs["building_walls"]):
+        start, end = np.array(wall["start"]), np.array(wall["end"])
+        along = (end - start) / np.linalg.norm(end - start)
+        x_a, x_b = wall["ground"]
+        cut = wall_profile(profile, float((start - point) @ direction), float(along @ direction))
+        if cut is None:  # the wall runs along the trough's axis: its ground settles uniformly
+            settled.append(float(profile.rate(np.array([(start - point) @ direction]))[0]))
+            continue
+        slope, most = greenfield_screen(cut, x_a, x_b)
+        slopes.append(slope)
+        settled.append(most)
+        parts += [replace(part, wall=wall["name"]) for part in ltsm_parts(cut, x_a, x_b, wall["height"])]
+    return Assessment(settlement, abs(settlement) * max(slopes), abs(settlement) * max(settled), tuple(parts))
+
+
+#: A wall within this cosine of the trough's axis has a uniform greenfield settlement along it.
+PARALLEL = 1e-9
+
+
+def wall_profile(profile: Profile, offset: float, cosine: float) -> Profile | None:
+    """The greenfield profile along a wall whose base line starts ``offset`` across the axis and runs at
+    ``cosine`` to the profile's direction: the profile coordinate is ``u = offset + cosine * s`` along the wall,
+    so a trough's centre moves to ``(center - offset) / cosine``, its width grows to ``width / |cosine|`` and its
+    horizontal movement (towards the axis, ``-(u - c) / z0 * rate``) along the wall is that of a depth
+    ``z0 / cosine^2``; None for a wall along the axis (no curvature, no horizontal strain along it)."""
+    if abs(cosine) <= PARALLEL:
+        return None
+
+    def along(u: float) -> float:
+        return (u - offset) / cosine
+
+    if profile.kind in TROUGHS:
+        return replace(profile, center=along(profile.center), width=profile.width / abs(cosine),
+                       depth=None if profile.depth is None else profile.depth / cosine**2)
+    if profile.kind in ("linear", "step"):
+        start, end = along(profile.start), along(profile.end)
+        return replace(profile, start=start, end=end) if profile.kind == "linear" else \
+            replace(profile, start=min(start, end), end=max(start, end))
+    points = sorted((along(u), rate) for u, rate in profile.points)
+    return replace(profile, points=tuple(points))
 
 
 def ltsm_variables(model: xr.Dataset, settlement: np.ndarray) -> dict[str, tuple]:

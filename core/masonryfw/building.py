@@ -15,6 +15,7 @@ turns about the horizontal axis across the wall with the slope between them).
 """
 from __future__ import annotations
 
+import json
 import math
 from dataclasses import dataclass
 
@@ -24,7 +25,7 @@ import xarray as xr
 from . import polyhedra
 from .errors import SpecError
 from .model3d import model_from_polyhedra
-from .profiles import SETTLEMENT_KEYS, Profile, node_motion, read_profile
+from .profiles import SETTLEMENT_KEYS, Profile, node_motion, read_profile, with_profile
 from .roles import ROLE
 from .spec import LENGTH_UNITS, SpecTable, read_material
 
@@ -317,9 +318,16 @@ def build_building(spec: dict, text: str) -> xr.Dataset:
     poly = oriented_boxes(walls, laid.wall, laid.s0, laid.s1, laid.z0, laid.z1)
     volume, _ = polyhedra.volumes_centroids(poly)
     contacts = polyhedra.find_contacts(poly, tol)
-    return _dataset(walls, laid, n_masonry, poly, volume, contacts, material, (profile, point, direction, depth),
-                    {"title": top.text("title"), "source_spec": text, **({"laying_notes": "\n".join(notes)} if notes else {}),
-                     **({"comment": top.text("description")} if top.has("description") else {})})
+    attrs = {"title": top.text("title"), "source_spec": text,
+             "building_walls": json.dumps([{"name": w.name, "start": w.start.tolist(), "end": w.end.tolist(),
+                                            "height": w.height, "thickness": w.thickness,
+                                            "ground": list(course_extent(walls, found, courses, k, 0))}
+                                           for k, w in enumerate(walls)]),
+             "settlement_axis": json.dumps({"point": point.tolist(), "direction": direction.tolist()}),
+             **({"laying_notes": "\n".join(notes)} if notes else {}),
+             **({"comment": top.text("description")} if top.has("description") else {})}
+    model = _dataset(walls, laid, n_masonry, poly, volume, contacts, material, (profile, point, direction, depth), attrs)
+    return with_profile(model, profile)
 
 
 def add_floors(building: SpecTable, walls: list[Wall], laid: Laid, unit_height: float) -> None:
@@ -377,8 +385,6 @@ def _dataset(walls, laid, n_masonry, poly, volume, contacts, material, ground_pr
               "interface_tensile_strength": np.full(m, material.tensile_strength),
               "dead_load": dead, "dead_moment": np.zeros((n, 3)), "live_load": live, "live_moment": np.zeros((n, 3)),
               "block_fixed": fixed, "settlement_direction": motion}
-    if profile.target is not None:
-        arrays["settlement_target"] = np.float64(profile.target)
     for name in ("young_modulus", "poisson_ratio"):
         value = getattr(material, name)
         if value is not None:

@@ -1,6 +1,8 @@
 """A model in words, as ``masonryfw info`` prints it: its counts, size, settlement profile, supports and loads."""
 from __future__ import annotations
 
+import json
+import math
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -50,6 +52,16 @@ def describe_model_3d(model: xr.Dataset) -> list[str]:
         low, high = points.min(axis=0), points.max(axis=0)
         lines.append("masonry: " + ", ".join(f"{c} {a:.6g}..{b:.6g} m" for c, a, b in zip("xyz", low, high))
                      + f"; volume {model.block_volume.values[masonry].sum():.6g} m3")
+    profile = model_profile(model)
+    if profile is not None and "settlement_axis" in model.attrs:
+        axis = json.loads(model.attrs["settlement_axis"])
+        degrees = math.degrees(math.atan2(-axis["direction"][0], axis["direction"][1])) % 180.0
+        lines.append(f"settlement profile: {profile_text(profile)}; its axis in plan at {degrees:.4g} degrees to x "
+                     f"through ({axis['point'][0]:.6g}, {axis['point'][1]:.6g}) m")
+    if "building_walls" in model.attrs:
+        walls = json.loads(model.attrs["building_walls"])
+        lines.append("walls: " + ", ".join(f"{w['name']} ({math.dist(w['start'], w['end']):.4g} m x "
+                                           f"{w['height']:.4g} m, {w['thickness']:.4g} m thick)" for w in walls))
     supports = support_blocks(role)
     moving = role == ROLE["moving_support"]
     lines += ["supports:", f"  {int((supports & ~moving).sum())} fixed, {int(moving.sum())} moving (settlement "

@@ -138,10 +138,17 @@ def _assessment_numbers(result: xr.Dataset) -> list[KeyNumber]:
                   "stage 1: largest greenfield settlement under the wall"),
         KeyNumber("screened_out", float(stages.screened_out), "1",
                   "stage 1: 1 if the slope stays under 1/500 and the settlement under 10 mm (negligible risk)"),
-        KeyNumber("ltsm_strain", stages.strain, "1", "stage 2: the limiting tensile strain method's governing strain"),
+        KeyNumber("ltsm_strain", stages.strain, "1", "stage 2: the limiting tensile strain method's governing strain"
+                  + governing_wall(stages)),
         KeyNumber("ltsm_category", float(stages.category), "1",
                   "stage 2: LTSM damage category (0 negligible .. 4 severe to very severe)"),
     ]
+
+
+def governing_wall(stages) -> str:
+    """`` (wall 'east')`` when the governing LTSM part belongs to a named wall of a building, else nothing."""
+    governing = max(stages.parts, key=lambda part: part.strain, default=None)
+    return f" (wall {governing.wall!r})" if governing is not None and governing.wall else ""
 
 
 def key_numbers(result: xr.Dataset) -> list[KeyNumber]:

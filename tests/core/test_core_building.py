@@ -141,3 +141,42 @@ def test_an_opening_off_the_bed_joints_is_moved_onto_them_and_said():
     spec["building"]["walls"][2]["openings"] = [{"x": 0.72, "y": 0.5, "width": 0.48, "height": 0.3}]
     notes = mf.build(spec).attrs["laying_notes"]
     assert "wall 'north' opening 0: sill and head moved onto bed joints (y 0.48 m, height 0.36 m)" in notes
+
+
+def test_the_engineers_stages_of_a_straight_building_wall_are_the_planar_walls():
+    """A tunnel under a one-wall building and under the same wall from a 2D spec: the same greenfield slope and
+    settlement (stage 1) and LTSM strain (stage 2) at S_max."""
+    tunnel = {"profile": "tunnel", "volume_loss": 2.0, "diameter": 3.0, "depth": 6.0}
+    planar = mf.build({"title": "wall", "wall": {"width": 2.4, "height": 1.2, "thickness": 0.12}, "unit": UNIT,
+                       "bond": {"pattern": "running", "first_course": "full"}, "material": MATERIAL,
+                       "settlement": {**tunnel, "center": 1.9}, "loading": {"type": "settlement"}})
+    building = mf.build({"title": "wall", "building": {"unit": UNIT, "walls": [wall("w", (0, 0), (2.4, 0))]},
+                         "material": MATERIAL, "settlement": {**tunnel, "center_x": 1.9}})
+    a, b = mfp.assess(planar, 0.02), mfp.assess(building, 0.02)
+    for name in ("slope", "greenfield_settlement", "strain"):
+        assert getattr(b, name) == pytest.approx(getattr(a, name), rel=1e-9), name
+    assert {part.wall for part in b.parts} == {"w"}
+
+
+@pytest.mark.parametrize("degrees", [0.0, 60.0, 30.0, 135.0, 180.0])
+def test_a_walls_cut_of_the_greenfield_surface_is_the_surface_along_it(degrees):
+    """The trough along a wall at an angle to the axis (``wall_profile``): its settlement and its horizontal
+    movement along the wall are the plan profile's at the wall's points, projected."""
+    from masonryfw.assessment import wall_profile
+    from masonryfw.profiles import Profile
+
+    profile = Profile("tunnel", 0.1, 0.01, center=0.3, width=3.0, depth=6.0)
+    angle = np.radians(degrees)
+    offset, cosine = -1.2, np.cos(angle)
+    cut = wall_profile(profile, offset, cosine)
+    s = np.linspace(-4.0, 9.0, 101)
+    u = offset + cosine * s
+    np.testing.assert_allclose(cut.rate(s), profile.rate(u), atol=1e-14)
+    np.testing.assert_allclose(cut.horizontal(s), cosine * profile.horizontal(u), atol=1e-14)
+
+
+def test_a_wall_along_the_trough_axis_settles_uniformly_and_is_not_strained():
+    from masonryfw.assessment import wall_profile
+    from masonryfw.profiles import Profile
+
+    assert wall_profile(Profile("tunnel", 0.1, 0.01, center=0.3, width=3.0, depth=6.0), -1.2, 0.0) is None
