@@ -5,6 +5,8 @@
   pyramid of 8 sides, of 4, and with the cone (Clarabel, the default), against the planar la of the same
   wall; alpha's difference from the planar one.
 - The bundled ``house-tunnel`` (a two-storey house over a tunnel, 1,126 blocks): build and solve.
+- The same house in units of a half and a third of its own (about 4,400 and 9,800 blocks): the whole process
+  ``masonryfw solve SPEC --plugin la`` (start-up, build, solve, write) timed, and its peak memory.
 
 Whole ``mf.build`` / ``mf.solve`` calls, one run each (the house's solve three times), this process.
 Run from the benchmarks folder: ``python bench_la3d.py``. Writes the ``la3d`` section of docs/benchmarks.md.
@@ -12,9 +14,13 @@ Run from the benchmarks folder: ``python bench_la3d.py``. Writes the ``la3d`` se
 from __future__ import annotations
 
 import os
+import resource
 import statistics
+import subprocess
 import sys
+import tempfile
 import time
+from pathlib import Path
 
 from _report import command_line, write_section
 
@@ -64,11 +70,44 @@ def house() -> list[str]:
             f"{int(numbers['cracked_joints'])} cracked interfaces, {int(numbers['macro_blocks'])} macro-blocks)."]
 
 
+def house_in_smaller_units(divisor: int, folder: Path) -> Path:
+    """``house-tunnel``'s spec with units ``divisor`` times smaller (its openings stay on the finer courses)."""
+    spec = dict(mf.load_spec(mf.bundled_spec_path("house-tunnel")))
+    building = dict(spec["building"])
+    building["unit"] = {k: v / divisor for k, v in building["unit"].items()}
+    spec["building"] = building
+    spec["settlement"] = {**spec["settlement"], "segment": spec["settlement"]["segment"] / divisor}
+    path = folder / f"house-{divisor}.toml"
+    path.write_text(mf.dump_toml(spec))
+    return path
+
+
+def whole_process() -> list[str]:
+    rows = ["| units | blocks | whole process | peak memory |", "|---|---|---|---|"]
+    with tempfile.TemporaryDirectory() as folder:
+        for divisor in (1, 2, 3):
+            spec = house_in_smaller_units(divisor, Path(folder))
+            before = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss
+            start = time.perf_counter()
+            done = subprocess.run([sys.executable, "-m", "masonryfw", "solve", str(spec), "--plugin", "la",
+                                   "--no-progress", "-o", str(spec.with_suffix(".nc"))],
+                                  capture_output=True, text=True, check=True)
+            seconds = time.perf_counter() - start
+            peak = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss
+            blocks = mf.open_checked(spec.with_suffix(".nc")).sizes["block"]
+            alpha = next(line for line in done.stdout.splitlines() if line.startswith("la: "))
+            rows.append(f"| {0.44 / divisor:.3g} x {0.22 / divisor:.3g} m | {blocks:,} | {seconds:.1f} s | "
+                        f"{max(peak, before) / 2**20:.2f} GiB{'' if peak > before else ' (at most)'} |")
+            print(rows[-1], alpha.split(",")[0], flush=True)
+    return rows
+
+
 def main() -> None:
     command_line(__doc__).parse_args()
     body = ["The running-bond walls one block thick in 3D against the planar la (one run each; alpha relative to the "
             "planar la's):", "", *walls(), "",
-            *house()]
+            *house(), "", "The house in smaller units, `masonryfw solve SPEC --plugin la` as a user runs it (the cone):",
+            "", *whole_process()]
     write_section("la3d", "la in 3D: time against size, the pyramid against the cone, a house", "\n".join(body))
 
 

@@ -6,7 +6,8 @@ A wall runs from ``start`` to ``end`` (its base line, the middle of its thicknes
 courses. Units are boxes of the wall's thickness, ``unit.length`` long and ``unit.height`` high, in running
 bond (every other course shifted by half a unit). Where two walls meet end to end at a right angle, the
 corner is toothed: in even courses the wall listed first runs through the corner to the other's outer face
-and the other stops at its inner face; in odd courses the other way round. An opening takes its courses
+and the other stops at its inner face; in odd courses the other way round. A wall ending on another's base
+line (a T) stops at its face in even courses and runs through it in odd ones. An opening takes its courses
 (its sill and head moved onto the nearest bed joints, said in ``laying_notes``) and a lintel one course high
 bears ``lintel_bearing`` into the masonry on either side. Floors are line loads [N/m] on the course at their
 height. Every wall stands on support blocks ``support_depth`` deep, cut into segments ``segment`` long under
@@ -18,6 +19,7 @@ from __future__ import annotations
 import json
 import math
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 import xarray as xr
@@ -106,48 +108,75 @@ def read_openings(wall: SpecTable, unit_length: float) -> tuple[tuple[float, flo
     return tuple(openings)
 
 
-def corners(walls: list[Wall], tol: float) -> dict[tuple[int, int], tuple[int, int]]:
-    """``{(wall, end): (other wall, its end)}`` for walls meeting end to end (end 0: start, 1: end); a right angle
-    is required, and a wall's end on another wall's middle (a T) is refused for now."""
+class Junctions(NamedTuple):
+    """Where walls meet: ``ends[(wall, end)] = (other wall, the wall that runs through in even courses)`` (end 0:
+    its start, 1: its end), and the T-junctions ``tees``: (through wall, abutting wall, the abutting wall's centre
+    line along the through wall's base line)."""
+
+    ends: dict[tuple[int, int], tuple[int, int]]
+    tees: list[tuple[int, int, float]]
+
+
+def junctions(walls: list[Wall], tol: float) -> Junctions:
+    """The corners (two walls' ends at one point) and T-junctions (a wall's end on another's base line between
+    its ends) of ``walls``, each at a right angle; a corner's first-listed wall runs through in even courses, a
+    T's through wall in even and the abutting wall in odd courses. Other meetings are refused, naming the walls."""
     ends = [(w, e, (wall.start, wall.end)[e]) for w, wall in enumerate(walls) for e in (0, 1)]
-    found: dict[tuple[int, int], tuple[int, int]] = {}
+    meets: dict[tuple[int, int], tuple[int, int]] = {}
     for a, (wa, ea, pa) in enumerate(ends):
         for wb, eb, pb in ends[a + 1:]:
             if wb != wa and np.linalg.norm(pa - pb) <= tol:
-                if (wa, ea) in found or (wb, eb) in found:
+                if (wa, ea) in meets or (wb, eb) in meets:
                     raise SpecError(f"walls {walls[wa].name!r} and {walls[wb].name!r}: more than two walls meet at "
                                     f"({pa[0]:.6g}, {pa[1]:.6g}); corners of two walls only so far")
-                cosine = abs(float(walls[wa].along @ walls[wb].along))
-                if cosine > 1e-6:
-                    raise SpecError(f"walls {walls[wa].name!r} and {walls[wb].name!r} meet at "
-                                    f"{math.degrees(math.acos(min(cosine, 1.0))):.4g} degrees: only right-angle "
-                                    "corners are toothed so far")
-                found[(wa, ea)], found[(wb, eb)] = (wb, eb), (wa, ea)
+                square(walls, wa, wb)
+                meets[(wa, ea)], meets[(wb, eb)] = (wb, min(wa, wb)), (wa, min(wa, wb))
+    tees = []
     for w, wall in enumerate(walls):
         for e, point in ((0, wall.start), (1, wall.end)):
-            if (w, e) in found:
+            if (w, e) in meets:
                 continue
             for v, other in enumerate(walls):
                 offset = float((point - other.start) @ other.along)
                 if v != w and abs(float((point - other.start) @ other.across)) <= tol and 0 < offset < other.length:
-                    raise SpecError(f"wall {wall.name!r} ends on the middle of wall {other.name!r} (a T-junction): "
-                                    "T-junctions are not laid yet; end the walls at corners")
-    return found
+                    square(walls, w, v)
+                    meets[(w, e)] = (v, v)
+                    tees.append((v, w, offset))
+    return Junctions(meets, tees)
 
 
-def course_extent(walls: list[Wall], found: dict, courses: list[int], w: int, course: int) -> tuple[float, float]:
-    """The wall's extent along its base line in ``course``: through a corner it owns in this course (to the
-    other wall's outer face), short of one it does not (to the other's inner face); its end where it is free
-    (or the other wall has no such course)."""
+def square(walls: list[Wall], a: int, b: int) -> None:
+    """Refuse two meeting walls that are not at a right angle."""
+    cosine = abs(float(walls[a].along @ walls[b].along))
+    if cosine > 1e-6:
+        raise SpecError(f"walls {walls[a].name!r} and {walls[b].name!r} meet at "
+                        f"{math.degrees(math.acos(min(cosine, 1.0))):.4g} degrees: only right angles are toothed so far")
+
+
+def course_extent(walls: list[Wall], joins: Junctions, courses: list[int], w: int, course: int) -> tuple[float, float]:
+    """The wall's extent along its base line in ``course``: through a junction it runs through in this course
+    (to the other wall's far face), short of one it does not (to the other's near face); its end where it is
+    free (or the other wall has no such course)."""
     wall = walls[w]
     extent = [0.0, wall.length]
     for e, sign in ((0, -1.0), (1, 1.0)):
-        if (w, e) not in found or course >= courses[found[(w, e)][0]]:
+        if (w, e) not in joins.ends or course >= courses[joins.ends[(w, e)][0]]:
             continue
-        other = found[(w, e)][0]
-        owner = min(w, other) if course % 2 == 0 else max(w, other)
+        other, even_owner = joins.ends[(w, e)]
+        owner = even_owner if course % 2 == 0 else (w if even_owner == other else other)
         extent[e] += sign * (0.5 if owner == w else -0.5) * walls[other].thickness
     return extent[0], extent[1]
+
+
+def tee_gaps(walls: list[Wall], joins: Junctions, courses: list[int], v: int) -> dict[int, list[tuple[float, float]]]:
+    """``{course: [(s0, s1)]}``: where an abutting wall runs through the through wall ``v`` (odd courses)."""
+    gaps: dict[int, list[tuple[float, float]]] = {}
+    for through, w, offset in joins.tees:
+        if through == v:
+            half = 0.5 * walls[w].thickness
+            for k in range(1, min(courses[v], courses[w]), 2):
+                gaps.setdefault(k, []).append((offset - half, offset + half))
+    return gaps
 
 
 def pieces(a: float, b: float, origin: float, unit_length: float) -> list[tuple[float, float]]:
@@ -193,13 +222,13 @@ class Laid:
             getattr(self, name).append(value)
 
 
-def lay_masonry(walls: list[Wall], found: dict, unit_length: float, unit_height: float, notes: list[str]) -> Laid:
+def lay_masonry(walls: list[Wall], joins: Junctions, unit_length: float, unit_height: float, notes: list[str]) -> Laid:
     """Every wall's courses: units in running bond between its course extents, openings left out, a lintel
     over each opening (module docstring)."""
     courses = [round(wall.height / unit_height) for wall in walls]
     laid = Laid([], [], [], [], [], [], [])
     for w, wall in enumerate(walls):
-        gaps: dict[int, list[tuple[float, float]]] = {}  # course: the ranges the openings leave open
+        gaps = tee_gaps(walls, joins, courses, w)  # course: the ranges left open (by openings, by abutting walls)
         lintels: dict[int, list[tuple[float, float]]] = {}  # course: the ranges of the lintels
         for number, (x, y, width, height, bearing) in enumerate(wall.openings):
             k0, k1 = round(y / unit_height), round((y + height) / unit_height)
@@ -214,9 +243,9 @@ def lay_masonry(walls: list[Wall], found: dict, unit_length: float, unit_height:
                 gaps.setdefault(k, []).append((x, x + width))
             if k1 < courses[w]:
                 lintels.setdefault(k1, []).append((max(x - bearing, 0.0), min(x + width + bearing, wall.length)))
-        origin = course_extent(walls, found, courses, w, 0)[0]  # the bond starts with a full unit there
+        origin = course_extent(walls, joins, courses, w, 0)[0]  # the bond starts with a full unit there
         for k in range(courses[w]):
-            a, b = course_extent(walls, found, courses, w, k)
+            a, b = course_extent(walls, joins, courses, w, k)
             cut = sorted(gaps.get(k, []) + lintels.get(k, []))
             if any(q > p + 1e-9 * unit_length for (_, q), (p, _) in zip(cut[:-1], cut[1:])):
                 raise SpecError(f"wall {wall.name!r}: two openings (or an opening and a lintel over another) overlap "
@@ -302,15 +331,15 @@ def build_building(spec: dict, text: str) -> xr.Dataset:
     depth = building.number("support_depth", unit_height / top.scale, length=True, positive=True)
     segment = building.number("segment", profile.segment / top.scale, length=True, positive=True)
     tol = 1e-6 * max(w.length for w in walls)
-    found = corners(walls, tol)
+    joins = junctions(walls, tol)
     notes: list[str] = []
-    laid = lay_masonry(walls, found, unit_length, unit_height, notes)
+    laid = lay_masonry(walls, joins, unit_length, unit_height, notes)
     add_floors(building, walls, laid, unit_height)
     courses = [round(w.height / unit_height) for w in walls]
     n_masonry = len(laid.wall)
     ground: list[tuple[int, float, float]] = []
     for w, _wall in enumerate(walls):
-        a, b = course_extent(walls, found, courses, w, 0)
+        a, b = course_extent(walls, joins, courses, w, 0)
         cuts = np.linspace(a, b, max(1, round((b - a) / segment)) + 1)
         ground += [(w, p, q) for p, q in zip(cuts[:-1], cuts[1:])]
     for w, p, q in ground:
@@ -321,7 +350,7 @@ def build_building(spec: dict, text: str) -> xr.Dataset:
     attrs = {"title": top.text("title"), "source_spec": text,
              "building_walls": json.dumps([{"name": w.name, "start": w.start.tolist(), "end": w.end.tolist(),
                                             "height": w.height, "thickness": w.thickness,
-                                            "ground": list(course_extent(walls, found, courses, k, 0))}
+                                            "ground": list(course_extent(walls, joins, courses, k, 0))}
                                            for k, w in enumerate(walls)]),
              "settlement_axis": json.dumps({"point": point.tolist(), "direction": direction.tolist()}),
              **({"laying_notes": "\n".join(notes)} if notes else {}),
