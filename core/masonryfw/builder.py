@@ -104,6 +104,9 @@ def load_wall(path_or_text) -> dict:
 
 
 def _validated(spec: dict, base_dir) -> dict:
+    if is_building(spec):  # checked as it is laid (masonryfw.building)
+        build_building(spec, "")
+        return spec
     if is_outlined(spec):  # checked as it is laid (masonryfw.outlined); its drawing found from the spec's folder
         geometry = spec.get("geometry", {})
         drawings = {k: str(Path(base_dir or ".", Path(geometry[k]).expanduser()).resolve())

@@ -207,3 +207,16 @@ def test_a_wall_along_the_trough_axis_settles_uniformly_and_is_not_strained():
     from masonryfw.profiles import Profile
 
     assert wall_profile(Profile("tunnel", 0.1, 0.01, center=0.3, width=3.0, depth=6.0), -1.2, 0.0) is None
+
+
+def test_a_building_spec_is_read_validated_and_built_again(tmp_path):
+    """``load_spec`` of a building (what a sweep or a script starts from), then ``build`` of what it returned."""
+    path = tmp_path / "house.toml"
+    path.write_text(mf.dump_toml(house_spec()))
+    spec = mf.load_spec(path)
+    assert mf.build(spec).sizes["block"] == mf.build(house_spec()).sizes["block"]
+    broken = {**house_spec(), "building": {**house_spec()["building"], "floors": [{"walls": ["attic"], "height": 1.2,
+                                                                                  "load": 1.0}]}}
+    path.write_text(mf.dump_toml(broken))
+    with pytest.raises(mf.SpecError, match="must list walls by name"):
+        mf.load_spec(path)
