@@ -56,8 +56,10 @@ def describe_model_3d(model: xr.Dataset) -> list[str]:
     if profile is not None and "settlement_axis" in model.attrs:
         axis = json.loads(model.attrs["settlement_axis"])
         degrees = math.degrees(math.atan2(-axis["direction"][0], axis["direction"][1])) % 180.0
-        lines.append(f"settlement profile: {profile_text(profile)}; its axis in plan at {degrees:.4g} degrees to x "
-                     f"through ({axis['point'][0]:.6g}, {axis['point'][1]:.6g}) m")
+        where = f"in plan at {degrees:.4g} degrees to x through ({axis['point'][0]:.6g}, {axis['point'][1]:.6g}) m"
+        text = profile_text(profile, where) if profile.kind in ("tunnel", "gaussian") else \
+            f"{profile_text(profile)}; its x measured across an axis {where}"
+        lines.append(f"settlement profile: {text}")
     if "building_walls" in model.attrs:
         walls = json.loads(model.attrs["building_walls"])
         lines.append("walls: " + ", ".join(f"{w['name']} ({math.dist(w['start'], w['end']):.4g} m x "
@@ -108,15 +110,17 @@ def _support_lines(model: xr.Dataset) -> list[str]:
     return lines
 
 
-def profile_text(profile: Profile) -> str:
-    """A settlement profile in a line: its kind and parameters, a tunnel's trough and S_max."""
+def profile_text(profile: Profile, axis: str | None = None) -> str:
+    """A settlement profile in a line: its kind and parameters, a tunnel's trough and S_max. ``axis``: where its
+    axis lies, said instead of its x (a building's, in plan)."""
+    where = axis or f"at x {profile.center:g} m"
     if profile.kind == "tunnel":
-        return (f"tunnel, V_L {profile.volume_loss:g} %, D {profile.diameter:g} m, axis {profile.depth:g} m deep at "
-                f"x {profile.center:g} m, K {profile.trough_width_factor:g}: i {profile.width:.4g} m, S_max "
+        return (f"tunnel, V_L {profile.volume_loss:g} %, D {profile.diameter:g} m, axis {profile.depth:g} m deep "
+                f"{where}, K {profile.trough_width_factor:g}: i {profile.width:.4g} m, S_max "
                 f"{1e3 * profile.target:.4g} mm (settlement_target); segments {profile.segment:.4g} m")
     if profile.kind == "gaussian":
         sideways = f", ground moving towards the axis (z0 {profile.depth:g} m)" if profile.depth else ""
-        return f"gaussian trough, axis x {profile.center:g} m, i {profile.width:.4g} m{sideways}; segments {profile.segment:.4g} m"
+        return f"gaussian trough, axis {where}, i {profile.width:.4g} m{sideways}; segments {profile.segment:.4g} m"
     if profile.kind == "linear":
         return f"tilt from x {profile.start:g} m (rate 0) to x {profile.end:g} m (rate 1); segments {profile.segment:.4g} m"
     return f"table of {len(profile.points)} rates; segments {profile.segment:.4g} m"
