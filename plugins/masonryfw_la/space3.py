@@ -215,16 +215,25 @@ def limit_state_3d(blocks: Blocks3D, sides: int = DEFAULT_SIDES, solver: str = "
     return LimitState3D(float(sol.alpha_primal), motion, point_force, active, sol)
 
 
-def settlement_reaction(blocks: Blocks3D, state: LimitState3D) -> float:
-    """The settlement reaction at collapse [N]: the wrench the masonry exerts on every moving support, weighted by
-    the support's motion per unit t (as in 2D, :func:`masonryfw.plugin_api.settlement_reaction`)."""
+def support_wrenches(blocks: Blocks3D, state: LimitState3D) -> np.ndarray:
+    """``(block, 6)``: the force and moment (about its centroid) the masonry exerts on every support block (0 for
+    masonry blocks); the contact forces between two supports are not the wall's."""
     contacts = blocks.contacts
     owner = contacts.point_interface()
+    support = mfp.support_blocks(blocks.role)
+    wall = ~support[contacts.sides].all(axis=1)[owner]
     wrench = np.zeros((blocks.n_block, 6))
     for side, sign in ((1, 1.0), (0, -1.0)):  # point_force acts on side 1, its opposite on side 0
         block = contacts.sides[owner, side]
-        force = sign * state.point_force
+        force = sign * state.point_force * wall[:, None]
         np.add.at(wrench, block, np.c_[force, np.cross(contacts.points - blocks.centroid[block], force)])
+    wrench[~support] = 0.0
+    return wrench
+
+
+def settlement_reaction(wrench: np.ndarray, blocks: Blocks3D) -> float:
+    """The settlement reaction at collapse [N]: the masonry's wrench on every moving support, weighted by the
+    support's motion per unit t (as in 2D, :func:`masonryfw.plugin_api.settlement_reaction`)."""
     moving = blocks.role == mfp.ROLE["moving_support"]
     return float((wrench[moving] * blocks.direction[moving]).sum())
 
@@ -255,8 +264,10 @@ def solve(model: xr.Dataset, options: Mapping[str, Any], progress=mfp.no_progres
     for k, c in enumerate("xyz"):
         data[f"interface_point_force_{c}"] = ("interface_node", state.point_force[:, k],
                                               mfp.variable_attrs(f"interface_point_force_{c}", "result3d"))
+    wrench = support_wrenches(blocks, state)
+    data["support_reaction"] = (axis, -wrench[:, :3] + 0.0, mfp.variable_attrs("support_reaction", "result3d"))
     if (blocks.role == mfp.ROLE["moving_support"]).any():
-        data["moving_support_reaction"] = ((), settlement_reaction(blocks, state),
+        data["moving_support_reaction"] = ((), settlement_reaction(wrench, blocks),
                                            mfp.variable_attrs("moving_support_reaction", "result3d"))
     progress(1.0, f"la: alpha = {state.alpha:.6g}")
     method = "cone, clarabel" if sides == 0 else f"pyramid of {sides} sides, {options['solver']}"

@@ -126,3 +126,15 @@ def test_the_comparable_fields_of_a_3d_twin_are_the_planar_ones(name):
     np.testing.assert_allclose(b.crack_indicator.values[same], a.crack_indicator.values, atol=1e-6)
     pairs = np.c_[a.macro_block.values, b.macro_block.values]
     assert len(np.unique(pairs, axis=0)) == len(np.unique(a.macro_block.values)) == len(np.unique(b.macro_block.values))
+
+
+def test_the_supports_carry_the_masonry_the_house_weighs():
+    """The support reactions of la's collapse state hold the masonry up: their sum is its weight and its floor
+    loads, upward, and nothing sideways (the masonry's own equilibrium, from the vertex forces)."""
+    model = mf.open_model("house-tunnel")
+    result = mf.solve(model, "la")
+    masonry = mfp.masonry_blocks(model.block_role.values)
+    reaction = result.support_reaction.values
+    load = -model.dead_load.values[masonry].sum(axis=0)
+    np.testing.assert_allclose(reaction.sum(axis=0), load, atol=1e-7 * abs(load[2]))
+    assert np.abs(reaction[masonry]).max() == 0.0
