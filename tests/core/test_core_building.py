@@ -220,3 +220,24 @@ def test_a_building_spec_is_read_validated_and_built_again(tmp_path):
     path.write_text(mf.dump_toml(broken))
     with pytest.raises(mf.SpecError, match="must list walls by name"):
         mf.load_spec(path)
+
+
+def test_the_house_in_millimetres_is_the_house_in_metres():
+    """Every length of the spec in mm with ``length_unit = "mm"`` (the floor loads stay N/m): the same blocks,
+    alpha and settlement reaction (scaled inputs are non-dimensionalised inside)."""
+    spec = house_spec()
+
+    def mm(value):
+        return [1000.0 * v for v in value] if isinstance(value, list) else 1000.0 * value
+
+    walls = [{**w, **{k: mm(w[k]) for k in ("start", "end", "height", "thickness")},
+              "openings": [{k: mm(v) for k, v in o.items()} for o in w["openings"]]} for w in spec["building"]["walls"]]
+    in_mm = {**spec, "length_unit": "mm",
+             "building": {**spec["building"], "unit": {k: mm(v) for k, v in UNIT.items()}, "walls": walls,
+                          "floors": [{**f, "height": mm(f["height"])} for f in spec["building"]["floors"]]},
+             "settlement": {k: mm(v) if k in ("diameter", "depth", "center_x", "center_y") else v
+                            for k, v in spec["settlement"].items()}}
+    a, b = mf.solve(mf.build(spec), "la"), mf.solve(mf.build(in_mm), "la")
+    assert b.sizes["block"] == a.sizes["block"]
+    assert float(b.collapse_multiplier) == pytest.approx(float(a.collapse_multiplier), rel=1e-9)
+    assert float(b.moving_support_reaction) == pytest.approx(float(a.moving_support_reaction), rel=1e-9)
