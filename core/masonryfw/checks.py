@@ -37,9 +37,9 @@ from .geometry import (
     polygon_area_centroid,
     vertex_turns,
 )
-from .model3d import polygon_normals, polyhedra_of, space
+from .model3d import interface_points, polyhedra_of, space
 from .overlaps import overlapping_blocks, self_intersections
-from .polyhedra import volumes_centroids
+from .polyhedra import polygon_normals, volumes_centroids
 from .roles import moving_blocks, support_blocks
 from .schema import FORMAT_VERSION, KINDS, KINDS_3D, READABLE_VERSIONS, load_schema
 
@@ -630,7 +630,7 @@ def _polyhedron_problems(ds, usable) -> list[Problem]:
         for i in np.flatnonzero(wrong):
             problems.append(Problem(f"interface {i}", f"joins blocks {sides[i].tolist()}: two different blocks of "
                                                       f"the {volume.size} are needed"))
-        _, area = contacts_area(ds)
+        _, area = polygon_normals(interface_points(ds), ds["interface_node_count"].values.astype(np.int64))
         for i in np.flatnonzero(~wrong & ~(area > 0)):
             problems.append(Problem(f"interface {i}", "has a polygon of zero area"))
     return problems
@@ -647,12 +647,6 @@ def unmatched_edges(poly) -> np.ndarray:
     at = np.clip(np.searchsorted(order, backward), 0, max(order.size - 1, 0))
     once = np.searchsorted(order, forward, side="right") - np.searchsorted(order, forward, side="left") == 1
     return np.flatnonzero((order[at] != backward) | ~once) if order.size else np.zeros(0, dtype=np.int64)
-
-
-def contacts_area(ds):
-    """Normals and areas of a 3D model's interface polygons."""
-    points = np.c_[ds["interface_node_x"].values, ds["interface_node_y"].values, ds["interface_node_z"].values]
-    return polygon_normals(points.astype(float), ds["interface_node_count"].values.astype(np.int64))
 
 
 def _dof_labels(ds) -> np.ndarray:

@@ -13,7 +13,7 @@ import xarray as xr
 from . import polyhedra
 from .dofs import block_loads
 from .errors import ModelError
-from .geometry import block_offsets, model_scale, next_node
+from .geometry import model_scale
 from .roles import support_blocks
 from .schema import FORMAT_VERSION, load_schema, variable_attrs
 
@@ -50,30 +50,24 @@ def polyhedra_of(ds: xr.Dataset) -> polyhedra.Polyhedra:
                                ds.face_node_count.values.astype(np.int64), ds.face_nodes.values.astype(np.int64))
 
 
+def interface_points(ds: xr.Dataset) -> np.ndarray:
+    """``(interface_node, 3)``: the vertices of a 3D model's interface polygons, interface after interface."""
+    return np.c_[ds.interface_node_x.values, ds.interface_node_y.values, ds.interface_node_z.values].astype(float)
+
+
 def contacts_of(ds: xr.Dataset) -> polyhedra.Contacts:
     """The interfaces a 3D model stores, with their normals and tangents derived from their polygons."""
     count = ds.interface_node_count.values.astype(np.int64)
-    points = np.c_[ds.interface_node_x.values, ds.interface_node_y.values, ds.interface_node_z.values].astype(float)
-    normal, area = polygon_normals(points, count)
+    points = interface_points(ds)
+    normal, area = polyhedra.polygon_normals(points, count)
     return polyhedra.Contacts(ds.interface_blocks.values.astype(np.int64).reshape(-1, 2), normal,
                               polyhedra.plane_frame(normal), count, points, area)
-
-
-def polygon_normals(points: np.ndarray, count: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Unit normals (counter-clockwise vertices: right-handed) and areas of ragged planar polygons."""
-    if count.size == 0:
-        return np.zeros((0, 3)), np.zeros(0)
-    doubled = np.add.reduceat(np.cross(points, points[next_node(count)]), block_offsets(count)[:-1], axis=0)
-    length = np.linalg.norm(doubled, axis=1)
-    return doubled / np.where(length > 0, length, 1.0)[:, None], 0.5 * length
 
 
 def derive_geometry_3d(ds: xr.Dataset) -> xr.Dataset:
     """``ds`` with its blocks' volumes and centroids and its interfaces' areas and normals (derived)."""
     volume, centroid = polyhedra.volumes_centroids(polyhedra_of(ds))
-    normal, area = polygon_normals(
-        np.c_[ds.interface_node_x.values, ds.interface_node_y.values, ds.interface_node_z.values].astype(float),
-        ds.interface_node_count.values.astype(np.int64))
+    normal, area = polyhedra.polygon_normals(interface_points(ds), ds.interface_node_count.values.astype(np.int64))
     out = ds.assign(block_volume=("block", volume, {"units": "m3", "long_name": "block volume (derived)"}))
     for k, c in enumerate("xyz"):
         out[f"block_centroid_{c}"] = ("block", centroid[:, k], {"units": "m", "long_name": f"block centroid {c} (derived)"})

@@ -101,19 +101,26 @@ def prisms(node_x: np.ndarray, node_y: np.ndarray, block_node_count: np.ndarray,
     return Polyhedra(vertices, 2 * counts, counts + 2, face_counts, per_block[order].astype(np.int64))
 
 
+def polygon_normals(points: np.ndarray, count: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Unit normals (counter-clockwise vertices: right-handed) and areas of ragged planar polygons."""
+    if count.size == 0:
+        return np.zeros((0, 3)), np.zeros(0)
+    doubled = np.add.reduceat(np.cross(points, points[next_node(count)]), block_offsets(count)[:-1], axis=0)
+    length = np.linalg.norm(doubled, axis=1)
+    return doubled / np.where(length > 0, length, 1.0)[:, None], 0.5 * length
+
+
 def face_normals_areas(poly: Polyhedra) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Every face's unit outward normal (Newell's, right for non-convex faces), area and centroid."""
     index = poly.face_vertex_index()
     starts = block_offsets(poly.face_node_count)[:-1]
     p, q = poly.vertices[index], poly.vertices[index[next_node(poly.face_node_count)]]
-    doubled = np.add.reduceat(np.cross(p, q), starts, axis=0)  # twice the vector area
-    length = np.linalg.norm(doubled, axis=1)
-    normal = doubled / np.where(length > 0, length, 1.0)[:, None]
+    normal, area = polygon_normals(p, poly.face_node_count)
     anchor = np.repeat(p[starts], poly.face_node_count, axis=0)
     fan = np.einsum("ij,ij->i", np.cross(p - anchor, q - anchor), np.repeat(normal, poly.face_node_count, axis=0))
     doubled_area = np.add.reduceat(fan, starts)
     centre = np.add.reduceat(fan[:, None] * (anchor + p + q), starts, axis=0) / 3.0
-    return normal, 0.5 * length, centre / np.where(doubled_area != 0, doubled_area, 1.0)[:, None]
+    return normal, area, centre / np.where(doubled_area != 0, doubled_area, 1.0)[:, None]
 
 
 def volumes_centroids(poly: Polyhedra) -> tuple[np.ndarray, np.ndarray]:

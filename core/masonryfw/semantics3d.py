@@ -12,7 +12,7 @@ import numpy as np
 import xarray as xr
 
 from .errors import SolveError
-from .model3d import polygon_normals
+from .model3d import interface_points
 from .roles import masonry_joints
 from .schema import variable_attrs
 from .semantics import (
@@ -31,8 +31,8 @@ def vertex_motion(model: xr.Dataset, u: np.ndarray) -> tuple[np.ndarray, np.ndar
     """Opening and slip ``(interface_node,)`` of block motions ``u`` ``(block, 6)`` (side 1 minus side 0), by the
     linearised rigid motion ``u_c + r x (p - c)`` (a mechanism)."""
     count = model.interface_node_count.values.astype(np.int64)
-    points = np.c_[model.interface_node_x.values, model.interface_node_y.values, model.interface_node_z.values]
-    normal, _ = polygon_normals(points.astype(float), count)
+    points = interface_points(model)
+    normal = np.c_[model.interface_normal_x.values, model.interface_normal_y.values, model.interface_normal_z.values]
     owner = np.repeat(np.arange(count.size), count)
     sides = model.interface_blocks.values.astype(np.int64)[owner]
     centroid = np.c_[model.block_centroid_x.values, model.block_centroid_y.values, model.block_centroid_z.values]

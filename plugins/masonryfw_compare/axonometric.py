@@ -135,7 +135,7 @@ def relative_to_largest(geo: xr.Dataset, u: np.ndarray, pieces) -> np.ndarray:
 def cracked_outlines(geo: xr.Dataset, u: np.ndarray, amplification: float, cracked: np.ndarray) -> list[np.ndarray]:
     """The polygon of every cracked interface, closed, carried by its side-0 block's amplified motion."""
     count = geo.interface_node_count.values.astype(np.int64)
-    points = np.c_[geo.interface_node_x.values, geo.interface_node_y.values, geo.interface_node_z.values]
+    points = mfp.interface_points(geo)
     owner = np.repeat(np.arange(count.size), count)
     side0 = geo.interface_blocks.values[owner, 0].astype(np.int64)
     centre = np.c_[geo.block_centroid_x.values, geo.block_centroid_y.values, geo.block_centroid_z.values][side0]

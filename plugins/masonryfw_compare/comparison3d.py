@@ -65,7 +65,7 @@ def locus_scores_3d(geo: xr.Dataset, cracked_a: np.ndarray, cracked_b: np.ndarra
     if not cracked_a.any() or not cracked_b.any():
         return {}
     count = geo.interface_node_count.values.astype(np.int64)
-    points = np.c_[geo.interface_node_x.values, geo.interface_node_y.values, geo.interface_node_z.values]
+    points = mfp.interface_points(geo)
     centre = np.add.reduceat(points, mfp.block_offsets(count)[:-1], axis=0) / count[:, None]
     area = geo.interface_area.values
 

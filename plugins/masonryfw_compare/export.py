@@ -133,7 +133,7 @@ def joints_mesh_3d(ds: xr.Dataset):
     their vertices, the interface's kind, state, crack indicator and normal force on the cell."""
     meshio = _meshio()
     count = ds.interface_node_count.values.astype(np.int64)
-    points = np.c_[ds.interface_node_x.values, ds.interface_node_y.values, ds.interface_node_z.values]
+    points = mfp.interface_points(ds)
     connectivity = np.full((count.size, int(count.max(initial=0))), -1, dtype=np.int64)
     rows = np.repeat(np.arange(count.size), count)
     connectivity[rows, np.arange(rows.size) - np.repeat(mfp.block_offsets(count)[:-1], count)] = np.arange(rows.size)
