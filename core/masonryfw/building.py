@@ -393,6 +393,10 @@ def _dataset(walls, laid, n_masonry, poly, volume, contacts, material, ground_pr
     motion = np.zeros((n, 6))
     motion[ground] = segment_motion(profile, point, direction, ends[ground], along[ground], across[ground], depth)
     moving = ground & (np.abs(motion).max(axis=1) > 0)
+    if not moving.any():
+        raise SpecError(f"spec table 'settlement': the ground settles at most {profile.cutoff:g} (the cutoff) times "
+                        "S_max under every segment of every wall: nothing settles under the building (move the "
+                        "profile's axis under it, center_x and center_y, or lower the cutoff)")
     role[moving] = ROLE["moving_support"]
     motion[~moving] = 0.0
     footprint = (np.array(laid.s1) - np.array(laid.s0)) * np.array([w.thickness for w in walls])[wall]
