@@ -261,20 +261,28 @@ def _circle_through(x: np.ndarray, y: np.ndarray, left: float, right: float, spr
 
 # ---------------------------------------------------------------- courses of units
 
+def pattern_cells(course: int, pattern: str, unit: float, header: float, first_course: str = "full"
+                  ) -> tuple[float, list[float]]:
+    """Where ``course``'s first head joint lies from the course origin and the lengths that repeat after it
+    (module docstring): running and stack (a full unit, or a half, first), English (courses of stretchers, then
+    of headers starting with a closer of half a header) and Flemish (stretcher and header alternating, each
+    header centred on the stretcher below). One definition for walls in 2D and buildings in 3D."""
+    even = course % 2 == 0
+    if pattern in ("running", "stack"):
+        full = first_course == "full"
+        if pattern == "running":
+            full = full == even
+        return (0.0 if full else 0.5 * unit), [unit]
+    if pattern == "english":
+        return (0.0, [unit]) if even else (0.5 * header, [header])
+    return (0.0, [unit, header]) if even else (0.5 * (unit - header), [header, unit])  # flemish
+
+
 def _joints(course: int, bond: Bond, bounds, tol: float) -> np.ndarray:
     """The head joints of ``course`` across the outline's width, from its left end at the base (module docstring);
     a joint beyond either end stands for the end."""
     x0, _, x1, _ = bounds
-    unit, header, even = bond.unit_length, bond.header, course % 2 == 0
-    if bond.pattern in ("running", "stack"):
-        full = bond.first_course == "full"
-        if bond.pattern == "running":
-            full = full == even
-        first, lengths = (0.0 if full else 0.5 * unit), [unit]
-    elif bond.pattern == "english":
-        first, lengths = (0.0, [unit]) if even else (0.25 * unit, [header])
-    else:  # flemish
-        first, lengths = (0.0, [unit, header]) if even else (0.25 * unit, [header, unit])
+    first, lengths = pattern_cells(course, bond.pattern, bond.unit_length, bond.header, bond.first_course)
     repeats = int(math.ceil((x1 - x0) / sum(lengths))) + 1
     joints = x0 + first + np.concatenate(([0.0], np.cumsum(np.tile(lengths, repeats))))
     inside = joints[(joints > x0 + tol) & (joints < x1 - tol)]

@@ -3,8 +3,12 @@ at their corners, with openings, lintels, floor loads and the ground cut into se
 settlement profile in plan (docs/buildings.md).
 
 A wall runs from ``start`` to ``end`` (its base line, the middle of its thickness), ``height`` high in whole
-courses. Units are boxes of the wall's thickness, ``unit.length`` long and ``unit.height`` high, in running
-bond (every other course shifted by half a unit). Where two walls meet end to end at a right angle, the
+courses. Units are boxes ``unit.length`` long, ``unit.height`` high and ``unit.depth`` deep (the wall's
+thickness unless given: one leaf); a wall is a whole number of leaves. The bond is running (every other course
+shifted by half a unit, every leaf alike and unbound but by its collar joints), English (a course of headers
+through the wall's thickness every ``header_every`` courses, 2 by default, the courses between in running bond)
+or Flemish (stretcher and header alternating in every course, each header centred on the stretcher below),
+the patterns of the 2D walls (:func:`masonryfw.bond.pattern_cells`) with the unit's depth as the header. Where two walls meet end to end at a right angle, the
 corner is toothed: in even courses the wall listed first runs through the corner to the other's outer face
 and the other stops at its inner face; in odd courses the other way round. A wall ending on another's base
 line (a T) stops at its face in even courses and runs through it in odd ones. An opening takes its courses
@@ -18,21 +22,23 @@ from __future__ import annotations
 
 import json
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import NamedTuple
 
 import numpy as np
 import xarray as xr
 
 from . import polyhedra
+from .bond import pattern_cells
 from .errors import SpecError
 from .model3d import model_from_polyhedra
 from .profiles import SETTLEMENT_KEYS, Profile, node_motion, read_profile, with_profile
 from .roles import ROLE
 from .spec import LENGTH_UNITS, SpecTable, read_material
 
-BUILDING_KEYS = ("unit", "walls", "floors", "support_depth", "segment")
-WALL_KEYS = ("name", "start", "end", "height", "thickness", "openings")
+BUILDING_KEYS = ("unit", "walls", "floors", "support_depth", "segment", "bond", "header_every")
+WALL_KEYS = ("name", "start", "end", "height", "thickness", "openings", "bond", "header_every")
+BONDS = ("running", "english", "flemish")
 OPENING_KEYS = ("x", "y", "width", "height", "lintel_bearing")
 FLOOR_KEYS = ("walls", "height", "load")
 #: A 3D profile's keys: the 2D ones, its axis in plan through a point instead of ``center``.
@@ -51,6 +57,14 @@ class Wall:
     height: float
     thickness: float
     openings: tuple[tuple[float, float, float, float, float], ...]  # x, y, width, height, lintel bearing
+    bond: str = "running"
+    header_every: int = 2  # English bond: a course of headers every this many courses
+    leaves: int = 1
+
+    @property
+    def depth(self) -> float:
+        """A leaf's depth: a unit's, and a header's length along the wall."""
+        return self.thickness / self.leaves
 
     @property
     def length(self) -> float:
@@ -70,7 +84,8 @@ def is_building(spec: dict) -> bool:
     return "building" in spec
 
 
-def read_walls(building: SpecTable, unit_length: float, unit_height: float) -> list[Wall]:
+def read_walls(building: SpecTable, unit_length: float, unit_height: float, unit_depth: float | None,
+               notes: list[str]) -> list[Wall]:
     raw = building.raw("walls")
     if not isinstance(raw, list) or not raw:
         raise SpecError(f"spec key {building.key('walls')!r} must be a list of tables [[building.walls]]")
@@ -86,12 +101,38 @@ def read_walls(building: SpecTable, unit_length: float, unit_height: float) -> l
             raise SpecError(f"spec key {wall.key('height')!r} = {wall.raw('height')!r}: not whole courses of "
                             f"{unit_height / building.scale:g} ({courses:.4g} courses)")
         thickness = wall.number("thickness", length=True, positive=True)
-        walls.append(Wall(wall.text("name", f"wall {i}"), start, end, round(courses) * unit_height, thickness,
-                          read_openings(wall, unit_length)))
+        name = wall.text("name", f"wall {i}")
+        bond = wall.choice("bond", BONDS, building.choice("bond", BONDS, "running"))
+        every = wall.integer("header_every", building.integer("header_every", 2, minimum=2), minimum=2)
+        leaves = read_leaves(wall, name, bond, thickness, unit_length, unit_depth, notes)
+        walls.append(Wall(name, start, end, round(courses) * unit_height, thickness, read_openings(wall, unit_length),
+                          bond, every, leaves))
     names = [w.name for w in walls]
     if len(set(names)) != len(names):
         raise SpecError(f"spec key {building.key('walls')!r}: two walls are named {next(n for n in names if names.count(n) > 1)!r}")
     return walls
+
+
+def read_leaves(wall: SpecTable, name: str, bond: str, thickness: float, unit_length: float,
+                unit_depth: float | None, notes: list[str]) -> int:
+    """How many leaves a wall of ``thickness`` is, of units ``unit_depth`` deep (one leaf when it is not given, in
+    running bond; a header's length, half a unit, in English and Flemish): a whole number, and at least two in
+    the bonds whose headers bind leaves."""
+    depth = unit_depth if unit_depth is not None else (thickness if bond == "running" else 0.5 * unit_length)
+    leaves = thickness / depth
+    if abs(leaves - round(leaves)) > 1e-6 * leaves or round(leaves) < 1:
+        raise SpecError(f"spec key {wall.key('thickness')!r}: wall {name!r} is {thickness:g} m thick, not a whole "
+                        f"number of leaves of units {depth:g} m deep ({leaves:.4g})")
+    if bond != "running" and round(leaves) < 2:
+        raise SpecError(f"spec key {wall.key('bond')!r}: wall {name!r} in {bond} bond is one leaf ({thickness:g} m "
+                        f"thick, units {depth:g} m deep); its headers bind two leaves or more")
+    if bond != "running" and depth >= unit_length * (1 - 1e-9):
+        raise SpecError(f"spec key 'building.unit.depth': units {depth:g} m deep and {unit_length:g} m long: a "
+                        "header (the unit's depth along the wall) must be shorter than a stretcher")
+    if bond != "running" and abs(thickness - unit_length) > 1e-9 * unit_length:
+        notes.append(f"wall {name!r}: its headers run through its {thickness:.4g} m thickness (units "
+                     f"{unit_length:.4g} m long)")
+    return round(leaves)
 
 
 def read_openings(wall: SpecTable, unit_length: float) -> tuple[tuple[float, float, float, float, float], ...]:
@@ -179,54 +220,80 @@ def tee_gaps(walls: list[Wall], joins: Junctions, courses: list[int], v: int) ->
     return gaps
 
 
-def pieces(a: float, b: float, origin: float, unit_length: float) -> list[tuple[float, float]]:
-    """``[a, b]`` cut at ``origin + m * unit_length``, a sliver under :data:`SLIVER` of a unit joined to its
-    neighbour."""
-    if b - a <= 1e-9 * unit_length:
+def course_cells(wall: Wall, course: int, origin: float, a: float, b: float, unit_length: float
+                 ) -> tuple[np.ndarray, np.ndarray]:
+    """The starts of the bond's cells covering ``[a, b]`` in ``course`` (the pattern repeated both ways from
+    ``origin``) and whether each is a header (through the wall's thickness) or a stretcher (one per leaf)."""
+    depth = wall.depth
+    if wall.bond == "english":
+        header_course = course % wall.header_every == wall.header_every - 1
+        first, lengths = pattern_cells(1, "english", unit_length, depth) if header_course else \
+            pattern_cells(course % wall.header_every, "running", unit_length, depth)
+        headers = [header_course] * len(lengths)
+    else:
+        first, lengths = pattern_cells(course, wall.bond, unit_length, depth)
+        headers = [wall.bond == "flemish" and length == depth for length in lengths]
+    period = sum(lengths)
+    offsets = np.concatenate(([0.0], np.cumsum(lengths)[:-1]))
+    repeats = np.arange(math.floor((a - origin - first) / period) - 1, math.ceil((b - origin - first) / period) + 1)
+    return (origin + first + repeats[:, None] * period + offsets).ravel(), np.tile(headers, repeats.size)
+
+
+def pieces(a: float, b: float, starts: np.ndarray, headers: np.ndarray, unit_length: float
+           ) -> list[tuple[float, float, bool]]:
+    """``[a, b]`` cut at the cells' ``starts``, each piece a header if its cell is; a sliver under :data:`SLIVER`
+    of a unit joins its neighbour (and takes its kind)."""
+    tol = 1e-9 * unit_length
+    if b - a <= tol:
         return []
-    first = origin + math.ceil((a - origin) / unit_length + 1e-9) * unit_length
-    cuts = [a, *np.arange(first, b - 1e-9 * unit_length, unit_length).tolist(), b]
-    parts = [(p, q) for p, q in zip(cuts[:-1], cuts[1:]) if q - p > 1e-9 * unit_length]
-    if len(parts) > 1 and parts[0][1] - parts[0][0] < SLIVER * unit_length:
-        parts[:2] = [(parts[0][0], parts[1][1])]
-    if len(parts) > 1 and parts[-1][1] - parts[-1][0] < SLIVER * unit_length:
-        parts[-2:] = [(parts[-2][0], parts[-1][1])]
+    cuts = [a, *starts[(starts > a + tol) & (starts < b - tol)].tolist(), b]
+    parts = [(p, q, bool(headers[np.searchsorted(starts, 0.5 * (p + q), side="right") - 1]))
+             for p, q in zip(cuts[:-1], cuts[1:]) if q - p > tol]
+    sliver = SLIVER * unit_length - tol
+    if len(parts) > 1 and parts[0][1] - parts[0][0] < sliver:
+        parts[:2] = [(parts[0][0], parts[1][1], parts[1][2])]
+    if len(parts) > 1 and parts[-1][1] - parts[-1][0] < sliver:
+        parts[-2:] = [(parts[-2][0], parts[-1][1], parts[-2][2])]
     return parts
 
 
-def whole_at_end(parts: list[tuple[float, float]], unit_length: float) -> list[tuple[float, float]]:
-    """``parts`` with a whole unit last (the quoin of a corner the course runs through) and the rest of the last
-    two in the piece before it (a closer; one longer piece when the closer would be a sliver)."""
+def whole_at_end(parts: list[tuple[float, float, bool]], unit_length: float) -> list[tuple[float, float, bool]]:
+    """Stretchers ``parts`` with a whole unit last (the quoin of a corner the course runs through) and the rest of
+    the last two in the piece before it (a closer; one longer piece when the closer would be a sliver)."""
     if len(parts) < 2 or parts[-1][1] - parts[-1][0] >= unit_length * (1 - 1e-9):
         return parts
     start, end = parts[-2][0], parts[-1][1]
     if end - start - unit_length < SLIVER * unit_length:
-        return parts[:-2] + [(start, end)]
-    return parts[:-2] + [(start, end - unit_length), (end - unit_length, end)]
+        return parts[:-2] + [(start, end, False)]
+    return parts[:-2] + [(start, end - unit_length, False), (end - unit_length, end, False)]
 
 
 @dataclass
 class Laid:
-    """Boxes in walls' frames as they are laid: wall, along [s0, s1], course (z0, z1), role, extra dead load."""
+    """Boxes in walls' frames as they are laid: wall, along [s0, s1], across [q0, q1] (from the wall's base line),
+    course (z0, z1), role, extra dead load."""
 
-    wall: list[int]
-    s0: list[float]
-    s1: list[float]
-    z0: list[float]
-    z1: list[float]
-    role: list[int]
-    load: list[float]  # a floor's line load times the length [N], down
+    wall: list[int] = field(default_factory=list)
+    s0: list[float] = field(default_factory=list)
+    s1: list[float] = field(default_factory=list)
+    q0: list[float] = field(default_factory=list)
+    q1: list[float] = field(default_factory=list)
+    z0: list[float] = field(default_factory=list)
+    z1: list[float] = field(default_factory=list)
+    role: list[int] = field(default_factory=list)
+    load: list[float] = field(default_factory=list)  # a floor's line load times the length and share [N], down
 
-    def add(self, wall, s0, s1, z0, z1, role, load=0.0):
-        for name, value in zip(("wall", "s0", "s1", "z0", "z1", "role", "load"), (wall, s0, s1, z0, z1, role, load)):
+    def add(self, wall: int, s: tuple[float, float], q: tuple[float, float], z: tuple[float, float], role: int):
+        for name, value in zip(("wall", "s0", "s1", "q0", "q1", "z0", "z1", "role", "load"),
+                               (wall, *s, *q, *z, role, 0.0)):
             getattr(self, name).append(value)
 
 
 def lay_masonry(walls: list[Wall], joins: Junctions, unit_length: float, unit_height: float, notes: list[str]) -> Laid:
-    """Every wall's courses: units in running bond between its course extents, openings left out, a lintel
-    over each opening (module docstring)."""
+    """Every wall's courses: units in its bond between its course extents, openings left out, a lintel over each
+    opening (module docstring)."""
     courses = [round(wall.height / unit_height) for wall in walls]
-    laid = Laid([], [], [], [], [], [], [])
+    laid = Laid()
     for w, wall in enumerate(walls):
         gaps = tee_gaps(walls, joins, courses, w)  # course: the ranges left open (by openings, by abutting walls)
         lintels: dict[int, list[tuple[float, float]]] = {}  # course: the ranges of the lintels
@@ -244,35 +311,41 @@ def lay_masonry(walls: list[Wall], joins: Junctions, unit_length: float, unit_he
             if k1 < courses[w]:
                 lintels.setdefault(k1, []).append((max(x - bearing, 0.0), min(x + width + bearing, wall.length)))
         origin = course_extent(walls, joins, courses, w, 0)[0]  # the bond starts with a full unit there
+        half = 0.5 * wall.thickness
+        leaves = [(-half + j * wall.depth, -half + (j + 1) * wall.depth) for j in range(wall.leaves)]
         for k in range(courses[w]):
             a, b = course_extent(walls, joins, courses, w, k)
+            z = (k * unit_height, (k + 1) * unit_height)
+            starts, headers = course_cells(wall, k, origin, a, b, unit_length)
             cut = sorted(gaps.get(k, []) + lintels.get(k, []))
             if any(q > p + 1e-9 * unit_length for (_, q), (p, _) in zip(cut[:-1], cut[1:])):
                 raise SpecError(f"wall {wall.name!r}: two openings (or an opening and a lintel over another) overlap "
                                 f"in course {k} ({k * unit_height:.4g} to {(k + 1) * unit_height:.4g} m); move them "
                                 "apart by a unit or more")
             for p, q in zip([a] + [end for _, end in cut], [start for start, _ in cut] + [b]):
-                parts = pieces(p, q, origin + (k % 2) * 0.5 * unit_length, unit_length)
-                if q > wall.length + 1e-9 * unit_length:  # through a corner: a whole unit there, a closer before it
+                parts = pieces(p, q, starts, headers, unit_length)
+                if q > wall.length + 1e-9 * unit_length and not headers.any():  # through a corner: a quoin there
                     parts = whole_at_end(parts, unit_length)
-                for s0, s1 in parts:
-                    laid.add(w, s0, s1, k * unit_height, (k + 1) * unit_height, ROLE["unit"])
-            for s0, s1 in lintels.get(k, []):
-                laid.add(w, s0, s1, k * unit_height, (k + 1) * unit_height, ROLE["lintel"])
+                for s0, s1, header in parts:
+                    for across in [(-half, half)] if header else leaves:
+                        laid.add(w, (s0, s1), across, z, ROLE["unit"])
+            for s in lintels.get(k, []):
+                laid.add(w, s, (-half, half), z, ROLE["lintel"])
     return laid
 
 
-def oriented_boxes(walls: list[Wall], laid_wall, s0, s1, z0, z1) -> polyhedra.Polyhedra:
-    """Boxes ``[s0, s1]`` along their walls' base lines, the walls' thickness across, ``[z0, z1]`` high."""
-    w = np.asarray(laid_wall)
+def oriented_boxes(walls: list[Wall], laid: Laid) -> polyhedra.Polyhedra:
+    """The laid boxes: ``[s0, s1]`` along their walls' base lines, ``[q0, q1]`` across, ``[z0, z1]`` high."""
+    w = np.asarray(laid.wall)
     start = np.array([wall.start for wall in walls])[w]
     along = np.array([wall.along for wall in walls])[w]
     across = np.array([wall.across for wall in walls])[w]
-    half = 0.5 * np.array([wall.thickness for wall in walls])[w]
     corner = np.array([[i & 1, (i >> 1) & 1, (i >> 2) & 1] for i in range(8)])
-    s = np.where(corner[None, :, 0] == 1, np.asarray(s1)[:, None], np.asarray(s0)[:, None])
-    q = np.where(corner[None, :, 1] == 1, half[:, None], -half[:, None])
-    z = np.where(corner[None, :, 2] == 1, np.asarray(z1)[:, None], np.asarray(z0)[:, None])
+
+    def pick(axis: int, low: list[float], high: list[float]) -> np.ndarray:
+        return np.where(corner[None, :, axis] == 1, np.asarray(high)[:, None], np.asarray(low)[:, None])
+
+    s, q, z = pick(0, laid.s0, laid.s1), pick(1, laid.q0, laid.q1), pick(2, laid.z0, laid.z1)
     plan = start[:, None, :] + s[..., None] * along[:, None, :] + q[..., None] * across[:, None, :]
     vertices = np.concatenate([plan, z[..., None]], axis=2).reshape(-1, 3)
     template = polyhedra.boxes(np.zeros((1, 3)), np.ones((1, 3)))
@@ -318,10 +391,12 @@ def build_building(spec: dict, text: str) -> xr.Dataset:
     if top.raw("space", 3) != 3:
         raise SpecError(f"spec key 'space' = {top.raw('space')!r}: a [building] is 3D (space = 3, or leave it out)")
     building = top.sub("building", BUILDING_KEYS)
-    unit = building.sub("unit", ("length", "height"))
+    unit = building.sub("unit", ("length", "height", "depth"))
     unit_length = unit.number("length", length=True, positive=True)
     unit_height = unit.number("height", length=True, positive=True)
-    walls = read_walls(building, unit_length, unit_height)
+    unit_depth = unit.number("depth", length=True, positive=True) if unit.has("depth") else None
+    notes: list[str] = []
+    walls = read_walls(building, unit_length, unit_height, unit_depth, notes)
     material = read_material(top)
     if not top.has("settlement"):
         raise SpecError("spec table 'settlement' is missing: a building stands on ground that moves by a profile "
@@ -332,7 +407,6 @@ def build_building(spec: dict, text: str) -> xr.Dataset:
     segment = building.number("segment", profile.segment / top.scale, length=True, positive=True)
     tol = 1e-6 * max(w.length for w in walls)
     joins = junctions(walls, tol)
-    notes: list[str] = []
     laid = lay_masonry(walls, joins, unit_length, unit_height, notes)
     add_floors(building, walls, laid, unit_height)
     courses = [round(w.height / unit_height) for w in walls]
@@ -343,8 +417,9 @@ def build_building(spec: dict, text: str) -> xr.Dataset:
         cuts = np.linspace(a, b, max(1, round((b - a) / segment)) + 1)
         ground += [(w, p, q) for p, q in zip(cuts[:-1], cuts[1:])]
     for w, p, q in ground:
-        laid.add(w, p, q, -depth, 0.0, ROLE["fixed_support"])
-    poly = oriented_boxes(walls, laid.wall, laid.s0, laid.s1, laid.z0, laid.z1)
+        half = 0.5 * walls[w].thickness
+        laid.add(w, (p, q), (-half, half), (-depth, 0.0), ROLE["fixed_support"])
+    poly = oriented_boxes(walls, laid)
     volume, _ = polyhedra.volumes_centroids(poly)
     contacts = polyhedra.find_contacts(poly, tol)
     attrs = {"title": top.text("title"), "source_spec": text,
@@ -360,7 +435,8 @@ def build_building(spec: dict, text: str) -> xr.Dataset:
 
 
 def add_floors(building: SpecTable, walls: list[Wall], laid: Laid, unit_height: float) -> None:
-    """Each ``[[building.floors]]`` line load [N/m] on the named walls' course whose top is nearest its height."""
+    """Each ``[[building.floors]]`` line load [N/m] on the named walls' course whose top is nearest its height,
+    a block taking the load on its length and on its share of the wall's thickness."""
     names = {wall.name: w for w, wall in enumerate(walls)}
     for i, table in enumerate(building.raw("floors", [])):
         floor = SpecTable(table, f"{building.key('floors')}[{i}]", FLOOR_KEYS, building.scale)
@@ -372,7 +448,8 @@ def add_floors(building: SpecTable, walls: list[Wall], laid: Laid, unit_height: 
         hit = False
         for b, (w, z0) in enumerate(zip(laid.wall, laid.z0)):
             if walls[w].name in on and round(z0 / unit_height) == top_course:
-                laid.load[b] += load * (laid.s1[b] - laid.s0[b])
+                share = (laid.q1[b] - laid.q0[b]) / walls[w].thickness
+                laid.load[b] += load * (laid.s1[b] - laid.s0[b]) * share
                 hit = True
         if not hit:
             raise SpecError(f"spec key {floor.key('height')!r} = {floor.raw('height')!r}: no course of the walls "

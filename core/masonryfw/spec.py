@@ -100,6 +100,14 @@ class SpecTable:
             raise SpecError(f"spec key {self.key(name)!r} = {value!r}: must be less than {below}")
         return float(value) * (self.scale if length else 1.0)
 
+    def integer(self, name: str, default=_REQUIRED, *, minimum: int | None = None) -> int:
+        value = self.raw(name, default)
+        if isinstance(value, bool) or not isinstance(value, int):
+            raise SpecError(f"spec key {self.key(name)!r} = {value!r}: must be a whole number")
+        if minimum is not None and value < minimum:
+            raise SpecError(f"spec key {self.key(name)!r} = {value!r}: must be at least {minimum}")
+        return value
+
     def flag(self, name: str, default=_REQUIRED) -> bool:
         value = self.raw(name, default)
         if not isinstance(value, bool):
