@@ -37,6 +37,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from .geometry import block_bounds
+from .ground_plan import GroundInPlan, SurfaceCut
 from .profiles import Profile, model_profile
 from .roles import masonry_blocks, support_blocks
 from .schema import variable_attrs
@@ -95,9 +96,12 @@ def ltsm_category(strain) -> np.ndarray:
     return np.searchsorted(np.array(LTSM_LIMITS), np.asarray(strain, dtype=float), side="right").astype(np.int8)
 
 
-def _splits(profile: Profile, x_a: float, x_b: float) -> list[float]:
+def _splits(profile: Profile | SurfaceCut, x_a: float, x_b: float) -> list[float]:
     """The part ends: the wall's ends and the inflection points between them."""
-    inner = [profile.center - profile.width, profile.center + profile.width] if profile.kind in TROUGHS else []
+    if isinstance(profile, SurfaceCut):
+        inner = profile.inflections(x_a, x_b, SAMPLES)
+    else:
+        inner = [profile.center - profile.width, profile.center + profile.width] if profile.kind in TROUGHS else []
     return [x_a, *sorted(x for x in inner if x_a < x < x_b), x_b]
 
 
@@ -119,7 +123,7 @@ def _largest(f, a: float, b: float) -> float:
     return float(y[k])
 
 
-def ltsm_parts(profile: Profile, x_a: float, x_b: float, height: float) -> list[Part]:
+def ltsm_parts(profile: Profile | SurfaceCut, x_a: float, x_b: float, height: float) -> list[Part]:
     """The sagging and hogging parts of a wall ``[x_a, x_b]`` of ``height`` over ``profile`` at t = 1."""
     ends = _splits(profile, x_a, x_b)
     parts = []
@@ -134,7 +138,8 @@ def ltsm_parts(profile: Profile, x_a: float, x_b: float, height: float) -> list[
 
         below, above = _largest(offset, start, end), _largest(lambda x, f=offset: -f(x), start, end)
         mid = 0.5 * (start + end)
-        sagging = abs(mid - profile.center) < profile.width if profile.kind in TROUGHS else below >= above
+        sagging = abs(mid - profile.center) < profile.width if isinstance(profile, Profile) and \
+            profile.kind in TROUGHS else below >= above
         ratio = max(below, above) / length
         horizontal = float(profile.horizontal(np.array([end]))[0] - profile.horizontal(np.array([start]))[0]) / length
         bending, diagonal = deep_beam_strains(ratio, length, height, sagging)
@@ -155,7 +160,7 @@ def wall_extent(model: xr.Dataset) -> tuple[float, float, float]:
     return float(x.min()), float(x.max()), float(ymax[masonry].max() - ymin[masonry].min())
 
 
-def greenfield_screen(profile: Profile, x_a: float, x_b: float) -> tuple[float, float]:
+def greenfield_screen(profile: Profile | SurfaceCut, x_a: float, x_b: float) -> tuple[float, float]:
     """Stage 1 at t = 1: ``(largest |slope|, largest settlement)`` of the greenfield profile over the wall."""
     x = np.linspace(x_a, x_b, SAMPLES)
     settled = profile.rate(x)
@@ -202,16 +207,19 @@ def assess(model: xr.Dataset, settlement: float) -> Assessment | None:
 
 def assess_building(model: xr.Dataset, profile: Profile, settlement: float) -> Assessment:
     """Stages 1 and 2 of every wall of a building (its ``building_walls``) over the greenfield profile in plan
-    (``settlement_axis``): each wall's line cut from the greenfield surface (:func:`wall_profile`), its own
-    length and height; the building's largest slope, settlement and strain are its worst wall's."""
+    (``settlement_axis``): each wall's line cut from the greenfield surface (:func:`wall_profile`; with a
+    tunnel's face, a :class:`SurfaceCut`), its own length and height; the building's largest slope, settlement
+    and strain are its worst wall's."""
     axis = json.loads(model.attrs["settlement_axis"])
     point, direction = np.array(axis["point"]), np.array(axis["direction"])
+    ground = GroundInPlan(profile, point, direction, axis.get("face"))
     slopes, settled, parts = [0.0], [0.0], []
     for wall in json.loads(model.attrs["building_walls"]):
         start, end = np.array(wall["start"]), np.array(wall["end"])
         along = (end - start) / np.linalg.norm(end - start)
         x_a, x_b = wall["ground"]
-        cut = wall_profile(profile, float((start - point) @ direction), float(along @ direction))
+        cut: Profile | SurfaceCut | None = SurfaceCut(ground, start, along) if ground.face is not None else \
+            wall_profile(profile, float((start - point) @ direction), float(along @ direction))
         if cut is None:  # the wall runs along the trough's axis: its ground settles uniformly
             settled.append(float(profile.rate(np.array([(start - point) @ direction]))[0]))
             continue

@@ -31,8 +31,9 @@ import xarray as xr
 from . import polyhedra
 from .bond import pattern_cells
 from .errors import SpecError
+from .ground_plan import GroundInPlan
 from .model3d import model_from_polyhedra
-from .profiles import SETTLEMENT_KEYS, Profile, node_motion, read_profile, with_profile
+from .profiles import SETTLEMENT_KEYS, read_profile, with_profile
 from .roles import ROLE
 from .spec import LENGTH_UNITS, SpecTable, read_material
 
@@ -42,7 +43,8 @@ BONDS = ("running", "english", "flemish")
 OPENING_KEYS = ("x", "y", "width", "height", "lintel_bearing")
 FLOOR_KEYS = ("walls", "height", "load")
 #: A 3D profile's keys: the 2D ones, its axis in plan through a point instead of ``center``.
-SETTLEMENT_3D_KEYS = tuple(k for k in SETTLEMENT_KEYS if k != "center") + ("axis_angle", "center_x", "center_y")
+SETTLEMENT_3D_KEYS = tuple(k for k in SETTLEMENT_KEYS if k != "center") + ("axis_angle", "center_x", "center_y",
+                                                                             "face")
 TOP_KEYS = ("title", "description", "space", "length_unit", "building", "material", "settlement")
 #: A piece of a unit shorter than this share of the unit length joins its neighbour.
 SLIVER = 0.25
@@ -354,32 +356,36 @@ def oriented_boxes(walls: list[Wall], laid: Laid) -> polyhedra.Polyhedra:
                                np.tile(template.face_nodes, n))
 
 
-def profile_in_plan(table: SpecTable, unit_length: float) -> tuple[Profile, np.ndarray, np.ndarray]:
-    """The ``[settlement]`` profile over the coordinate across its axis in plan, the axis's point and the unit
-    vector its coordinate runs along: ``axis_angle`` degrees from x (90: the axis along y, the profile along
-    x) through (``center_x``, ``center_y``)."""
+def profile_in_plan(table: SpecTable, unit_length: float) -> GroundInPlan:
+    """The ``[settlement]`` profile over the coordinate across its axis in plan: ``axis_angle`` degrees from x (90:
+    the axis along y, the profile along x) through (``center_x``, ``center_y``); a trough's tunnel ``face`` along
+    the axis from that point, driven towards ``axis_angle`` (:mod:`masonryfw.ground_plan`)."""
     angle = math.radians(table.number("axis_angle", 90.0))
     point = np.array([table.number("center_x", 0.0, length=True), table.number("center_y", 0.0, length=True)])
-    plain = {k: v for k, v in table.table.items() if k not in ("axis_angle", "center_x", "center_y")}
+    plain = {k: v for k, v in table.table.items() if k not in ("axis_angle", "center_x", "center_y", "face")}
     if plain.get("profile") in ("gaussian", "tunnel"):
         plain["center"] = 0.0
+    elif table.has("face"):
+        raise SpecError(f"spec key {table.key('face')!r}: a tunnel's face bounds a trough; profile = "
+                        f"{plain.get('profile')!r} has none (use 'tunnel' or 'gaussian')")
     profile = read_profile(SpecTable(plain, table.path, SETTLEMENT_KEYS, table.scale), 0.0, 1.0, unit_length)
-    return profile, point, np.array([math.sin(angle), -math.cos(angle)])
+    face = table.number("face", length=True) if table.has("face") else None
+    return GroundInPlan(profile, point, np.array([math.sin(angle), -math.cos(angle)]), face)
 
 
-def segment_motion(profile: Profile, point: np.ndarray, direction: np.ndarray, ends: np.ndarray, along: np.ndarray,
-                   across: np.ndarray, depth: float) -> np.ndarray:
+def segment_motion(ground: GroundInPlan, ends: np.ndarray, along: np.ndarray, across: np.ndarray, depth: float
+                   ) -> np.ndarray:
     """``(segment, 6)``: a ground segment's motion per unit t at its centroid, ``depth`` below the middle of its top
     edge from ``ends[:, 0]`` to ``ends[:, 1]`` (plan): the top edge follows the ground at both ends as in 2D
-    (:func:`masonryfw.profiles.node_motion`: down linear between them, across the horizontal mean of theirs,
-    turned about the wall's horizontal axis ``across``)."""
-    down, horizontal = node_motion(profile, (ends - point) @ direction)  # (segment, 2) each
+    (:meth:`GroundInPlan.motion`: down linear between them, sideways by the mean of theirs, turned about the
+    wall's horizontal axis ``across``)."""
+    down, horizontal = ground.motion(ends.reshape(-1, 2))
+    down, horizontal = down.reshape(-1, 2), horizontal.reshape(-1, 2, 2)
     length = np.linalg.norm(ends[:, 1] - ends[:, 0], axis=1)
     theta = (down[:, 1] - down[:, 0]) / length  # about ``across``: (along x across) = z
-    top = np.c_[horizontal.mean(axis=1)[:, None] * direction, -down.mean(axis=1)]
     motion = np.zeros((ends.shape[0], 6))
-    motion[:, :2] = top[:, :2] - (theta * 0.5 * depth)[:, None] * along
-    motion[:, 2] = top[:, 2]
+    motion[:, :2] = horizontal.mean(axis=1) - (theta * 0.5 * depth)[:, None] * along
+    motion[:, 2] = -down.mean(axis=1)
     motion[:, 3:5] = theta[:, None] * across
     return motion + 0.0
 
@@ -402,7 +408,8 @@ def build_building(spec: dict, text: str) -> xr.Dataset:
         raise SpecError("spec table 'settlement' is missing: a building stands on ground that moves by a profile "
                         "in plan ([settlement] with profile, axis_angle, center_x, center_y)")
     settlement = top.sub("settlement", SETTLEMENT_3D_KEYS)
-    profile, point, direction = profile_in_plan(settlement, unit_length)
+    ground_plan = profile_in_plan(settlement, unit_length)
+    profile = ground_plan.profile
     depth = building.number("support_depth", unit_height / top.scale, length=True, positive=True)
     segment = building.number("segment", profile.segment / top.scale, length=True, positive=True)
     tol = 1e-6 * max(w.length for w in walls)
@@ -427,10 +434,12 @@ def build_building(spec: dict, text: str) -> xr.Dataset:
                                             "height": w.height, "thickness": w.thickness,
                                             "ground": list(course_extent(walls, joins, courses, k, 0))}
                                            for k, w in enumerate(walls)]),
-             "settlement_axis": json.dumps({"point": point.tolist(), "direction": direction.tolist()}),
+             "settlement_axis": json.dumps({"point": ground_plan.point.tolist(),
+                                            "direction": ground_plan.across.tolist(),
+                                            **({} if ground_plan.face is None else {"face": ground_plan.face})}),
              **({"laying_notes": "\n".join(notes)} if notes else {}),
              **({"comment": top.text("description")} if top.has("description") else {})}
-    model = _dataset(walls, laid, n_masonry, poly, volume, contacts, material, (profile, point, direction, depth), attrs)
+    model = _dataset(walls, laid, n_masonry, poly, volume, contacts, material, ground_plan, depth, attrs)
     return with_profile(model, profile)
 
 
@@ -456,8 +465,7 @@ def add_floors(building: SpecTable, walls: list[Wall], laid: Laid, unit_height: 
                             f"{', '.join(on)} ends there")
 
 
-def _dataset(walls, laid, n_masonry, poly, volume, contacts, material, ground_profile, attrs) -> xr.Dataset:
-    profile, point, direction, depth = ground_profile
+def _dataset(walls, laid, n_masonry, poly, volume, contacts, material, ground_plan, depth, attrs) -> xr.Dataset:
     n = len(laid.wall)
     role = np.array(laid.role, dtype=np.int8)
     weight = np.where(np.arange(n) < n_masonry, material.unit_weight * volume, 0.0) + np.array(laid.load)
@@ -468,10 +476,11 @@ def _dataset(walls, laid, n_masonry, poly, volume, contacts, material, ground_pr
     ends = starts[:, None, :] + np.stack([np.array(laid.s0), np.array(laid.s1)], axis=1)[..., None] * along[:, None, :]
     ground = np.arange(n) >= n_masonry
     motion = np.zeros((n, 6))
-    motion[ground] = segment_motion(profile, point, direction, ends[ground], along[ground], across[ground], depth)
+    motion[ground] = segment_motion(ground_plan, ends[ground], along[ground], across[ground], depth)
     moving = ground & (np.abs(motion).max(axis=1) > 0)
     if not moving.any():
-        raise SpecError(f"spec table 'settlement': the ground settles at most {profile.cutoff:g} (the cutoff) times "
+        raise SpecError(f"spec table 'settlement': the ground settles at most {ground_plan.profile.cutoff:g} (the "
+                        "cutoff) times "
                         "S_max under every segment of every wall: nothing settles under the building (move the "
                         "profile's axis under it, center_x and center_y, or lower the cutoff)")
     role[moving] = ROLE["moving_support"]

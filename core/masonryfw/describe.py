@@ -59,6 +59,10 @@ def describe_model_3d(model: xr.Dataset) -> list[str]:
         where = f"in plan at {degrees:.4g} degrees to x through ({axis['point'][0]:.6g}, {axis['point'][1]:.6g}) m"
         text = profile_text(profile, where) if profile.kind in ("tunnel", "gaussian") else \
             f"{profile_text(profile)}; its x measured across an axis {where}"
+        if "face" in axis:
+            driven = math.degrees(math.atan2(axis["direction"][0], -axis["direction"][1])) % 360.0
+            text += (f"; the tunnel's face {axis['face']:.6g} m from that point along the axis, the tunnel driven "
+                     f"towards {driven:.4g} degrees from x")
         lines.append(f"settlement profile: {text}")
     if "building_walls" in model.attrs:
         walls = json.loads(model.attrs["building_walls"])

@@ -217,11 +217,17 @@ def node_motion(profile: Profile, x: np.ndarray) -> tuple[np.ndarray, np.ndarray
     """``(down, horizontal)`` rates of the ground at the nodes ``x``: the profile's rate less the cutoff c, over
     ``1 - c`` (so a rate of 1 stays 1, S_max stays t), 0 where the rate is at most c; the horizontal motion
     scaled alike. Continuous, and within c of the profile everywhere."""
-    rate = profile.rate(x)
+    down, share = beyond_cutoff(profile, profile.rate(x))
+    return down, profile.horizontal(x) * share
+
+
+def beyond_cutoff(profile: Profile, rate: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``(down, share)``: a greenfield ``rate`` less the profile's cutoff c, over ``1 - c``, 0 where it is at most
+    c; and ``down / rate``, what the horizontal motion is scaled by."""
     down = np.maximum(rate - profile.cutoff, 0.0) / (1.0 - profile.cutoff)
     with np.errstate(invalid="ignore", divide="ignore"):
         share = np.where(rate > 0, down / rate, 0.0)
-    return down, profile.horizontal(x) * share
+    return down, share
 
 
 def segment_edges(profile: Profile, x0: float, x1: float) -> np.ndarray:

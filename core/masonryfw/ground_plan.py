@@ -1,0 +1,99 @@
+"""The greenfield ground in plan: a 2D profile across an axis, and a tunnel's face.
+
+A building's ``[settlement]`` is a 2D profile (:mod:`masonryfw.profiles`) over the coordinate ``u`` across an
+axis in plan (the unit vector ``across``, from ``point``). A trough's tunnel may have a face: driven along the
+axis (``v``, along ``axis``, ``across`` turned a quarter left), its face at ``v = face``. Behind the face the
+ground has settled by the trough, ahead of it by less: the longitudinal profile is the cumulative normal
+(Attewell & Woodman 1982)
+
+    S(u, v) = S_max exp(-u^2 / (2 i^2)) Phi((face - v) / i),
+
+half the trough at the face. The ground moves horizontally towards the tunnel: across it as in 2D
+(O'Reilly & New 1982, ``-u / z0`` times the settlement) and along it, back towards the excavated length,
+
+    u_v = -S_max i / (sqrt(2 pi) z0) exp(-u^2 / (2 i^2)) exp(-(v - face)^2 / (2 i^2))
+
+(Attewell, Yeates & Selby 1986). Both are what point sinks along the excavated tunnel, each with its
+displacements pointing at it, sum to; the tests check that by quadrature.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import NamedTuple
+
+import numpy as np
+from scipy.special import ndtr
+
+from .profiles import Profile, beyond_cutoff
+
+
+class GroundInPlan(NamedTuple):
+    """A 2D ``profile`` across the axis through ``point`` (the unit vector ``across``), and the position of a
+    tunnel's ``face`` along the axis (None: the face has passed long ago, the 2D trough everywhere)."""
+
+    profile: Profile
+    point: np.ndarray  # (2,) [m]
+    across: np.ndarray  # (2,)
+    face: float | None = None
+
+    @property
+    def axis(self) -> np.ndarray:
+        """The direction the tunnel is driven: ``across`` turned a quarter left."""
+        return np.array([-self.across[1], self.across[0]])
+
+    def greenfield(self, xy: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """``(settlement rate, horizontal motion (n, 2))`` of the ground at the points ``xy`` (n, 2) in plan, per
+        unit of the settlement parameter (module docstring)."""
+        u = (xy - self.point) @ self.across
+        rate = self.profile.rate(u)
+        horizontal = self.profile.horizontal(u)[:, None] * self.across
+        if self.face is None:
+            return rate, horizontal
+        v = (xy - self.point) @ self.axis
+        width = self.profile.width
+        behind = ndtr((self.face - v) / width)
+        horizontal = horizontal * behind[:, None]
+        if self.profile.depth is not None and self.profile.sideways:
+            along = -width / (math.sqrt(2.0 * math.pi) * self.profile.depth) * rate * np.exp(
+                -0.5 * ((v - self.face) / width) ** 2)
+            horizontal = horizontal + along[:, None] * self.axis
+        return rate * behind, horizontal
+
+    def motion(self, xy: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """``(down, horizontal (n, 2))``: the greenfield less the profile's cutoff, as the 2D ground's nodes
+        (:func:`masonryfw.profiles.beyond_cutoff`)."""
+        rate, horizontal = self.greenfield(xy)
+        down, share = beyond_cutoff(self.profile, rate)
+        return down, horizontal * share[:, None]
+
+
+@dataclass(frozen=True)
+class SurfaceCut:
+    """The greenfield surface along a wall's base line from ``start`` in the unit direction ``along``: the
+    settlement rate and the horizontal motion along the wall at ``s`` from its start, what the engineers'
+    stages read of a profile (:mod:`masonryfw.assessment`); its inflection points found on the curve."""
+
+    ground: GroundInPlan
+    start: np.ndarray
+    along: np.ndarray
+    kind: str = "cut"
+
+    def _points(self, s) -> np.ndarray:
+        return self.start + np.atleast_1d(np.asarray(s, dtype=float))[:, None] * self.along
+
+    def rate(self, s) -> np.ndarray:
+        return self.ground.greenfield(self._points(s))[0]
+
+    def horizontal(self, s) -> np.ndarray:
+        return self.ground.greenfield(self._points(s))[1] @ self.along
+
+    def inflections(self, a: float, b: float, samples: int) -> list[float]:
+        """Where the settlement's curvature changes sign on ``(a, b)`` (linear between ``samples`` points)."""
+        s = np.linspace(a, b, samples)
+        curvature = np.diff(self.rate(s), 2)
+        curvature[np.abs(curvature) < 1e-12 * np.abs(curvature).max(initial=0.0)] = 0.0
+        change = np.flatnonzero(curvature[:-1] * curvature[1:] < 0)
+        mid = s[1:-1]
+        return [float(mid[k] + (mid[k + 1] - mid[k]) * curvature[k] / (curvature[k] - curvature[k + 1]))
+                for k in change]
