@@ -20,12 +20,14 @@ turns about the horizontal axis across the wall with the slope between them).
 """
 from __future__ import annotations
 
+import itertools
 import json
 import math
 from dataclasses import dataclass, field
 from typing import NamedTuple
 
 import numpy as np
+import shapely
 import xarray as xr
 
 from . import polyhedra
@@ -153,17 +155,19 @@ def read_openings(wall: SpecTable, unit_length: float) -> tuple[tuple[float, flo
 
 class Junctions(NamedTuple):
     """Where walls meet: ``ends[(wall, end)] = (other wall, the wall that runs through in even courses)`` (end 0:
-    its start, 1: its end), and the T-junctions ``tees``: (through wall, abutting wall, the abutting wall's centre
-    line along the through wall's base line)."""
+    its start, 1: its end), and where a wall is cut for another running through it, ``cuts``: (the wall cut, the
+    wall through it, that wall's centre line along the cut wall's base line, the parity of the courses cut)."""
 
     ends: dict[tuple[int, int], tuple[int, int]]
-    tees: list[tuple[int, int, float]]
+    cuts: list[tuple[int, int, float, int]]
 
 
 def junctions(walls: list[Wall], tol: float) -> Junctions:
-    """The corners (two walls' ends at one point) and T-junctions (a wall's end on another's base line between
-    its ends) of ``walls``, each at a right angle; a corner's first-listed wall runs through in even courses, a
-    T's through wall in even and the abutting wall in odd courses. Other meetings are refused, naming the walls."""
+    """The corners (two walls' ends at one point), T-junctions (a wall's end on another's base line between its
+    ends) and crossings (two base lines crossing between their ends) of ``walls``, each at a right angle. A
+    corner's first-listed wall runs through in even courses; a T's through wall in even courses and the
+    abutting wall in odd ones; at a crossing the first-listed wall in even courses and the other in odd ones.
+    Other meetings are refused, naming the walls."""
     ends = [(w, e, (wall.start, wall.end)[e]) for w, wall in enumerate(walls) for e in (0, 1)]
     meets: dict[tuple[int, int], tuple[int, int]] = {}
     for a, (wa, ea, pa) in enumerate(ends):
@@ -174,7 +178,7 @@ def junctions(walls: list[Wall], tol: float) -> Junctions:
                                     f"({pa[0]:.6g}, {pa[1]:.6g}); corners of two walls only so far")
                 square(walls, wa, wb)
                 meets[(wa, ea)], meets[(wb, eb)] = (wb, min(wa, wb)), (wa, min(wa, wb))
-    tees = []
+    cuts = []
     for w, wall in enumerate(walls):
         for e, point in ((0, wall.start), (1, wall.end)):
             if (w, e) in meets:
@@ -184,8 +188,25 @@ def junctions(walls: list[Wall], tol: float) -> Junctions:
                 if v != w and abs(float((point - other.start) @ other.across)) <= tol and 0 < offset < other.length:
                     square(walls, w, v)
                     meets[(w, e)] = (v, v)
-                    tees.append((v, w, offset))
-    return Junctions(meets, tees)
+                    cuts.append((v, w, offset, 1))
+    for first, second in itertools.combinations(range(len(walls)), 2):
+        crossing = base_lines_cross(walls[first], walls[second], tol)
+        if crossing is not None:
+            square(walls, first, second)
+            cuts += [(first, second, crossing[0], 1), (second, first, crossing[1], 0)]
+    return Junctions(meets, cuts)
+
+
+def base_lines_cross(a: Wall, b: Wall, tol: float) -> tuple[float, float] | None:
+    """Where the base lines of ``a`` and ``b`` cross between the ends of both (further than ``tol`` from every
+    end): the distances along each from its start; None if they do not."""
+    matrix = np.c_[a.along, -b.along]
+    if abs(np.linalg.det(matrix)) < 1e-12:
+        return None
+    s, r = np.linalg.solve(matrix, b.start - a.start)
+    if tol < s < a.length - tol and tol < r < b.length - tol:
+        return float(s), float(r)
+    return None
 
 
 def square(walls: list[Wall], a: int, b: int) -> None:
@@ -211,13 +232,15 @@ def course_extent(walls: list[Wall], joins: Junctions, courses: list[int], w: in
     return extent[0], extent[1]
 
 
-def tee_gaps(walls: list[Wall], joins: Junctions, courses: list[int], v: int) -> dict[int, list[tuple[float, float]]]:
-    """``{course: [(s0, s1)]}``: where an abutting wall runs through the through wall ``v`` (odd courses)."""
+def junction_gaps(walls: list[Wall], joins: Junctions, courses: list[int], v: int
+                  ) -> dict[int, list[tuple[float, float]]]:
+    """``{course: [(s0, s1)]}``: where another wall runs through wall ``v`` (a T's abutting wall in odd courses,
+    a crossing wall in the courses it runs through)."""
     gaps: dict[int, list[tuple[float, float]]] = {}
-    for through, w, offset in joins.tees:
-        if through == v:
+    for cut, w, offset, parity in joins.cuts:
+        if cut == v:
             half = 0.5 * walls[w].thickness
-            for k in range(1, min(courses[v], courses[w]), 2):
+            for k in range(parity, min(courses[v], courses[w]), 2):
                 gaps.setdefault(k, []).append((offset - half, offset + half))
     return gaps
 
@@ -297,7 +320,7 @@ def lay_masonry(walls: list[Wall], joins: Junctions, unit_length: float, unit_he
     courses = [round(wall.height / unit_height) for wall in walls]
     laid = Laid()
     for w, wall in enumerate(walls):
-        gaps = tee_gaps(walls, joins, courses, w)  # course: the ranges left open (by openings, by abutting walls)
+        gaps = junction_gaps(walls, joins, courses, w)  # course: the ranges left open (by openings, other walls)
         lintels: dict[int, list[tuple[float, float]]] = {}  # course: the ranges of the lintels
         for number, (x, y, width, height, bearing) in enumerate(wall.openings):
             k0, k1 = round(y / unit_height), round((y + height) / unit_height)
@@ -334,6 +357,40 @@ def lay_masonry(walls: list[Wall], joins: Junctions, unit_length: float, unit_he
             for s in lintels.get(k, []):
                 laid.add(w, s, (-half, half), z, ROLE["lintel"])
     return laid
+
+
+def plan_corners(walls: list[Wall], laid: Laid) -> np.ndarray:
+    """``(box, 4, 2)``: every laid box's corners in plan, anticlockwise."""
+    w = np.asarray(laid.wall)
+    start = np.array([wall.start for wall in walls])[w]
+    along = np.array([wall.along for wall in walls])[w]
+    across = np.array([wall.across for wall in walls])[w]
+    s = np.c_[laid.s0, laid.s1, laid.s1, laid.s0]
+    q = np.c_[laid.q0, laid.q0, laid.q1, laid.q1]
+    return start[:, None] + s[..., None] * along[:, None] + q[..., None] * across[:, None]
+
+
+def refuse_overlaps(walls: list[Wall], laid: Laid, unit_length: float) -> None:
+    """Refuse walls laid into one another (parallel walls closer than their half thicknesses, a wall ending inside
+    another short of its base line): two boxes of one course whose plans share an area, the walls and the place
+    named."""
+    corners = plan_corners(walls, laid)
+    level = np.round(np.asarray(laid.z0) / unit_length, 6)
+    for z in np.unique(level):
+        boxes = np.flatnonzero(level == z)
+        polygons = shapely.polygons(corners[boxes])
+        pairs = shapely.STRtree(polygons).query(polygons, predicate="intersects")
+        pairs = pairs[:, pairs[0] < pairs[1]]
+        if not pairs.shape[1]:
+            continue
+        common = shapely.area(shapely.intersection(polygons[pairs[0]], polygons[pairs[1]]))
+        worst = int(np.argmax(common))
+        if common[worst] > 1e-9 * unit_length**2:
+            a, b = boxes[pairs[:, worst]]
+            x, y = shapely.centroid(shapely.intersection(polygons[pairs[0, worst]], polygons[pairs[1, worst]])).coords[0]
+            raise SpecError(f"walls {walls[laid.wall[a]].name!r} and {walls[laid.wall[b]].name!r} are laid into one "
+                            f"another at ({x:.6g}, {y:.6g}), {laid.z0[a]:.4g} m up ({common[worst]:.3g} m2 in plan): "
+                            "walls meet at their ends or on another's base line, or keep clear of each other")
 
 
 def oriented_boxes(walls: list[Wall], laid: Laid) -> polyhedra.Polyhedra:
@@ -418,14 +475,15 @@ def build_building(spec: dict, text: str) -> xr.Dataset:
     add_floors(building, walls, laid, unit_height)
     courses = [round(w.height / unit_height) for w in walls]
     n_masonry = len(laid.wall)
-    ground: list[tuple[int, float, float]] = []
-    for w, _wall in enumerate(walls):
+    for w, wall in enumerate(walls):  # the ground under the first course, less where a crossing wall's ground is
+        half = 0.5 * wall.thickness
         a, b = course_extent(walls, joins, courses, w, 0)
-        cuts = np.linspace(a, b, max(1, round((b - a) / segment)) + 1)
-        ground += [(w, p, q) for p, q in zip(cuts[:-1], cuts[1:])]
-    for w, p, q in ground:
-        half = 0.5 * walls[w].thickness
-        laid.add(w, (p, q), (-half, half), (-depth, 0.0), ROLE["fixed_support"])
+        crossed = sorted(junction_gaps(walls, joins, courses, w).get(0, []))
+        for p, q in zip([a] + [end for _, end in crossed], [start for start, _ in crossed] + [b]):
+            cuts = np.linspace(p, q, max(1, round((q - p) / segment)) + 1)
+            for s0, s1 in zip(cuts[:-1], cuts[1:]):
+                laid.add(w, (s0, s1), (-half, half), (-depth, 0.0), ROLE["fixed_support"])
+    refuse_overlaps(walls, laid, unit_length)
     poly = oriented_boxes(walls, laid)
     volume, _ = polyhedra.volumes_centroids(poly)
     contacts = polyhedra.find_contacts(poly, tol)

@@ -242,3 +242,43 @@ def test_the_house_in_millimetres_is_the_house_in_metres():
     assert b.sizes["block"] == a.sizes["block"]
     assert float(b.collapse_multiplier) == pytest.approx(float(a.collapse_multiplier), rel=1e-9)
     assert float(b.moving_support_reaction) == pytest.approx(float(a.moving_support_reaction), rel=1e-9)
+
+
+def test_crossing_walls_are_toothed_into_each_other():
+    """Two inner walls crossing between their ends (an X): the masonry fills the walls' footprint in plan (the
+    crossing square once) times their height, no two blocks (nor ground segments) overlap, and the block in
+    the crossing's square is the first-listed wall's in even courses and the other's in odd ones."""
+    spec = house_spec()
+    spec["building"]["walls"] += [wall("a", (1.2, 0.6), (1.2, 1.5)), wall("b", (0.6, 1.0), (1.8, 1.0))]
+    model = mf.build(spec)
+    masonry = mfp.masonry_blocks(model.block_role.values)
+    t = 0.12
+    expected = (2 * t * (2.4 + 1.8) + t * (0.9 + 1.2 - t)) * 1.2 - t * (0.48 * 0.72 + 0.48 * 0.36)
+    assert model.block_volume.values[masonry].sum() == pytest.approx(expected, rel=1e-12)
+    low, high = box_bounds(model)
+    common = np.clip(np.minimum(high[:, None], high[None]) - np.maximum(low[:, None], low[None]), 0, None).prod(-1)
+    np.fill_diagonal(common, 0.0)
+    assert common.max() < 1e-12
+    eps = 1e-9
+    in_a = (low[:, 0] >= 1.14 - eps) & (high[:, 0] <= 1.26 + eps)  # within wall a's strip (along y at x = 1.2)
+    in_b = (low[:, 1] >= 0.94 - eps) & (high[:, 1] <= 1.06 + eps)  # within wall b's (along x at y = 1.0)
+    for course in range(10):
+        for point in ((1.17, 0.97), (1.23, 1.03)):
+            covering = (masonry & (low[:, 0] < point[0]) & (high[:, 0] > point[0]) & (low[:, 1] < point[1])
+                        & (high[:, 1] > point[1]) & (low[:, 2] < (course + 0.5) * 0.12) & (high[:, 2] > (course + 0.5) * 0.12))
+            block = int(np.flatnonzero(covering)[0])
+            assert covering.sum() == 1 and in_a[block] != in_b[block]
+            assert in_a[block] == (course % 2 == 0), (course, point)
+    assert 0 < float(mf.solve(model, "la").collapse_multiplier) < 1
+
+
+@pytest.mark.parametrize("extra, message", [
+    (wall("twin", (0.0, 0.1), (2.4, 0.1)), "walls 'south' and 'twin' are laid into one another at"),
+    (wall("short", (1.2, 1.77), (1.2, 0.9)), "walls 'north' and 'short' are laid into one another at"),
+])
+def test_walls_laid_into_one_another_are_refused_with_the_place(extra, message):
+    """A wall 0.1 m beside another 0.12 m thick, a wall ending 0.03 m short of another's base line (inside it)."""
+    spec = house_spec()
+    spec["building"]["walls"].append(extra)
+    with pytest.raises(mf.SpecError, match=message):
+        mf.build(spec)
