@@ -38,6 +38,7 @@ import numpy as np
 
 from .geometry import block_bounds
 from .ground_plan import GroundInPlan, SurfaceCut
+from .model3d import space
 from .profiles import Profile, model_profile
 from .roles import masonry_blocks, support_blocks
 from .schema import variable_attrs
@@ -193,12 +194,15 @@ class Assessment:
 
 def assess(model: xr.Dataset, settlement: float) -> Assessment | None:
     """Stages 1 and 2 of ``model``'s wall over its greenfield profile (``mf.model_profile``) at ``settlement``;
-    None for a model built without a profile."""
+    None for a model built without a profile, and for a 3D model that is not a building (a drawing's blocks do
+    not say which walls to assess)."""
     profile = model_profile(model)
     if profile is None:
         return None
     if "building_walls" in model.attrs:
         return assess_building(model, profile, settlement)
+    if space(model) == 3:
+        return None
     x_a, x_b, height = wall_extent(model)
     slope, settled = greenfield_screen(profile, x_a, x_b)
     return Assessment(settlement, abs(settlement) * slope, abs(settlement) * settled,

@@ -43,6 +43,7 @@ import numpy as np
 
 from . import blocks
 from .building import build_building, is_building
+from .drawing3d import build_drawn_3d, is_drawn_3d, mesh_path
 from .errors import SpecError
 from .imported import build_drawn, is_drawn, parse_drawn_spec, resolved_drawing
 from .inputs import fits_in_memory
@@ -106,6 +107,10 @@ def load_wall(path_or_text) -> dict:
 def _validated(spec: dict, base_dir) -> dict:
     if is_building(spec):  # checked as it is laid (masonryfw.building)
         build_building(spec, "")
+        return spec
+    if is_drawn_3d(spec):  # checked as it is read; its mesh found from the spec's folder
+        spec = {**spec, "geometry": {**spec["geometry"], "mesh": str(mesh_path(spec, base_dir).resolve())}}
+        build_drawn_3d(spec, "", None)
         return spec
     if is_outlined(spec):  # checked as it is laid (masonryfw.outlined); its drawing found from the spec's folder
         geometry = spec.get("geometry", {})
@@ -420,8 +425,8 @@ def build(spec, *, validate: bool = True) -> xr.Dataset:
     space = spec_dict.get("space", 2)
     if space not in (2, 3) or isinstance(space, bool):
         raise SpecError(f"space: must be 2 (the wall in its plane) or 3 (the wall one block thick in 3D), not {space!r}")
-    if is_building(spec_dict):
-        model = build_building(spec_dict, text)
+    if is_building(spec_dict) or is_drawn_3d(spec_dict):
+        model = build_building(spec_dict, text) if is_building(spec_dict) else build_drawn_3d(spec_dict, text, base_dir)
         warn_implausible(model)
         return checked_model(model, repr(model.attrs["title"])) if validate else model
     if is_outlined(spec_dict):

@@ -33,9 +33,9 @@ import xarray as xr
 from . import polyhedra
 from .bond import pattern_cells
 from .errors import SpecError
-from .ground_plan import GroundInPlan
-from .model3d import model_from_polyhedra
-from .profiles import SETTLEMENT_KEYS, read_profile, with_profile
+from .ground_plan import SETTLEMENT_3D_KEYS, GroundInPlan, profile_in_plan
+from .on_ground import model_on_ground
+from .profiles import with_profile
 from .roles import ROLE
 from .spec import LENGTH_UNITS, SpecTable, read_material
 
@@ -44,13 +44,9 @@ WALL_KEYS = ("name", "start", "end", "height", "thickness", "openings", "bond", 
 BONDS = ("running", "english", "flemish")
 OPENING_KEYS = ("x", "y", "width", "height", "lintel_bearing")
 FLOOR_KEYS = ("walls", "height", "load")
-#: A 3D profile's keys: the 2D ones, its axis in plan through a point instead of ``center``.
-SETTLEMENT_3D_KEYS = tuple(k for k in SETTLEMENT_KEYS if k != "center") + ("axis_angle", "center_x", "center_y",
-                                                                             "face")
 TOP_KEYS = ("title", "description", "space", "length_unit", "building", "material", "settlement")
 #: A piece of a unit shorter than this share of the unit length joins its neighbour.
 SLIVER = 0.25
-KIND = {"bed": 0, "head": 1, "support": 2, "other": 3}
 
 
 @dataclass(frozen=True)
@@ -413,23 +409,6 @@ def oriented_boxes(walls: list[Wall], laid: Laid) -> polyhedra.Polyhedra:
                                np.tile(template.face_nodes, n))
 
 
-def profile_in_plan(table: SpecTable, unit_length: float) -> GroundInPlan:
-    """The ``[settlement]`` profile over the coordinate across its axis in plan: ``axis_angle`` degrees from x (90:
-    the axis along y, the profile along x) through (``center_x``, ``center_y``); a trough's tunnel ``face`` along
-    the axis from that point, driven towards ``axis_angle`` (:mod:`masonryfw.ground_plan`)."""
-    angle = math.radians(table.number("axis_angle", 90.0))
-    point = np.array([table.number("center_x", 0.0, length=True), table.number("center_y", 0.0, length=True)])
-    plain = {k: v for k, v in table.table.items() if k not in ("axis_angle", "center_x", "center_y", "face")}
-    if plain.get("profile") in ("gaussian", "tunnel"):
-        plain["center"] = 0.0
-    elif table.has("face"):
-        raise SpecError(f"spec key {table.key('face')!r}: a tunnel's face bounds a trough; profile = "
-                        f"{plain.get('profile')!r} has none (use 'tunnel' or 'gaussian')")
-    profile = read_profile(SpecTable(plain, table.path, SETTLEMENT_KEYS, table.scale), 0.0, 1.0, unit_length)
-    face = table.number("face", length=True) if table.has("face") else None
-    return GroundInPlan(profile, point, np.array([math.sin(angle), -math.cos(angle)]), face)
-
-
 def segment_motion(ground: GroundInPlan, ends: np.ndarray, along: np.ndarray, across: np.ndarray, depth: float
                    ) -> np.ndarray:
     """``(segment, 6)``: a ground segment's motion per unit t at its centroid, ``depth`` below the middle of its top
@@ -485,19 +464,15 @@ def build_building(spec: dict, text: str) -> xr.Dataset:
                 laid.add(w, (s0, s1), (-half, half), (-depth, 0.0), ROLE["fixed_support"])
     refuse_overlaps(walls, laid, unit_length)
     poly = oriented_boxes(walls, laid)
-    volume, _ = polyhedra.volumes_centroids(poly)
-    contacts = polyhedra.find_contacts(poly, tol)
     attrs = {"title": top.text("title"), "source_spec": text,
              "building_walls": json.dumps([{"name": w.name, "start": w.start.tolist(), "end": w.end.tolist(),
                                             "height": w.height, "thickness": w.thickness,
                                             "ground": list(course_extent(walls, joins, courses, k, 0))}
                                            for k, w in enumerate(walls)]),
-             "settlement_axis": json.dumps({"point": ground_plan.point.tolist(),
-                                            "direction": ground_plan.across.tolist(),
-                                            **({} if ground_plan.face is None else {"face": ground_plan.face})}),
+             "settlement_axis": ground_plan.axis_attr(),
              **({"laying_notes": "\n".join(notes)} if notes else {}),
              **({"comment": top.text("description")} if top.has("description") else {})}
-    model = _dataset(walls, laid, n_masonry, poly, volume, contacts, material, ground_plan, depth, attrs)
+    model = _dataset(walls, laid, n_masonry, poly, material, ground_plan, depth, attrs, tol)
     return with_profile(model, profile)
 
 
@@ -523,47 +498,16 @@ def add_floors(building: SpecTable, walls: list[Wall], laid: Laid, unit_height: 
                             f"{', '.join(on)} ends there")
 
 
-def _dataset(walls, laid, n_masonry, poly, volume, contacts, material, ground_plan, depth, attrs) -> xr.Dataset:
-    n = len(laid.wall)
-    role = np.array(laid.role, dtype=np.int8)
-    weight = np.where(np.arange(n) < n_masonry, material.unit_weight * volume, 0.0) + np.array(laid.load)
-    wall = np.array(laid.wall)
+def _dataset(walls, laid, n_masonry, poly, material, ground_plan, depth, attrs, tol) -> xr.Dataset:
+    volume, _ = polyhedra.volumes_centroids(poly)
+    weight = material.unit_weight * volume[:n_masonry] + np.array(laid.load[:n_masonry])
+    wall = np.array(laid.wall[n_masonry:])
     starts = np.array([w.start for w in walls])[wall]
     along = np.array([w.along for w in walls])[wall]
     across = np.array([w.across for w in walls])[wall]
-    ends = starts[:, None, :] + np.stack([np.array(laid.s0), np.array(laid.s1)], axis=1)[..., None] * along[:, None, :]
-    ground = np.arange(n) >= n_masonry
-    motion = np.zeros((n, 6))
-    motion[ground] = segment_motion(ground_plan, ends[ground], along[ground], across[ground], depth)
-    moving = ground & (np.abs(motion).max(axis=1) > 0)
-    if not moving.any():
-        raise SpecError(f"spec table 'settlement': the ground settles at most {ground_plan.profile.cutoff:g} (the "
-                        "cutoff) times "
-                        "S_max under every segment of every wall: nothing settles under the building (move the "
-                        "profile's axis under it, center_x and center_y, or lower the cutoff)")
-    role[moving] = ROLE["moving_support"]
-    motion[~moving] = 0.0
-    footprint = (np.array(laid.s1) - np.array(laid.s0)) * np.array([w.thickness for w in walls])[wall]
-    share = weight[:n_masonry].sum() * footprint / footprint[ground].sum()
-    dead = np.zeros((n, 3))
-    live = np.zeros((n, 3))
-    dead[:, 2] = -weight
-    dead[moving, 2] = share[moving]  # the paper's convention: up the weight it carries uniformly, the same down live
-    live[moving, 2] = -share[moving]
-    fixed = np.zeros((n, 6), dtype=np.int8)
-    fixed[ground & ~moving] = 1
-    normal_z = np.abs(contacts.normal[:, 2])
-    support = ground[contacts.sides].any(axis=1)
-    kind = np.where(support, KIND["support"], np.where(normal_z > 0.5, KIND["bed"], KIND["head"])).astype(np.int8)
-    m = contacts.n_interface
-    arrays = {"block_role": role, "block_unit_weight": np.where(ground, 0.0, material.unit_weight),
-              "interface_kind": kind, "interface_friction": np.full(m, material.friction),
-              "interface_cohesion": np.full(m, material.cohesion),
-              "interface_tensile_strength": np.full(m, material.tensile_strength),
-              "dead_load": dead, "dead_moment": np.zeros((n, 3)), "live_load": live, "live_moment": np.zeros((n, 3)),
-              "block_fixed": fixed, "settlement_direction": motion}
-    for name in ("young_modulus", "poisson_ratio"):
-        value = getattr(material, name)
-        if value is not None:
-            arrays[f"block_{name}"] = np.full(n, value)
-    return model_from_polyhedra(poly, contacts, arrays, attrs)
+    s = np.c_[laid.s0[n_masonry:], laid.s1[n_masonry:]]
+    ends = starts[:, None, :] + s[..., None] * along[:, None, :]
+    motion = segment_motion(ground_plan, ends, along, across, depth)
+    footprint = (s[:, 1] - s[:, 0]) * np.array([w.thickness for w in walls])[wall]
+    return model_on_ground(poly, np.array(laid.role[:n_masonry]), weight, motion, footprint, material, attrs, tol,
+                           "segment of every wall")

@@ -18,6 +18,7 @@ displacements pointing at it, sum to; the tests check that by quadrature.
 """
 from __future__ import annotations
 
+import json
 import math
 from dataclasses import dataclass
 from typing import NamedTuple
@@ -25,7 +26,13 @@ from typing import NamedTuple
 import numpy as np
 from scipy.special import ndtr
 
-from .profiles import Profile, beyond_cutoff
+from .errors import SpecError
+from .profiles import SETTLEMENT_KEYS, Profile, beyond_cutoff, read_profile
+from .spec import SpecTable
+
+#: A 3D profile's keys: the 2D ones, its axis in plan through a point instead of ``center``, a tunnel's face.
+SETTLEMENT_3D_KEYS = tuple(k for k in SETTLEMENT_KEYS if k != "center") + ("axis_angle", "center_x", "center_y",
+                                                                             "face")
 
 
 class GroundInPlan(NamedTuple):
@@ -41,6 +48,12 @@ class GroundInPlan(NamedTuple):
     def axis(self) -> np.ndarray:
         """The direction the tunnel is driven: ``across`` turned a quarter left."""
         return np.array([-self.across[1], self.across[0]])
+
+    def axis_attr(self) -> str:
+        """The model's ``settlement_axis`` attribute (docs/format.md): JSON of the point, the direction across the
+        axis and the face, if any."""
+        return json.dumps({"point": self.point.tolist(), "direction": self.across.tolist(),
+                           **({} if self.face is None else {"face": self.face})})
 
     def greenfield(self, xy: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """``(settlement rate, horizontal motion (n, 2))`` of the ground at the points ``xy`` (n, 2) in plan, per
@@ -66,6 +79,23 @@ class GroundInPlan(NamedTuple):
         rate, horizontal = self.greenfield(xy)
         down, share = beyond_cutoff(self.profile, rate)
         return down, horizontal * share[:, None]
+
+
+def profile_in_plan(table: SpecTable, unit_length: float) -> GroundInPlan:
+    """The ``[settlement]`` profile over the coordinate across its axis in plan: ``axis_angle`` degrees from x (90:
+    the axis along y, the profile along x) through (``center_x``, ``center_y``); a trough's tunnel ``face`` along
+    the axis from that point, driven towards ``axis_angle`` (:mod:`masonryfw.ground_plan`)."""
+    angle = math.radians(table.number("axis_angle", 90.0))
+    point = np.array([table.number("center_x", 0.0, length=True), table.number("center_y", 0.0, length=True)])
+    plain = {k: v for k, v in table.table.items() if k not in ("axis_angle", "center_x", "center_y", "face")}
+    if plain.get("profile") in ("gaussian", "tunnel"):
+        plain["center"] = 0.0
+    elif table.has("face"):
+        raise SpecError(f"spec key {table.key('face')!r}: a tunnel's face bounds a trough; profile = "
+                        f"{plain.get('profile')!r} has none (use 'tunnel' or 'gaussian')")
+    profile = read_profile(SpecTable(plain, table.path, SETTLEMENT_KEYS, table.scale), 0.0, 1.0, unit_length)
+    face = table.number("face", length=True) if table.has("face") else None
+    return GroundInPlan(profile, point, np.array([math.sin(angle), -math.cos(angle)]), face)
 
 
 @dataclass(frozen=True)

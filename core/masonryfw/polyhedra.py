@@ -101,6 +101,31 @@ def prisms(node_x: np.ndarray, node_y: np.ndarray, block_node_count: np.ndarray,
     return Polyhedra(vertices, 2 * counts, counts + 2, face_counts, per_block[order].astype(np.int64))
 
 
+def vertical_prisms(node_x: np.ndarray, node_y: np.ndarray, block_node_count: np.ndarray, bottom: np.ndarray,
+                    top: np.ndarray) -> Polyhedra:
+    """Polygons in plan (counter-clockwise seen from above) extruded from ``bottom`` to ``top`` (per block): the
+    planar :func:`prisms` turned a quarter about x, which keeps every face outward."""
+    bottom, top = np.asarray(bottom, dtype=float), np.asarray(top, dtype=float)
+    stood = prisms(node_x, node_y, block_node_count, top - bottom)
+    middle = np.repeat(0.5 * (bottom + top), 2 * np.asarray(block_node_count, dtype=np.int64))
+    x, y, z = stood.vertices.T
+    return stood._replace(vertices=np.c_[x, z, middle - y])
+
+
+def joined(*parts: Polyhedra) -> Polyhedra:
+    """The blocks of ``parts`` one after another."""
+    return Polyhedra(*(np.concatenate([getattr(part, name) for part in parts]) for name in Polyhedra._fields))
+
+
+def subset(blocks: Polyhedra, keep: np.ndarray) -> Polyhedra:
+    """The blocks where the mask ``keep`` is true, in their order."""
+    keep = np.asarray(keep, dtype=bool)
+    faces = np.repeat(keep, blocks.block_face_count)
+    return Polyhedra(blocks.vertices[np.repeat(keep, blocks.block_node_count)], blocks.block_node_count[keep],
+                     blocks.block_face_count[keep], blocks.face_node_count[faces],
+                     blocks.face_nodes[np.repeat(faces, blocks.face_node_count)])
+
+
 def polygon_normals(points: np.ndarray, count: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Unit normals (counter-clockwise vertices: right-handed) and areas of ragged planar polygons."""
     if count.size == 0:

@@ -201,3 +201,17 @@ def test_each_broken_model_differs_from_a_valid_one_by_its_break_alone(make_mode
         problems = mf.check(breaker(make_model()))
         assert problems, case
         assert any(__import__("re").search(message, str(p)) for p in problems), (case, [str(p) for p in problems])
+
+
+def test_an_open_mesh_fails_build_naming_its_block_and_line_and_the_mesh_is_unchanged(tmp_path):
+    mesh = tmp_path / "box.obj"
+    mesh.write_text("o box\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n"
+                    "f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\n")
+    spec = tmp_path / "box.toml"
+    spec.write_text('title = "box"\n[geometry]\nmesh = "box.obj"\n[material]\nunit_weight = 20000.0\n'
+                    'friction_angle = 30.0\n[settlement]\nprofile = "gaussian"\nwidth = 1.0\n')
+    digests = _sha(spec), _sha(mesh)
+    result = CliRunner().invoke(cli, ["build", str(spec), "-o", str(tmp_path / "box.nc")])
+    _assert_clean_failure(result, r"block 'box' \(line 10\): not a closed solid: the edge from \(0, 0, 0\) to "
+                                  r"\(0, 1, 0\)", spec, digests[0])
+    assert _sha(mesh) == digests[1] and not (tmp_path / "box.nc").exists()

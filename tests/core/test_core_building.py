@@ -154,7 +154,7 @@ def test_a_wall_along_y_is_the_wall_along_x_turned():
      "wall 'south': two openings \\(or an opening and a lintel over another\\) overlap in course 6"),
     (lambda s: s.pop("settlement"), "spec table 'settlement' is missing"),
     (lambda s: s.update(space=2), "a \\[building\\] is 3D"),
-    (lambda s: s["settlement"].update(center_x=400.0), "nothing settles under the building"),
+    (lambda s: s["settlement"].update(center_x=400.0), "nothing settles under it"),
     (lambda s: s["building"]["walls"][0].update(colour="red"), "unknown spec key 'building.walls\\[0\\].colour'"),
 ])
 def test_a_bad_building_spec_names_the_key_or_the_walls(change, message):
