@@ -8,10 +8,13 @@ thickness unless given: one leaf); a wall is a whole number of leaves. The bond 
 shifted by half a unit, every leaf alike and unbound but by its collar joints), English (a course of headers
 through the wall's thickness every ``header_every`` courses, 2 by default, the courses between in running bond)
 or Flemish (stretcher and header alternating in every course, each header centred on the stretcher below),
-the patterns of the 2D walls (:func:`masonryfw.bond.pattern_cells`) with the unit's depth as the header. Where two walls meet end to end at a right angle, the
-corner is toothed: in even courses the wall listed first runs through the corner to the other's outer face
-and the other stops at its inner face; in odd courses the other way round. A wall ending on another's base
-line (a T) stops at its face in even courses and runs through it in odd ones. An opening takes its courses
+the patterns of the 2D walls (:func:`masonryfw.bond.pattern_cells`) with the unit's depth as the header.
+Where two walls meet end to end, at any angle of :data:`MIN_ANGLE` or more, the corner is toothed: in even
+courses the wall listed first runs through the corner to the other's outer face and the other stops at its
+inner face; in odd courses the other way round. A wall ending on another's base line (a T) stops at its face
+in even courses and runs through it in odd ones; two walls crossing run through in turn. Where a wall meets
+another at an angle its end follows the other's face: the end blocks are prisms with a slanted end
+(:class:`Cut`), the rest boxes. An opening takes its courses
 (its sill and head moved onto the nearest bed joints, said in ``laying_notes``) and a lintel one course high
 bears ``lintel_bearing`` into the masonry on either side. Floors are line loads [N/m] on the course at their
 height. Every wall stands on support blocks ``support_depth`` deep, cut into segments ``segment`` long under
@@ -47,6 +50,8 @@ FLOOR_KEYS = ("walls", "height", "load")
 TOP_KEYS = ("title", "description", "space", "length_unit", "building", "material", "settlement")
 #: A piece of a unit shorter than this share of the unit length joins its neighbour.
 SLIVER = 0.25
+#: Walls meeting at less than this angle [degrees] are refused: a slanted end would run far along the wall.
+MIN_ANGLE = 30.0
 
 
 @dataclass(frozen=True)
@@ -149,19 +154,35 @@ def read_openings(wall: SpecTable, unit_length: float) -> tuple[tuple[float, flo
     return tuple(openings)
 
 
+class Cut(NamedTuple):
+    """A vertical plane across a wall, in the wall's frame: ``s = at + slope * q`` along its base line at ``q``
+    across it. A free end, a head joint or an opening's side is square to the wall (slope 0); where it meets
+    another wall at an angle, the other wall's face is slanted."""
+
+    at: float
+    slope: float = 0.0
+
+    def at_face(self, q: float) -> float:
+        return self.at + self.slope * q
+
+    def span(self, half: float) -> tuple[float, float]:
+        """Its least and greatest ``s`` over a wall ``2 half`` thick."""
+        return self.at - abs(self.slope) * half, self.at + abs(self.slope) * half
+
+
 class Junctions(NamedTuple):
     """Where walls meet: ``ends[(wall, end)] = (other wall, the wall that runs through in even courses)`` (end 0:
     its start, 1: its end), and where a wall is cut for another running through it, ``cuts``: (the wall cut, the
-    wall through it, that wall's centre line along the cut wall's base line, the parity of the courses cut)."""
+    wall through it, the parity of the courses cut)."""
 
     ends: dict[tuple[int, int], tuple[int, int]]
-    cuts: list[tuple[int, int, float, int]]
+    cuts: list[tuple[int, int, int]]
 
 
 def junctions(walls: list[Wall], tol: float) -> Junctions:
     """The corners (two walls' ends at one point), T-junctions (a wall's end on another's base line between its
-    ends) and crossings (two base lines crossing between their ends) of ``walls``, each at a right angle. A
-    corner's first-listed wall runs through in even courses; a T's through wall in even courses and the
+    ends) and crossings (two base lines crossing between their ends) of ``walls``, each at :data:`MIN_ANGLE` or
+    more. A corner's first-listed wall runs through in even courses; a T's through wall in even courses and the
     abutting wall in odd ones; at a crossing the first-listed wall in even courses and the other in odd ones.
     Other meetings are refused, naming the walls."""
     ends = [(w, e, (wall.start, wall.end)[e]) for w, wall in enumerate(walls) for e in (0, 1)]
@@ -172,7 +193,7 @@ def junctions(walls: list[Wall], tol: float) -> Junctions:
                 if (wa, ea) in meets or (wb, eb) in meets:
                     raise SpecError(f"walls {walls[wa].name!r} and {walls[wb].name!r}: more than two walls meet at "
                                     f"({pa[0]:.6g}, {pa[1]:.6g}); corners of two walls only so far")
-                square(walls, wa, wb)
+                steep_enough(walls, wa, wb)
                 meets[(wa, ea)], meets[(wb, eb)] = (wb, min(wa, wb)), (wa, min(wa, wb))
     cuts = []
     for w, wall in enumerate(walls):
@@ -182,62 +203,69 @@ def junctions(walls: list[Wall], tol: float) -> Junctions:
             for v, other in enumerate(walls):
                 offset = float((point - other.start) @ other.along)
                 if v != w and abs(float((point - other.start) @ other.across)) <= tol and 0 < offset < other.length:
-                    square(walls, w, v)
+                    steep_enough(walls, w, v)
                     meets[(w, e)] = (v, v)
-                    cuts.append((v, w, offset, 1))
+                    cuts.append((v, w, 1))
     for first, second in itertools.combinations(range(len(walls)), 2):
         crossing = base_lines_cross(walls[first], walls[second], tol)
-        if crossing is not None:
-            square(walls, first, second)
-            cuts += [(first, second, crossing[0], 1), (second, first, crossing[1], 0)]
+        if crossing:
+            steep_enough(walls, first, second)
+            cuts += [(first, second, 1), (second, first, 0)]
     return Junctions(meets, cuts)
 
 
-def base_lines_cross(a: Wall, b: Wall, tol: float) -> tuple[float, float] | None:
-    """Where the base lines of ``a`` and ``b`` cross between the ends of both (further than ``tol`` from every
-    end): the distances along each from its start; None if they do not."""
+def base_lines_cross(a: Wall, b: Wall, tol: float) -> bool:
+    """Whether the base lines of ``a`` and ``b`` cross between the ends of both (further than ``tol`` from every
+    end)."""
     matrix = np.c_[a.along, -b.along]
     if abs(np.linalg.det(matrix)) < 1e-12:
-        return None
+        return False
     s, r = np.linalg.solve(matrix, b.start - a.start)
-    if tol < s < a.length - tol and tol < r < b.length - tol:
-        return float(s), float(r)
-    return None
+    return bool(tol < s < a.length - tol and tol < r < b.length - tol)
 
 
-def square(walls: list[Wall], a: int, b: int) -> None:
-    """Refuse two meeting walls that are not at a right angle."""
-    cosine = abs(float(walls[a].along @ walls[b].along))
-    if cosine > 1e-6:
+def steep_enough(walls: list[Wall], a: int, b: int) -> None:
+    """Refuse two meeting walls at less than :data:`MIN_ANGLE` to each other."""
+    sine = abs(float(walls[a].along @ walls[b].across))
+    if sine < math.sin(math.radians(MIN_ANGLE)):
         raise SpecError(f"walls {walls[a].name!r} and {walls[b].name!r} meet at "
-                        f"{math.degrees(math.acos(min(cosine, 1.0))):.4g} degrees: only right angles are toothed so far")
+                        f"{math.degrees(math.asin(min(sine, 1.0))):.4g} degrees: walls are toothed at {MIN_ANGLE:g} "
+                        "degrees or more")
 
 
-def course_extent(walls: list[Wall], joins: Junctions, courses: list[int], w: int, course: int) -> tuple[float, float]:
-    """The wall's extent along its base line in ``course``: through a junction it runs through in this course
-    (to the other wall's far face), short of one it does not (to the other's near face); its end where it is
-    free (or the other wall has no such course)."""
+def face_cut(wall: Wall, other: Wall, side: float) -> Cut:
+    """Where ``other``'s face on ``side`` (+1: its left, -1: its right) crosses ``wall``, in ``wall``'s frame."""
+    along, across = float(wall.along @ other.across), float(wall.across @ other.across)
+    return Cut((0.5 * side * other.thickness - float((wall.start - other.start) @ other.across)) / along,
+               -across / along)
+
+
+def course_extent(walls: list[Wall], joins: Junctions, courses: list[int], w: int, course: int) -> tuple[Cut, Cut]:
+    """The wall's ends in ``course``: through a junction it runs through in this course (to the other wall's far
+    face), short of one it does not (to the other's near face); square where it is free (or the other wall has
+    no such course)."""
     wall = walls[w]
-    extent = [0.0, wall.length]
-    for e, sign in ((0, -1.0), (1, 1.0)):
+    extent = [Cut(0.0), Cut(wall.length)]
+    for e, inwards in ((0, wall.along), (1, -wall.along)):
         if (w, e) not in joins.ends or course >= courses[joins.ends[(w, e)][0]]:
             continue
         other, even_owner = joins.ends[(w, e)]
         owner = even_owner if course % 2 == 0 else (w if even_owner == other else other)
-        extent[e] += sign * (0.5 if owner == w else -0.5) * walls[other].thickness
+        near = math.copysign(1.0, float(inwards @ walls[other].across))  # the other's face on this wall's side
+        extent[e] = face_cut(wall, walls[other], -near if owner == w else near)
     return extent[0], extent[1]
 
 
 def junction_gaps(walls: list[Wall], joins: Junctions, courses: list[int], v: int
-                  ) -> dict[int, list[tuple[float, float]]]:
-    """``{course: [(s0, s1)]}``: where another wall runs through wall ``v`` (a T's abutting wall in odd courses,
-    a crossing wall in the courses it runs through)."""
-    gaps: dict[int, list[tuple[float, float]]] = {}
-    for cut, w, offset, parity in joins.cuts:
+                  ) -> dict[int, list[tuple[Cut, Cut]]]:
+    """``{course: [(start, end)]}``: where another wall runs through wall ``v`` (a T's abutting wall in odd
+    courses, a crossing wall in the courses it runs through), between its two faces."""
+    gaps: dict[int, list[tuple[Cut, Cut]]] = {}
+    for cut, w, parity in joins.cuts:
         if cut == v:
-            half = 0.5 * walls[w].thickness
+            faces = sorted((face_cut(walls[v], walls[w], side) for side in (1.0, -1.0)), key=lambda c: c.at)
             for k in range(parity, min(courses[v], courses[w]), 2):
-                gaps.setdefault(k, []).append((offset - half, offset + half))
+                gaps.setdefault(k, []).append((faces[0], faces[1]))
     return gaps
 
 
@@ -260,43 +288,51 @@ def course_cells(wall: Wall, course: int, origin: float, a: float, b: float, uni
     return (origin + first + repeats[:, None] * period + offsets).ravel(), np.tile(headers, repeats.size)
 
 
-def pieces(a: float, b: float, starts: np.ndarray, headers: np.ndarray, unit_length: float
-           ) -> list[tuple[float, float, bool]]:
-    """``[a, b]`` cut at the cells' ``starts``, each piece a header if its cell is; a sliver under :data:`SLIVER`
-    of a unit joins its neighbour (and takes its kind)."""
+def pieces(a: Cut, b: Cut, starts: np.ndarray, headers: np.ndarray, unit_length: float, half: float
+           ) -> list[tuple[Cut, Cut, bool]]:
+    """The range from ``a`` to ``b`` of a wall ``2 half`` thick cut at the cells' ``starts`` (square head joints,
+    none where a slanted end passes), each piece a header if its cell is; a piece shorter than :data:`SLIVER` of
+    a unit on either face joins its neighbour (and takes its kind)."""
     tol = 1e-9 * unit_length
-    if b - a <= tol:
+
+    def shortest(p: Cut, q: Cut) -> float:
+        return min(q.at_face(side * half) - p.at_face(side * half) for side in (-1.0, 1.0))
+
+    if shortest(a, b) <= tol:
         return []
-    cuts = [a, *starts[(starts > a + tol) & (starts < b - tol)].tolist(), b]
-    parts = [(p, q, bool(headers[np.searchsorted(starts, 0.5 * (p + q), side="right") - 1]))
-             for p, q in zip(cuts[:-1], cuts[1:]) if q - p > tol]
+    inside = starts[(starts > a.span(half)[1] + tol) & (starts < b.span(half)[0] - tol)]
+    cuts = [a, *(Cut(float(x)) for x in inside), b]
+    parts = [(p, q, bool(headers[np.searchsorted(starts, 0.5 * (p.at + q.at), side="right") - 1]))
+             for p, q in zip(cuts[:-1], cuts[1:]) if shortest(p, q) > tol]
     sliver = SLIVER * unit_length - tol
-    if len(parts) > 1 and parts[0][1] - parts[0][0] < sliver:
+    if len(parts) > 1 and shortest(*parts[0][:2]) < sliver:
         parts[:2] = [(parts[0][0], parts[1][1], parts[1][2])]
-    if len(parts) > 1 and parts[-1][1] - parts[-1][0] < sliver:
+    if len(parts) > 1 and shortest(*parts[-1][:2]) < sliver:
         parts[-2:] = [(parts[-2][0], parts[-1][1], parts[-2][2])]
     return parts
 
 
-def whole_at_end(parts: list[tuple[float, float, bool]], unit_length: float) -> list[tuple[float, float, bool]]:
-    """Stretchers ``parts`` with a whole unit last (the quoin of a corner the course runs through) and the rest of
-    the last two in the piece before it (a closer; one longer piece when the closer would be a sliver)."""
-    if len(parts) < 2 or parts[-1][1] - parts[-1][0] >= unit_length * (1 - 1e-9):
+def whole_at_end(parts: list[tuple[Cut, Cut, bool]], unit_length: float) -> list[tuple[Cut, Cut, bool]]:
+    """Stretchers ``parts`` ending square with a whole unit last (the quoin of a corner the course runs through)
+    and the rest of the last two in the piece before it (a closer; one longer piece when the closer would be a
+    sliver)."""
+    if len(parts) < 2 or parts[-1][1].at - parts[-1][0].at >= unit_length * (1 - 1e-9):
         return parts
     start, end = parts[-2][0], parts[-1][1]
-    if end - start - unit_length < SLIVER * unit_length:
+    if end.at - start.at - unit_length < SLIVER * unit_length:
         return parts[:-2] + [(start, end, False)]
-    return parts[:-2] + [(start, end - unit_length, False), (end - unit_length, end, False)]
+    return parts[:-2] + [(start, Cut(end.at - unit_length), False), (Cut(end.at - unit_length), end, False)]
 
 
 @dataclass
 class Laid:
-    """Boxes in walls' frames as they are laid: wall, along [s0, s1], across [q0, q1] (from the wall's base line),
-    course (z0, z1), role, extra dead load."""
+    """Blocks in walls' frames as they are laid: wall, along from ``s0`` to ``s1`` (their ends' cuts: boxes, or
+    prisms with a slanted end where walls meet at an angle), across [q0, q1] (from the wall's base line), course
+    (z0, z1), role, extra dead load."""
 
     wall: list[int] = field(default_factory=list)
-    s0: list[float] = field(default_factory=list)
-    s1: list[float] = field(default_factory=list)
+    s0: list[Cut] = field(default_factory=list)
+    s1: list[Cut] = field(default_factory=list)
     q0: list[float] = field(default_factory=list)
     q1: list[float] = field(default_factory=list)
     z0: list[float] = field(default_factory=list)
@@ -304,7 +340,7 @@ class Laid:
     role: list[int] = field(default_factory=list)
     load: list[float] = field(default_factory=list)  # a floor's line load times the length and share [N], down
 
-    def add(self, wall: int, s: tuple[float, float], q: tuple[float, float], z: tuple[float, float], role: int):
+    def add(self, wall: int, s: tuple[Cut, Cut], q: tuple[float, float], z: tuple[float, float], role: int):
         for name, value in zip(("wall", "s0", "s1", "q0", "q1", "z0", "z1", "role", "load"),
                                (wall, *s, *q, *z, role, 0.0)):
             getattr(self, name).append(value)
@@ -317,7 +353,7 @@ def lay_masonry(walls: list[Wall], joins: Junctions, unit_length: float, unit_he
     laid = Laid()
     for w, wall in enumerate(walls):
         gaps = junction_gaps(walls, joins, courses, w)  # course: the ranges left open (by openings, other walls)
-        lintels: dict[int, list[tuple[float, float]]] = {}  # course: the ranges of the lintels
+        lintels: dict[int, list[tuple[Cut, Cut]]] = {}  # course: the ranges of the lintels
         for number, (x, y, width, height, bearing) in enumerate(wall.openings):
             k0, k1 = round(y / unit_height), round((y + height) / unit_height)
             if abs(k0 * unit_height - y) > 1e-9 or abs(k1 * unit_height - y - height) > 1e-9:
@@ -328,24 +364,26 @@ def lay_masonry(walls: list[Wall], joins: Junctions, unit_length: float, unit_he
                                 f"{height:g} m does not fit in the wall ({wall.length:.6g} m long, {wall.height:.6g} "
                                 "m high, at least a course high)")
             for k in range(k0, k1):
-                gaps.setdefault(k, []).append((x, x + width))
+                gaps.setdefault(k, []).append((Cut(x), Cut(x + width)))
             if k1 < courses[w]:
-                lintels.setdefault(k1, []).append((max(x - bearing, 0.0), min(x + width + bearing, wall.length)))
-        origin = course_extent(walls, joins, courses, w, 0)[0]  # the bond starts with a full unit there
+                lintels.setdefault(k1, []).append((Cut(max(x - bearing, 0.0)),
+                                                   Cut(min(x + width + bearing, wall.length))))
+        origin = course_extent(walls, joins, courses, w, 0)[0].at  # the bond starts with a full unit there
         half = 0.5 * wall.thickness
         leaves = [(-half + j * wall.depth, -half + (j + 1) * wall.depth) for j in range(wall.leaves)]
         for k in range(courses[w]):
             a, b = course_extent(walls, joins, courses, w, k)
             z = (k * unit_height, (k + 1) * unit_height)
-            starts, headers = course_cells(wall, k, origin, a, b, unit_length)
-            cut = sorted(gaps.get(k, []) + lintels.get(k, []))
-            if any(q > p + 1e-9 * unit_length for (_, q), (p, _) in zip(cut[:-1], cut[1:])):
-                raise SpecError(f"wall {wall.name!r}: two openings (or an opening and a lintel over another) overlap "
-                                f"in course {k} ({k * unit_height:.4g} to {(k + 1) * unit_height:.4g} m); move them "
-                                "apart by a unit or more")
-            for p, q in zip([a] + [end for _, end in cut], [start for start, _ in cut] + [b]):
-                parts = pieces(p, q, starts, headers, unit_length)
-                if q > wall.length + 1e-9 * unit_length and not headers.any():  # through a corner: a quoin there
+            starts, headers = course_cells(wall, k, origin, a.span(half)[0], b.span(half)[1], unit_length)
+            cut = sorted(gaps.get(k, []) + lintels.get(k, []), key=lambda gap: gap[0].at)
+            bounds = [a, *(c for gap in cut for c in gap), b]
+            if any(p.span(half)[1] > q.span(half)[0] + 1e-9 * unit_length for p, q in zip(bounds[:-1], bounds[1:])):
+                raise SpecError(f"wall {wall.name!r}: its openings, lintels and the walls it meets overlap in course "
+                                f"{k} ({k * unit_height:.4g} to {(k + 1) * unit_height:.4g} m); move them apart by a "
+                                "unit or more")
+            for p, q in zip(bounds[0::2], bounds[1::2]):
+                parts = pieces(p, q, starts, headers, unit_length, half)
+                if q.slope == 0 and q.at > wall.length + 1e-9 * unit_length and not headers.any():  # a quoin there
                     parts = whole_at_end(parts, unit_length)
                 for s0, s1, header in parts:
                     for across in [(-half, half)] if header else leaves:
@@ -356,13 +394,15 @@ def lay_masonry(walls: list[Wall], joins: Junctions, unit_length: float, unit_he
 
 
 def plan_corners(walls: list[Wall], laid: Laid) -> np.ndarray:
-    """``(box, 4, 2)``: every laid box's corners in plan, anticlockwise."""
+    """``(block, 4, 2)``: every laid block's corners in plan, anticlockwise: its ends' cuts at its two faces."""
     w = np.asarray(laid.wall)
     start = np.array([wall.start for wall in walls])[w]
     along = np.array([wall.along for wall in walls])[w]
     across = np.array([wall.across for wall in walls])[w]
-    s = np.c_[laid.s0, laid.s1, laid.s1, laid.s0]
     q = np.c_[laid.q0, laid.q0, laid.q1, laid.q1]
+    at = np.array([[c.at for c in laid.s0], [c.at for c in laid.s1]]).T
+    slope = np.array([[c.slope for c in laid.s0], [c.slope for c in laid.s1]]).T
+    s = at[:, [0, 1, 1, 0]] + slope[:, [0, 1, 1, 0]] * q
     return start[:, None] + s[..., None] * along[:, None] + q[..., None] * across[:, None]
 
 
@@ -390,19 +430,12 @@ def refuse_overlaps(walls: list[Wall], laid: Laid, unit_length: float) -> None:
 
 
 def oriented_boxes(walls: list[Wall], laid: Laid) -> polyhedra.Polyhedra:
-    """The laid boxes: ``[s0, s1]`` along their walls' base lines, ``[q0, q1]`` across, ``[z0, z1]`` high."""
+    """The laid blocks: their plans (:func:`plan_corners`) from ``z0`` to ``z1``, eight vertices and six faces
+    each (a box, or a prism with a slanted end)."""
+    plan = plan_corners(walls, laid)[:, [0, 1, 3, 2]]  # the box template's order: along fastest, then across
+    z = np.c_[laid.z0, laid.z1]
+    vertices = np.concatenate([np.tile(plan, (1, 2, 1)), np.repeat(z, 4, axis=1)[..., None]], axis=2).reshape(-1, 3)
     w = np.asarray(laid.wall)
-    start = np.array([wall.start for wall in walls])[w]
-    along = np.array([wall.along for wall in walls])[w]
-    across = np.array([wall.across for wall in walls])[w]
-    corner = np.array([[i & 1, (i >> 1) & 1, (i >> 2) & 1] for i in range(8)])
-
-    def pick(axis: int, low: list[float], high: list[float]) -> np.ndarray:
-        return np.where(corner[None, :, axis] == 1, np.asarray(high)[:, None], np.asarray(low)[:, None])
-
-    s, q, z = pick(0, laid.s0, laid.s1), pick(1, laid.q0, laid.q1), pick(2, laid.z0, laid.z1)
-    plan = start[:, None, :] + s[..., None] * along[:, None, :] + q[..., None] * across[:, None, :]
-    vertices = np.concatenate([plan, z[..., None]], axis=2).reshape(-1, 3)
     template = polyhedra.boxes(np.zeros((1, 3)), np.ones((1, 3)))
     n = w.size
     return polyhedra.Polyhedra(vertices, np.full(n, 8), np.full(n, 6), np.full(6 * n, 4),
@@ -457,9 +490,12 @@ def build_building(spec: dict, text: str) -> xr.Dataset:
     for w, wall in enumerate(walls):  # the ground under the first course, less where a crossing wall's ground is
         half = 0.5 * wall.thickness
         a, b = course_extent(walls, joins, courses, w, 0)
-        crossed = sorted(junction_gaps(walls, joins, courses, w).get(0, []))
-        for p, q in zip([a] + [end for _, end in crossed], [start for start, _ in crossed] + [b]):
-            cuts = np.linspace(p, q, max(1, round((q - p) / segment)) + 1)
+        crossed = sorted(junction_gaps(walls, joins, courses, w).get(0, []), key=lambda gap: gap[0].at)
+        bounds = [a, *(c for gap in crossed for c in gap), b]
+        for p, q in zip(bounds[0::2], bounds[1::2]):
+            inner = np.linspace(p.at, q.at, max(1, round((q.at - p.at) / segment)) + 1)[1:-1]
+            inner = inner[(inner > p.span(half)[1] + 1e-9 * segment) & (inner < q.span(half)[0] - 1e-9 * segment)]
+            cuts = [p, *(Cut(float(x)) for x in inner), q]
             for s0, s1 in zip(cuts[:-1], cuts[1:]):
                 laid.add(w, (s0, s1), (-half, half), (-depth, 0.0), ROLE["fixed_support"])
     refuse_overlaps(walls, laid, unit_length)
@@ -467,7 +503,7 @@ def build_building(spec: dict, text: str) -> xr.Dataset:
     attrs = {"title": top.text("title"), "source_spec": text,
              "building_walls": json.dumps([{"name": w.name, "start": w.start.tolist(), "end": w.end.tolist(),
                                             "height": w.height, "thickness": w.thickness,
-                                            "ground": list(course_extent(walls, joins, courses, k, 0))}
+                                            "ground": [c.at for c in course_extent(walls, joins, courses, k, 0)]}
                                            for k, w in enumerate(walls)]),
              "settlement_axis": ground_plan.axis_attr(),
              **({"laying_notes": "\n".join(notes)} if notes else {}),
@@ -491,7 +527,8 @@ def add_floors(building: SpecTable, walls: list[Wall], laid: Laid, unit_height: 
         for b, (w, z0) in enumerate(zip(laid.wall, laid.z0)):
             if walls[w].name in on and round(z0 / unit_height) == top_course:
                 share = (laid.q1[b] - laid.q0[b]) / walls[w].thickness
-                laid.load[b] += load * (laid.s1[b] - laid.s0[b]) * share
+                middle = 0.5 * (laid.q0[b] + laid.q1[b])
+                laid.load[b] += load * (laid.s1[b].at_face(middle) - laid.s0[b].at_face(middle)) * share
                 hit = True
         if not hit:
             raise SpecError(f"spec key {floor.key('height')!r} = {floor.raw('height')!r}: no course of the walls "
@@ -505,7 +542,7 @@ def _dataset(walls, laid, n_masonry, poly, material, ground_plan, depth, attrs, 
     starts = np.array([w.start for w in walls])[wall]
     along = np.array([w.along for w in walls])[wall]
     across = np.array([w.across for w in walls])[wall]
-    s = np.c_[laid.s0[n_masonry:], laid.s1[n_masonry:]]
+    s = np.array([[c.at for c in laid.s0[n_masonry:]], [c.at for c in laid.s1[n_masonry:]]]).T
     ends = starts[:, None, :] + s[..., None] * along[:, None, :]
     motion = segment_motion(ground_plan, ends, along, across, depth)
     footprint = (s[:, 1] - s[:, 0]) * np.array([w.thickness for w in walls])[wall]

@@ -216,7 +216,8 @@ def _canonical_planes(normal: np.ndarray, centre: np.ndarray, tol: float) -> tup
 
 def find_contacts(poly: Polyhedra, tol: float) -> Contacts:
     """The interfaces of ``poly`` (module docstring): faces of two blocks in one plane within ``tol`` facing each
-    other, over a common polygon whose extent in the plane exceeds ``tol`` both ways."""
+    other, over a common polygon whose extent in the plane exceeds ``tol`` both ways and whose area exceeds ``tol``
+    times its greater extent (two faces meeting along an edge give a polygon of no width)."""
     import shapely
 
     normal, _, centre = face_normals_areas(poly)
@@ -248,7 +249,8 @@ def find_contacts(poly: Polyhedra, tol: float) -> Contacts:
     parts = np.asarray(shapely.simplify(parts, 1e-6 * tol))
     polygonal = shapely.get_type_id(parts) == 3
     bounds = shapely.bounds(parts)
-    wide = polygonal & (bounds[:, 2] - bounds[:, 0] > tol) & (bounds[:, 3] - bounds[:, 1] > tol)
+    extent = bounds[:, 2:] - bounds[:, :2]
+    wide = polygonal & (extent > tol).all(axis=1) & (shapely.area(parts) > tol * extent.max(axis=1, initial=0.0))
     parts, pair = parts[wide], pair[wide]
     return _contacts(parts, a[pair], b[pair], block, direction, frame, centre)
 

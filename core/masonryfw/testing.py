@@ -146,14 +146,17 @@ def arch_model(thickness_ratio: float, voussoirs: int = 40, radius: float = 1.0,
     return checked_model(ds, "arch")
 
 
-def corner_building(bond: str = "running") -> xr.Dataset:
-    """A small building in 3D (:mod:`masonryfw.building`): two walls toothed at a right-angle corner, 1.44 and 1.2 m
-    long and 0.96 m high in 0.24 x 0.12 m units, a door in the first, over a trough whose axis runs at 30 degrees
-    to x; one leaf (0.12 m) thick in running ``bond``, two leaves (0.24 m) in English or Flemish."""
+def corner_building(bond: str = "running", angle: float = 90.0) -> xr.Dataset:
+    """A small building in 3D (:mod:`masonryfw.building`): two walls toothed at a corner (``angle`` degrees between
+    them), 1.44 and 1.2 m long and 0.96 m high in 0.24 x 0.12 m units, a door in the first, over a trough whose
+    axis runs at 30 degrees to x; one leaf (0.12 m) thick in running ``bond``, two leaves (0.24 m) in English or
+    Flemish."""
     thickness = 0.12 if bond == "running" else 0.24
+    turn = math.radians(angle)
+    end = [1.44 - 1.2 * math.cos(turn), 1.2 * math.sin(turn)]
     walls = [{"name": "a", "start": [0.0, 0.0], "end": [1.44, 0.0], "height": 0.96, "thickness": thickness,
               "openings": [{"x": 0.48, "y": 0.0, "width": 0.48, "height": 0.6}]},
-             {"name": "b", "start": [1.44, 0.0], "end": [1.44, 1.2], "height": 0.96, "thickness": thickness}]
+             {"name": "b", "start": [1.44, 0.0], "end": end, "height": 0.96, "thickness": thickness}]
     return build({"title": "corner", "building": {"unit": {"length": 0.24, "height": 0.12, "depth": 0.12},
                                                   "walls": walls, "bond": bond},
                   "material": {"unit_weight": 20000.0, "friction_angle": 30.0},

@@ -134,13 +134,16 @@ def static_residuals(blocks: space3.Blocks3D, state: space3.LimitState3D) -> tup
 
 @pytest.mark.parametrize("sides", [8, 0])
 @pytest.mark.parametrize("case", ["tilted stack", "twisted stack", "panel-5", "facade-2", "corner building",
-                                  "corner in english bond", "corner in flemish bond"])
+                                  "corner in english bond", "corner in flemish bond", "corner at 120 degrees",
+                                  "corner at 60 degrees"])
 def test_the_forces_satisfy_every_blocks_six_equilibrium_equations_and_the_cone(case, sides):
     if case.endswith("stack"):
         lower = [[-1, -1, -0.2], [-0.5, -0.4, 0], [-0.1, -0.3, 0.4], [-0.3, -0.35, 0.8]]
         upper = [[1, 1, 0], [0.5, 0.4, 0.4], [0.7, 0.3, 0.8], [0.5, 0.35, 1.0]]
         load = {"live_force": (0.6, 0.3, 0.0)} if case == "tilted stack" else {"live_moment": (0.0, 0.0, 1.0)}
         blocks = boxes_on_a_base(lower, upper, 0.6, **load)
+    elif case.startswith("corner at"):
+        blocks = space3.blocks_of(mt.corner_building(angle=float(case.split()[2])))
     elif case.startswith("corner"):
         blocks = space3.blocks_of(mt.corner_building(case.split()[2] if case.endswith("bond") else "running"))
     else:
