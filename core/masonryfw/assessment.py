@@ -37,7 +37,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from .geometry import block_bounds
-from .ground_plan import GroundInPlan, SurfaceCut
+from .ground_plan import SurfaceCut, ground_in_plan
 from .model3d import space
 from .profiles import Profile, model_profile
 from .roles import masonry_blocks, support_blocks
@@ -214,9 +214,9 @@ def assess_building(model: xr.Dataset, profile: Profile, settlement: float) -> A
     (``settlement_axis``): each wall's line cut from the greenfield surface (:func:`wall_profile`; with a
     tunnel's face, a :class:`SurfaceCut`), its own length and height; the building's largest slope, settlement
     and strain are its worst wall's."""
-    axis = json.loads(model.attrs["settlement_axis"])
-    point, direction = np.array(axis["point"]), np.array(axis["direction"])
-    ground = GroundInPlan(profile, point, direction, axis.get("face"))
+    ground = ground_in_plan(model)
+    assert ground is not None  # a building is built over a profile in plan
+    point, direction = ground.point, ground.across
     slopes, settled, parts = [0.0], [0.0], []
     for wall in json.loads(model.attrs["building_walls"]):
         start, end = np.array(wall["start"]), np.array(wall["end"])

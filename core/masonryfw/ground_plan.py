@@ -27,7 +27,7 @@ import numpy as np
 from scipy.special import ndtr
 
 from .errors import SpecError
-from .profiles import SETTLEMENT_KEYS, Profile, beyond_cutoff, read_profile
+from .profiles import SETTLEMENT_KEYS, Profile, beyond_cutoff, model_profile, read_profile
 from .spec import SpecTable
 
 #: A 3D profile's keys: the 2D ones, its axis in plan through a point instead of ``center``, a tunnel's face.
@@ -96,6 +96,16 @@ def profile_in_plan(table: SpecTable, unit_length: float) -> GroundInPlan:
     profile = read_profile(SpecTable(plain, table.path, SETTLEMENT_KEYS, table.scale), 0.0, 1.0, unit_length)
     face = table.number("face", length=True) if table.has("face") else None
     return GroundInPlan(profile, point, np.array([math.sin(angle), -math.cos(angle)]), face)
+
+
+def ground_in_plan(model) -> GroundInPlan | None:
+    """The ground in plan a 3D model was built over (its ``settlement_profile`` and ``settlement_axis``
+    attributes), None for a model without them."""
+    profile = model_profile(model)
+    if profile is None or "settlement_axis" not in model.attrs:
+        return None
+    axis = json.loads(model.attrs["settlement_axis"])
+    return GroundInPlan(profile, np.array(axis["point"]), np.array(axis["direction"]), axis.get("face"))
 
 
 @dataclass(frozen=True)

@@ -10,7 +10,7 @@ here, documented in docs/api.md ("For plugin authors"), and like ``mf`` every na
 import lazy_loader
 
 __getattr__, __dir__, __all__ = lazy_loader.attach("masonryfw", submod_attrs={
-    "assessment": ["LTSM_LIMITS", "POISSON", "Part", "assess", "deep_beam_strains", "volume_loss_per_settlement", "wall_extent"],
+    "assessment": ["LTSM_LIMITS", "POISSON", "Part", "assess", "deep_beam_strains", "ltsm_category", "volume_loss_per_settlement", "wall_extent"],
     "command_kit": ["LENGTH", "OPTIONS", "PROGRESS", "command_line"],
     "cores": ["core_share", "cores", "free_cores", "machine_load"],
     "damage": ["distortion", "support_profile"],
@@ -19,6 +19,7 @@ __getattr__, __dir__, __all__ = lazy_loader.attach("masonryfw", submod_attrs={
     "errors": ["listed"],
     "derived": ["DERIVED_VARIABLES", "derive_geometry"],
     "geometry": ["DERIVED_GEOMETRY_VARIABLES", "block_bounds", "block_offsets", "convex_blocks", "convex_pieces", "interface_frame", "model_scale", "node_block", "point_segment_distance", "polygon_area_centroid", "triangulated"],
+    "ground_plan": ["GroundInPlan", "ground_in_plan"],
     "hookspecs": ["hookimpl"],
     "inputs": ["fits_in_memory", "read_text", "regular_file"],
     "io": ["FIGURE_FORMATS", "check_output_path", "content_sha256", "save_text", "sha256_file", "write_atomically"],

@@ -419,9 +419,10 @@ SINGLE_RESULT_KINDS = {"mechanism": "block_displacement", "cracks": "interface_o
 
 def drawable_kinds(ds: xr.Dataset) -> list[str]:
     """The one-result kinds ``ds`` can be drawn as, in the order of :data:`SINGLE_RESULT_KINDS`; then ``ltsm``
-    for a result over a settlement profile with a settlement to assess."""
+    for a result over a settlement profile with a settlement to assess (and walls: a wall, or a building's)."""
     kinds = [kind for kind, needs in SINGLE_RESULT_KINDS.items() if needs in ds]
     if mfp.space(ds) == 3:  # the kinds that draw in 3D (their records' spaces)
-        return [kind for kind in kinds if mf.get_plotter(kind).spaces != (2,)]
+        kinds = [kind for kind in kinds if mf.get_plotter(kind).spaces != (2,)]
     assessed = ("step_settlement" in ds and ds.step_settlement.size) or "settlement_target" in ds
-    return kinds + (["ltsm"] if ds.attrs.get("settlement_profile") and assessed else [])
+    walls = mfp.space(ds) == 2 or "building_walls" in ds.attrs  # a drawing's blocks name no walls to assess
+    return kinds + (["ltsm"] if ds.attrs.get("settlement_profile") and assessed and walls else [])

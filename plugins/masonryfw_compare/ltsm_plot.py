@@ -1,13 +1,17 @@
 """The ``ltsm`` plot: the engineers' stage 2 of a result over a settlement profile.
 
-Above, the greenfield trough under the wall with its sagging and hogging parts; below, the classic
-interaction chart (Burland 1995; Boscardin & Cording 1989) for every part of the wall: the deflection ratio
+Above, the greenfield trough under the wall with its sagging and hogging parts (a building's: its plan over the
+greenfield settlement, each wall coloured by its LTSM category); below, the classic interaction chart (Burland
+1995; Boscardin & Cording 1989) for every part of the wall (a building's worst wall): the deflection ratio
 against the horizontal strain, the zones of the LTSM categories for that part's length over height and kind
-(sagging, hogging), and the part as a point at the assessed settlement. The numbers are :mod:`masonryfw.assessment`'s.
+(sagging, hogging), and the part as a point at the assessed settlement. The numbers are
+:mod:`masonryfw.assessment`'s.
 """
 from __future__ import annotations
 
+import json
 from collections.abc import Mapping, Sequence
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
@@ -51,20 +55,79 @@ def draw_ltsm(datasets: Sequence[xr.Dataset], ax, options: Mapping[str, Any]) ->
     ds = single_result(datasets, "ltsm")
     settlement = assessed_settlement(ds)
     stages = mfp.assess(ds, settlement)
+    if stages is None and mfp.space(ds) == 3 and ds.attrs.get("settlement_profile"):
+        raise mf.MasonryError("the ltsm plot needs walls to assess: a 3D drawing's blocks name none (a building "
+                              "built from a [building] spec has them)")
     if stages is None:
         raise mf.MasonryError("the ltsm plot needs a model built over a settlement profile ([settlement] in its spec)")
-    profile = mf.model_profile(ds)
-    x_a, x_b, height = mfp.wall_extent(ds)
     figure, spec = ax.figure, ax.get_subplotspec()
     ax.set_axis_off()
-    rows = spec.subgridspec(2, 1, height_ratios=(1, 2), hspace=0.08)
-    trough = figure.add_subplot(rows[0])
-    _draw_trough(trough, profile, stages, settlement, x_a, x_b, height)
-    _draw_charts(figure, rows[1], stages, settlement, height)
-    trough.set_title(f"{title_of(ds)}: stage 2 (LTSM) at S_max = {1e3 * settlement:.3g} mm\n"
-                     f"LTSM strain {100 * stages.strain:.3g} %, category {ZONE_NAMES[stages.category]}; stage 1: slope "
-                     f"1/{1 / max(stages.slope, 1e-12):.0f}, settlement {1e3 * stages.greenfield_settlement:.3g} mm"
-                     f"{' (screened out)' if stages.screened_out else ''}", fontsize="medium")
+    rows = spec.subgridspec(2, 1, height_ratios=(1.3, 2) if "building_walls" in ds.attrs else (1, 2), hspace=0.12)
+    top = figure.add_subplot(rows[0])
+    if "building_walls" in ds.attrs:
+        figure.set_size_inches(8.5, 8.5)  # a plan above the charts
+        walls = json.loads(ds.attrs["building_walls"])
+        worst = _draw_plan(top, ds, walls, stages, settlement)
+        _draw_charts(figure, rows[1], replace(stages, parts=tuple(p for p in stages.parts if p.wall == worst["name"])),
+                     settlement, worst["height"])
+        where = f" (worst wall: {worst['name']!r})"
+    else:
+        x_a, x_b, height = mfp.wall_extent(ds)
+        _draw_trough(top, mf.model_profile(ds), stages, settlement, x_a, x_b, height)
+        _draw_charts(figure, rows[1], stages, settlement, height)
+        where = ""
+    top.set_title(f"{title_of(ds)}: stage 2 (LTSM) at S_max = {1e3 * settlement:.3g} mm\n"
+                  f"LTSM strain {100 * stages.strain:.3g} %, category {ZONE_NAMES[stages.category]}{where}; stage 1: "
+                  f"slope 1/{1 / max(stages.slope, 1e-12):.0f}, settlement {1e3 * stages.greenfield_settlement:.3g} mm"
+                  f"{' (screened out)' if stages.screened_out else ''}", fontsize="medium")
+
+
+def _draw_plan(ax, ds: xr.Dataset, walls: list[dict], stages, settlement: float) -> dict:
+    """A building's plan over the greenfield settlement at ``settlement`` (contours), the trough's axis (and a
+    tunnel's face), each wall coloured by its LTSM category and labelled with its strain; returns the worst
+    wall."""
+    ground = mfp.ground_in_plan(ds)
+    ends = np.array([[w["start"], w["end"]] for w in walls]).reshape(-1, 2)
+    low, high = ends.min(axis=0), ends.max(axis=0)
+    margin = 0.35 * float((high - low).max()) + 0.5
+    x, y = np.meshgrid(np.linspace(low[0] - margin, high[0] + margin, 160),
+                       np.linspace(low[1] - margin, high[1] + margin, 160))
+    rate, _ = ground.greenfield(np.c_[x.ravel(), y.ravel()])
+    shown = ax.contourf(x, y, 1e3 * settlement * rate.reshape(x.shape), levels=12, cmap="Blues", alpha=0.55)
+    ax.figure.colorbar(shown, ax=ax, label="greenfield settlement [mm]", shrink=0.9, pad=0.02)
+    if ground.profile.kind in ("gaussian", "tunnel"):
+        reach = np.array([-1.0, 1.0])[:, None] * 3 * margin * ground.axis + ground.point
+        ax.plot(*reach.T, color="0.3", lw=1.0, ls="--", label="trough axis" if ground.profile.kind == "gaussian"
+                else "tunnel axis")
+        if ground.face is not None:  # the face across the tunnel (its diameter wide), an arrow the way it goes
+            face = ground.point + ground.face * ground.axis
+            half = 0.5 * (ground.profile.diameter or 0.2 * margin) * ground.across
+            ax.plot(*np.array([face - half, face + half]).T, color="0.1", lw=3,
+                    label=f"tunnel face, {ground.face:.3g} m along the axis")
+            ax.annotate("", xy=face + 0.25 * margin * ground.axis, xytext=face,
+                        arrowprops={"arrowstyle": "->", "color": "0.1", "lw": 1.5})
+    strain = {w["name"]: max((settlement * p.strain for p in stages.parts if p.wall == w["name"]), default=0.0)
+              for w in walls}
+    centre = ends.mean(axis=0)
+    for wall in walls:
+        category = int(mfp.ltsm_category(strain[wall["name"]]))
+        line = np.array([wall["start"], wall["end"]])
+        ax.plot(*line.T, color=DAMAGE_COLOURS[category], lw=6, solid_capstyle="butt")
+        along = (line[1] - line[0]) / np.linalg.norm(line[1] - line[0])
+        outward = np.array([-along[1], along[0]])
+        outward *= np.sign(outward @ (line.mean(axis=0) - centre)) or 1.0
+        angle = np.degrees(np.arctan2(along[1], along[0]))
+        angle = (angle + 90.0) % 180.0 - 90.0  # upright text
+        ax.annotate(f"{wall['name']}: {100 * strain[wall['name']]:.3g} %, cat. {category}",
+                    line.mean(axis=0) + 0.25 * margin * outward, fontsize="small", ha="center", va="center",
+                    rotation=angle, bbox={"boxstyle": "round,pad=0.2", "fc": "white", "alpha": 0.8, "lw": 0})
+    ax.set_aspect("equal")
+    ax.set_xlim(x.min(), x.max())
+    ax.set_ylim(y.min(), y.max())
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("y [m]")
+    ax.legend(loc="upper left", bbox_to_anchor=(1.25, 1.0), fontsize="small", frameon=False)
+    return max(walls, key=lambda w: strain[w["name"]])
 
 
 def _draw_trough(ax, profile, stages, settlement: float, x_a: float, x_b: float, height: float) -> None:
@@ -128,7 +191,8 @@ def _draw_chart(ax, part, worst: int, settlement: float, height: float) -> None:
         lower = np.maximum(upper, lower)
     kind = "sagging" if part.sagging else "hogging"
     ax.plot(x, y, "o" if part.sagging else "s", ms=8, color="k", mfc="#4575b4" if part.sagging else "#d73027")
-    ax.set_title(f"{kind} {part.start:.3g}..{part.end:.3g} m, L/H {(part.end - part.start) / height:.2g}:\n"
+    ax.set_title(f"{part.wall + ': ' if part.wall else ''}{kind} {part.start:.3g}..{part.end:.3g} m, "
+                 f"L/H {(part.end - part.start) / height:.2g}:\n"
                  f"strain {100 * settlement * part.strain:.3g} %", fontsize="small")
     ax.set_xlim(low_strain, top_strain)
     ax.set_ylim(0.0, ceiling)

@@ -74,8 +74,9 @@ PLOTTERS = {
                  table=True, module="history_plot"),
         _plotter("compare", "two or more results side by side with their scores",
                  (AMPLIFICATION_OPTION, THRESHOLD_OPTION), side_by_side=True, module="compare_plot"),
-        _plotter("ltsm", "the engineers' stage 2 over a settlement profile: the trough under the wall and the LTSM "
-                 "interaction chart (deflection ratio against horizontal strain, the category zones, the wall's "
-                 "sagging and hogging parts)", module="ltsm_plot"),
+        _plotter("ltsm", "the engineers' stage 2 over a settlement profile: the trough under the wall (a building's "
+                 "plan, its walls by category) and the LTSM interaction chart (deflection ratio against horizontal "
+                 "strain, the category zones, the (worst) wall's sagging and hogging parts)", module="ltsm_plot",
+                 spaces=(2, 3)),
     )
 }

@@ -143,9 +143,12 @@ def _result_figures(ds: xr.Dataset, label: str) -> list[str]:
         "cracks": "joints that open, slide or both.",
         "forces": f"joint resultants {_forces_state(ds)}; colour: the share of the friction used.",
         "plastic": "plastic quadrature points of the continuum.",
-        "ltsm": "the engineers' stages 1 and 2 beside the model: the greenfield trough under the wall, its sagging "
-                "and hogging parts, and the LTSM chart (deflection ratio against horizontal strain, the category "
-                "zones for the governing part) at the assessed settlement.",
+        "ltsm": ("the engineers' stages 1 and 2 beside the model: the building's plan over the greenfield "
+                 "settlement, each wall in the colour of its own LTSM category, and the LTSM charts of the worst "
+                 "wall's parts at the assessed settlement." if "building_walls" in ds.attrs else
+                 "the engineers' stages 1 and 2 beside the model: the greenfield trough under the wall, its sagging "
+                 "and hogging parts, and the LTSM chart (deflection ratio against horizontal strain, the category "
+                 "zones for the governing part) at the assessed settlement."),
     }
     return [_figure([ds], kind, f"{label}: {captions[kind]}") for kind in drawable_kinds(ds)]
 

@@ -68,7 +68,7 @@ def test_the_drawing_moves_blocks_relative_to_the_largest_macro_block(corner):
     np.testing.assert_allclose(actual - drawn, rigid, atol=1e-9 * np.abs(actual).max())
 
 
-@pytest.mark.parametrize("kind", ["cracks", "forces", "history", "ltsm"])
+@pytest.mark.parametrize("kind", ["cracks", "forces", "history"])
 def test_the_kinds_that_draw_2d_only_say_so(corner, kind):
     with pytest.raises(mf.ModelError, match=f"the {kind} plot handles 2D models and results"):
         mf.render([corner[1]], kind)
@@ -162,3 +162,55 @@ def test_the_report_of_two_3d_results(corner, tmp_path):
     assert "<h2>The building</h2>" in text and text.count("<img ") == 3
     assert "A: la (cone, clarabel)" in text and "B: la (pyramid of 8 sides, ipm)" in text
     assert "<h2>Agreement</h2>" in text and 'id="agreement"' in text
+
+
+def test_a_buildings_ltsm_plot_colours_each_wall_by_its_category_and_charts_the_worst():
+    """The house over the tunnel with its face under it: the plan shows every wall as a line in the colour of its
+    own LTSM category (each wall's largest part strain at the assessed settlement), the worst wall's name in the
+    title, and one interaction chart per part of that wall; a drawn 3D result has no walls and is refused."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.colors import to_hex
+
+    from masonryfw_compare.block_plots import drawable_kinds
+    from masonryfw_compare.figure_parts import DAMAGE_COLOURS
+
+    spec = mf.load_spec(mf.bundled_spec_path("house-tunnel"))
+    spec = {**spec, "settlement": {**spec["settlement"], "face": 2.0, "volume_loss": 4.5}}
+    result = mf.solve(mf.build(spec), "la")
+    assert "ltsm" in drawable_kinds(result)
+    figure = mf.render([result], "ltsm")
+    FigureCanvasAgg(figure).draw()
+    settlement = float(result.settlement_target)
+    stages = mfp.assess(result, settlement)
+    walls = {w["name"] for w in __import__("json").loads(result.attrs["building_walls"])}
+    strain = {name: max(settlement * p.strain for p in stages.parts if p.wall == name) for name in walls}
+    plan = figure.axes[1]
+    drawn = {tuple(np.round(line.get_xydata()[[0, -1]].ravel(), 6)): to_hex(line.get_color())
+             for line in plan.get_lines() if line.get_linewidth() == 6}
+    assert len(drawn) == len(walls)
+    for wall in __import__("json").loads(result.attrs["building_walls"]):
+        key = tuple(np.round(np.r_[wall["start"], wall["end"]], 6))
+        assert drawn[key] == DAMAGE_COLOURS[int(mfp.ltsm_category(strain[wall["name"]]))]
+    worst = max(strain, key=strain.get)
+    assert f"worst wall: {worst!r}" in plan.get_title()
+    charts = [ax for ax in figure.axes if ax.get_xlabel().startswith("horizontal strain")]
+    assert len(charts) == sum(p.wall == worst for p in stages.parts)
+    assert max(strain.values()) > 0.0005  # a category above 0 somewhere: the colours are not all one
+
+
+def test_a_drawn_3d_result_has_no_walls_for_the_ltsm_plot(corner, tmp_path):
+    from masonryfw import polyhedra
+    from masonryfw_compare.block_plots import drawable_kinds
+    from tests.core.test_core_drawing3d import write_obj
+
+    model, _ = corner
+    write_obj(tmp_path / "corner.obj", polyhedra.subset(mfp.polyhedra_of(model),
+                                                        mfp.masonry_blocks(model.block_role.values)))
+    drawn = mf.build({"title": "drawn", "geometry": {"mesh": str(tmp_path / "corner.obj")},
+                      "material": {"unit_weight": 20000.0, "friction_angle": 30.0},
+                      "settlement": {"profile": "tunnel", "volume_loss": 1.0, "diameter": 3.0, "depth": 6.0,
+                                     "axis_angle": 30.0, "center_x": 1.4, "center_y": 0.2}})
+    result = mf.solve(drawn, "la")
+    assert "ltsm" not in drawable_kinds(result)
+    with pytest.raises(mf.MasonryError, match="the ltsm plot needs walls to assess: a 3D drawing's blocks name none"):
+        mf.render([result], "ltsm")
