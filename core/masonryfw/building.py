@@ -12,7 +12,8 @@ the patterns of the 2D walls (:func:`masonryfw.bond.pattern_cells`) with the uni
 Where two walls meet end to end, at any angle of :data:`MIN_ANGLE` or more, the corner is toothed: in even
 courses the wall listed first runs through the corner to the other's outer face and the other stops at its
 inner face; in odd courses the other way round. A wall ending on another's base line (a T) stops at its face
-in even courses and runs through it in odd ones; two walls crossing run through in turn. Where a wall meets
+in even courses and runs through it in odd ones; two walls crossing run through in turn; walls drawn to a
+common point make the same junctions (:func:`meeting`). Where a wall meets
 another at an angle its end follows the other's face: the end blocks are prisms with a slanted end
 (:class:`Cut`), the rest boxes. An opening takes its courses
 (its sill and head moved onto the nearest bed joints, said in ``laying_notes``) and a lintel one course high
@@ -170,31 +171,34 @@ class Cut(NamedTuple):
         return self.at - abs(self.slope) * half, self.at + abs(self.slope) * half
 
 
-class Junctions(NamedTuple):
-    """Where walls meet: ``ends[(wall, end)] = (other wall, the wall that runs through in even courses)`` (end 0:
-    its start, 1: its end), and where a wall is cut for another running through it, ``cuts``: (the wall cut, the
-    wall through it, the parity of the courses cut)."""
+class End(NamedTuple):
+    """How a wall's end meets another wall: in the courses the wall owns it runs through to the other's far face
+    (or, ``continued`` by a wall in line with it, stops at the point they meet), in the others it stops at the
+    other's near face."""
 
-    ends: dict[tuple[int, int], tuple[int, int]]
+    other: int
+    even_owner: int  # the wall that owns the even courses
+    continued: bool = False
+
+
+class Junctions(NamedTuple):
+    """Where walls meet: ``ends[(wall, end)]`` (end 0: its start, 1: its end), and where a wall is cut for another
+    running through it, ``cuts``: (the wall cut, the wall through it, the parity of the courses cut)."""
+
+    ends: dict[tuple[int, int], End]
     cuts: list[tuple[int, int, int]]
 
 
 def junctions(walls: list[Wall], tol: float) -> Junctions:
     """The corners (two walls' ends at one point), T-junctions (a wall's end on another's base line between its
-    ends) and crossings (two base lines crossing between their ends) of ``walls``, each at :data:`MIN_ANGLE` or
-    more. A corner's first-listed wall runs through in even courses; a T's through wall in even courses and the
-    abutting wall in odd ones; at a crossing the first-listed wall in even courses and the other in odd ones.
-    Other meetings are refused, naming the walls."""
-    ends = [(w, e, (wall.start, wall.end)[e]) for w, wall in enumerate(walls) for e in (0, 1)]
-    meets: dict[tuple[int, int], tuple[int, int]] = {}
-    for a, (wa, ea, pa) in enumerate(ends):
-        for wb, eb, pb in ends[a + 1:]:
-            if wb != wa and np.linalg.norm(pa - pb) <= tol:
-                if (wa, ea) in meets or (wb, eb) in meets:
-                    raise SpecError(f"walls {walls[wa].name!r} and {walls[wb].name!r}: more than two walls meet at "
-                                    f"({pa[0]:.6g}, {pa[1]:.6g}); corners of two walls only so far")
-                steep_enough(walls, wa, wb)
-                meets[(wa, ea)], meets[(wb, eb)] = (wb, min(wa, wb)), (wa, min(wa, wb))
+    ends, or three walls' ends at a point, two of them in line) and crossings (two base lines crossing between
+    their ends, or four walls' ends at a point in two lines) of ``walls``, each at :data:`MIN_ANGLE` or more. A
+    corner's first-listed wall runs through in even courses; a T's through wall (or the two walls in line) in
+    even courses and the abutting wall in odd ones; at a crossing the first-listed wall (or line) in even
+    courses and the other in odd ones. Other meetings are refused, naming the walls."""
+    meets: dict[tuple[int, int], End] = {}
+    for group in ends_together(walls, tol):
+        meets.update(meeting(walls, group))
     cuts = []
     for w, wall in enumerate(walls):
         for e, point in ((0, wall.start), (1, wall.end)):
@@ -204,7 +208,7 @@ def junctions(walls: list[Wall], tol: float) -> Junctions:
                 offset = float((point - other.start) @ other.along)
                 if v != w and abs(float((point - other.start) @ other.across)) <= tol and 0 < offset < other.length:
                     steep_enough(walls, w, v)
-                    meets[(w, e)] = (v, v)
+                    meets[(w, e)] = End(v, v)
                     cuts.append((v, w, 1))
     for first, second in itertools.combinations(range(len(walls)), 2):
         crossing = base_lines_cross(walls[first], walls[second], tol)
@@ -212,6 +216,53 @@ def junctions(walls: list[Wall], tol: float) -> Junctions:
             steep_enough(walls, first, second)
             cuts += [(first, second, 1), (second, first, 0)]
     return Junctions(meets, cuts)
+
+
+def ends_together(walls: list[Wall], tol: float) -> list[list[tuple[int, int]]]:
+    """The walls' ends, ``(wall, end)``, grouped by the point they are at (within ``tol``), groups of two or more."""
+    groups: list[tuple[np.ndarray, list[tuple[int, int]]]] = []
+    for w, wall in enumerate(walls):
+        for e, point in ((0, wall.start), (1, wall.end)):
+            group = next((g for p, g in groups if np.linalg.norm(point - p) <= tol), None)
+            if group is None:
+                groups.append((point, [(w, e)]))
+            else:
+                group.append((w, e))
+    return [group for _, group in groups if len(group) > 1]
+
+
+def meeting(walls: list[Wall], group: list[tuple[int, int]]) -> dict[tuple[int, int], End]:
+    """How the walls whose ends are at one point meet: two at an angle (a corner), three of which two are in line
+    (a T), four in two lines (a crossing)."""
+    def outward(w: int, e: int) -> np.ndarray:
+        return walls[w].along if e == 0 else -walls[w].along
+
+    names = ", ".join(repr(walls[w].name) for w, _ in group)
+    point = (walls[group[0][0]].start, walls[group[0][0]].end)[group[0][1]]
+    lines = [(a, b) for a, b in itertools.combinations(group, 2) if float(outward(*a) @ outward(*b)) < -1 + 1e-9]
+    if len(group) == 2 and not lines:
+        (wa, _), (wb, _) = group
+        steep_enough(walls, wa, wb)
+        return {group[0]: End(wb, min(wa, wb)), group[1]: End(wa, min(wa, wb))}
+    in_line = {end for line in lines for end in line}
+    if len(group) == 3 and len(lines) == 1 or len(group) == 4 and len(lines) == 2 and len(in_line) == 4:
+        lines = sorted(lines, key=lambda line: min(line[0][0], line[1][0]))  # the first-listed wall's line first
+        through = lines[0]
+        crossing = lines[1] if len(lines) > 1 else tuple(end for end in group if end not in in_line)
+        for line in lines:
+            if abs(walls[line[0][0]].thickness - walls[line[1][0]].thickness) > 1e-9:
+                raise SpecError(f"walls {walls[line[0][0]].name!r} and {walls[line[1][0]].name!r} continue each "
+                                "other in a line with different thicknesses; the walls meeting them would not fit")
+        steep_enough(walls, through[0][0], crossing[0][0])
+        owner = through[0][0]
+        ends = {end: End(crossing[0][0], end[0], continued=True) for end in through}
+        ends.update({end: End(owner, owner, continued=len(crossing) == 2) for end in crossing})
+        return ends
+    if len(group) == 2:
+        raise SpecError(f"walls {names} continue each other in a line at ({point[0]:.6g}, {point[1]:.6g}): make "
+                        "them one wall (a wall's openings may be anywhere along it)")
+    raise SpecError(f"walls {names} meet at ({point[0]:.6g}, {point[1]:.6g}): at a point, two walls (a corner), three "
+                    "of which two are in line (a T) or four in two lines (a crossing) are toothed, not this")
 
 
 def base_lines_cross(a: Wall, b: Wall, tol: float) -> bool:
@@ -247,10 +298,12 @@ def course_extent(walls: list[Wall], joins: Junctions, courses: list[int], w: in
     wall = walls[w]
     extent = [Cut(0.0), Cut(wall.length)]
     for e, inwards in ((0, wall.along), (1, -wall.along)):
-        if (w, e) not in joins.ends or course >= courses[joins.ends[(w, e)][0]]:
+        if (w, e) not in joins.ends or course >= courses[joins.ends[(w, e)].other]:
             continue
-        other, even_owner = joins.ends[(w, e)]
+        other, even_owner, continued = joins.ends[(w, e)]
         owner = even_owner if course % 2 == 0 else (w if even_owner == other else other)
+        if owner == w and continued:  # its line runs on through the other wall's place: it stops where they meet
+            continue
         near = math.copysign(1.0, float(inwards @ walls[other].across))  # the other's face on this wall's side
         extent[e] = face_cut(wall, walls[other], -near if owner == w else near)
     return extent[0], extent[1]

@@ -33,6 +33,7 @@ from .drawing import DRAWING_UNITS
 from .errors import SpecError
 from .geometry import block_offsets
 from .ground_plan import SETTLEMENT_3D_KEYS, GroundInPlan, profile_in_plan
+from .imported import LAYER_ROLES as DRAWN_LAYER_ROLES
 from .mesh_drawing import MeshDrawing, read_obj
 from .on_ground import model_on_ground, plane_motion
 from .profiles import with_profile
@@ -41,7 +42,8 @@ from .spec import LENGTH_UNITS, SpecTable, read_material
 
 GEOMETRY_KEYS = ("mesh", "drawing_unit", "snap_tolerance", "ground_depth", "layers")
 TOP_KEYS = ("title", "description", "space", "length_unit", "geometry", "material", "settlement")
-LAYER_ROLES = {"unit": ROLE["unit"], "lintel": ROLE["lintel"], "ignore": -1}
+#: A layer's role (the 2D drawings' names) as the block role it gives; -1 leaves its blocks out.
+LAYER_ROLES = {name: ROLE.get(name, -1) for name in DRAWN_LAYER_ROLES}
 
 
 def is_drawn_3d(spec: dict) -> bool:

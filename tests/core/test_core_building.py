@@ -386,3 +386,59 @@ def test_a_slanted_inner_wall_is_toothed_into_the_walls_it_meets(extra):
         assert shapely.area(shapely.intersection(hulls[course][pairs[0]], hulls[course][pairs[1]])).max(
             initial=0.0) < 1e-12, level
     assert 0 < float(mf.solve(model, "la").collapse_multiplier) < 1
+
+
+def test_walls_drawn_to_a_common_point_make_the_t_and_the_crossing_of_the_walls_drawn_through():
+    """The south wall drawn as two walls meeting the cross wall's end at one point (three walls at a point, two in
+    line) lays what the south wall drawn through and the cross wall abutting it lay (a T): the same volume, no
+    overlap, the T's square the line's in even courses and the cross wall's in odd ones. Two inner walls drawn
+    as four meeting at their crossing: the crossing of the two drawn through, the square alternating."""
+    spec = house_spec()
+    spec["building"]["walls"][0:1] = [wall("south a", (0, 0), (1.2, 0)), wall("south b", (1.2, 0), (2.4, 0))]
+    spec["building"]["walls"][2]["openings"] = []
+    spec["building"]["floors"] = []
+    spec["building"]["walls"] += [wall("cross", (1.2, 0.0), (1.2, 1.8)),
+                                  wall("x a", (0.3, 0.9), (0.6, 0.9)), wall("y a", (0.6, 0.4), (0.6, 0.9)),
+                                  wall("x b", (0.6, 0.9), (1.0, 0.9)), wall("y b", (0.6, 0.9), (0.6, 1.4))]
+    model = mf.build(spec)
+    masonry = mfp.masonry_blocks(model.block_role.values)
+    t = 0.12
+    expected = (2 * t * (2.4 + 1.8) + t * (1.8 - t)) * 1.2 + t * (0.7 + 1.0 - t) * 1.2  # the crossing counted once
+    assert model.block_volume.values[masonry].sum() == pytest.approx(expected, rel=1e-12)
+    hulls, bottom = plan_polygons(model)
+    import shapely
+
+    for level in np.unique(np.round(bottom, 9)):
+        course = np.flatnonzero(np.isclose(bottom, level))
+        pairs = shapely.STRtree(hulls[course]).query(hulls[course], predicate="intersects")
+        pairs = pairs[:, pairs[0] < pairs[1]]
+        assert shapely.area(shapely.intersection(hulls[course][pairs[0]], hulls[course][pairs[1]])).max(
+            initial=0.0) < 1e-12, level
+    for point in ((1.21, 0.01), (0.61, 0.91), (0.63, 0.93)):
+        for course in range(10):
+            covering = [b for b in np.flatnonzero(masonry & np.isclose(bottom, course * 0.12))
+                        if hulls[b].contains(shapely.Point(point))]
+            assert len(covering) == 1
+            x0, y0, x1, y1 = hulls[covering[0]].bounds
+            along_x = x1 - x0 > y1 - y0 + 1e-9 or (y1 - y0 <= t + 1e-9 and x1 - x0 > t + 1e-9)
+            assert along_x == (course % 2 == 0), (point, course, hulls[covering[0]].bounds)
+    assert 0 < float(mf.solve(model, "la").collapse_multiplier) < 1
+
+
+@pytest.mark.parametrize("extra, message", [
+    ([wall("south b", (2.4, 0), (3.6, 0)), wall("y", (2.4, 0), (3.0, -1.0))],
+     "walls 'south', 'east', 'south b', 'y' meet at \\(2.4, 0\\)"),
+    ([wall("y", (2.4, 0), (3.0, -1.0))], "walls 'south', 'east', 'y' meet at \\(2.4, 0\\)"),
+])
+def test_walls_at_a_point_that_make_no_corner_t_or_crossing_are_refused(extra, message):
+    spec = house_spec()
+    spec["building"]["walls"] += extra
+    with pytest.raises(mf.SpecError, match=message):
+        mf.build(spec)
+
+
+def test_two_walls_in_line_are_one_wall():
+    spec = {"title": "w", "building": {"unit": UNIT, "walls": [wall("a", (0, 0), (1.2, 0)), wall("b", (1.2, 0), (2.4, 0))]},
+            "material": MATERIAL, "settlement": {"profile": "gaussian", "width": 0.8, "center_x": 1.9}}
+    with pytest.raises(mf.SpecError, match="walls 'a', 'b' continue each other in a line at \\(1.2, 0\\): make them one"):
+        mf.build(spec)
