@@ -24,17 +24,19 @@ CASE_NAMES = (
 DRAWN_NAMES = ("lact3-wall", "lact3-portal", "lact3-arch", "arch-settlement", "stepped-units", "gable-house")
 #: Walls over a settlement profile (``[settlement]``, docs/settlements.md and docs/tunnels.md).
 PROFILE_NAMES = ("facade-1-trough", "tunnel-facade")
-#: Buildings in 3D (``[building]``, docs/buildings.md).
+#: Buildings in 3D: laid from a ``[building]`` spec (docs/buildings.md), and drawn block by block as an OBJ mesh
+#: (``datasets/drawings``, docs/import.md section 7).
 BUILDING_NAMES = ("house-tunnel",)
+DRAWN_3D_NAMES = ("drawn-corner",)
 #: Every name :func:`bundled_spec_path` knows.
-BUNDLED_NAMES = CASE_NAMES + DRAWN_NAMES + PROFILE_NAMES + BUILDING_NAMES
+BUNDLED_NAMES = CASE_NAMES + DRAWN_NAMES + PROFILE_NAMES + BUILDING_NAMES + DRAWN_3D_NAMES
 
 
 def bundled_spec_path(name: str):
     """The spec file of a bundled case or drawn example (an ``importlib.resources`` Traversable)."""
     if name in CASE_NAMES or name in PROFILE_NAMES or name in BUILDING_NAMES:
         return resources.files(__name__).joinpath(f"{name}.toml")
-    if name in DRAWN_NAMES:
+    if name in DRAWN_NAMES or name in DRAWN_3D_NAMES:
         return resources.files(__name__).joinpath("drawings", f"{name}.toml")
     raise ModelError(f"unknown bundled case {name!r}; valid names: {', '.join(BUNDLED_NAMES)}")
 

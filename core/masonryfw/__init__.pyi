@@ -9,6 +9,7 @@ from .datasets import (
     BUILDING_NAMES,
     BUNDLED_NAMES,
     CASE_NAMES,
+    DRAWN_3D_NAMES,
     DRAWN_NAMES,
     PROFILE_NAMES,
     bundled_cases,
@@ -36,7 +37,7 @@ __all__ = [
     # Models: from a spec, a drawing, a file or a bundled case
     "STAND_IN_GROUND", "build", "load_spec", "load_wall", "dump_toml",
     "open_model", "open_checked", "checked_model", "describe_model",
-    "BUILDING_NAMES", "BUNDLED_NAMES", "CASE_NAMES", "DRAWN_NAMES", "PROFILE_NAMES", "bundled_cases", "bundled_spec_path",
+    "BUILDING_NAMES", "BUNDLED_NAMES", "CASE_NAMES", "DRAWN_3D_NAMES", "DRAWN_NAMES", "PROFILE_NAMES", "bundled_cases", "bundled_spec_path",
     "Profile", "model_profile", "settlement_profile", "ground_model", "over_profile",
     "detect_interfaces", "Problem", "check", "PlausibilityWarning", "plausibility",
     # Solving, comparing, drawing

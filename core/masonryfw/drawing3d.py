@@ -87,7 +87,7 @@ def build_drawn_3d(spec: dict, text: str, base_dir: Path | None) -> xr.Dataset:
     ground = polyhedra.vertical_prisms(*_rings(pieces), np.full(len(pieces), level - depth), np.full(len(pieces), level))
     motion = np.array([_piece_motion(ground_plan, piece, depth) for piece in pieces])
     volume, _ = polyhedra.volumes_centroids(masonry)
-    attrs = {"title": top.text("title"), "source_spec": text, "drawing": path.name,
+    attrs = {"title": top.text("title"), "source_spec": text, "source_drawing": path.name,
              "settlement_axis": ground_plan.axis_attr(),
              **({"laying_notes": "\n".join(drawing.notes)} if drawing.notes else {}),
              **({"comment": top.text("description")} if top.has("description") else {})}

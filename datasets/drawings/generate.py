@@ -24,6 +24,10 @@ rewrites every ``<name>.dxf``/``.geojson`` and ``<name>.toml`` in this folder.
   gable-fronted terraced house (6.5 m wide, eaves 8.5 m, ridge 10.5 m, on layer OUTLINE) and its door and
   five windows (layer OPENINGS; the top one has a semicircular head, drawn as an arc), in mm, as
   architects draw them. The spec lays an English bond in it (``geometry.outline_layer``).
+- ``drawn-corner``: a corner of a building drawn block by block in 3D, as a modeller exports it (an OBJ file,
+  one object per brick, the lintel on its own material): two walls 2.4 and 1.8 m long, 1.2 m high, one brick
+  (0.12 m) thick, toothed course by course, a window with a lintel; written here brick by brick, not by
+  masonryfw's building laying.
 - ``stepped-units``: a running-bond wall whose units are partly merged in pairs
   into stepped (non-convex) blocks, as a GeoJSON polygon file; the right part of
   its base settles. ``stepped_wall(merged=False)`` is the same wall in rectangles.
@@ -268,7 +272,65 @@ def gable_house() -> tuple[list[list], list[str]]:
     return polygons, ["OUTLINE"] + ["OPENINGS"] * (len(polygons) - 1)
 
 
+#: The drawn corner [m]: brick length, height and depth; the walls' lengths; the window (x0, x1, courses) in
+#: the long wall and its lintel's bearing.
+CORNER = {"brick": (0.24, 0.12, 0.12), "long": 2.4, "short": 1.8, "courses": 10, "window": (0.96, 1.44, 3, 6),
+          "bearing": 0.12}
+
+
+def _cut(a: float, b: float, first_joint: float, unit: float) -> list[tuple[float, float]]:
+    """``[a, b]`` in units from ``first_joint`` on, a piece under a quarter unit joined to its neighbour."""
+    joints = [a] + [j for j in (first_joint + k * unit for k in range(200)) if a + 1e-9 < j < b - 1e-9] + [b]
+    pieces = list(zip(joints[:-1], joints[1:]))
+    if len(pieces) > 1 and pieces[-1][1] - pieces[-1][0] < 0.25 * unit - 1e-9:
+        pieces[-2:] = [(pieces[-2][0], pieces[-1][1])]
+    return pieces
+
+
+def drawn_corner() -> tuple[list[tuple[tuple, tuple]], list[str]]:
+    """The corner's bricks as boxes ``((x0, y0, z0), (x1, y1, z1))`` and their materials: the long wall along x
+    from x = 0 (y from 0 to the depth), the short one along y at its end; in even courses the long wall runs
+    to the corner's outside, in odd ones the short wall does; running bond from each wall's free end."""
+    c = CORNER
+    length, height, depth = c["brick"]
+    x0, x1, k0, k1 = c["window"]
+    boxes, materials = [], []
+    for k in range(c["courses"]):
+        z = (k * height, (k + 1) * height)
+        shift = 0.5 * length * (k % 2)
+        end = c["long"] if k % 2 == 0 else c["long"] - depth
+        spans = [(0.0, end)] if not k0 <= k < k1 else [(0.0, x0), (x1, end)]
+        if k == k1:  # the lintel's course
+            lintel = (x0 - c["bearing"], x1 + c["bearing"])
+            spans = [(0.0, lintel[0]), (lintel[1], end)]
+            boxes.append(((lintel[0], 0.0, z[0]), (lintel[1], depth, z[1])))
+            materials.append("LINTEL")
+        for a, b in spans:
+            for p, q in _cut(a, b, shift + length if shift else length, length):
+                boxes.append(((p, 0.0, z[0]), (q, depth, z[1])))
+                materials.append("BRICK")
+        start = depth if k % 2 == 0 else 0.0  # the short wall, from the corner to its free end at y = short
+        for p, q in _cut(start, c["short"], c["short"] - (length if k % 2 == 0 else 1.5 * length) - 20 * length,
+                         length):
+            boxes.append(((c["long"] - depth, p, z[0]), (c["long"], q, z[1])))
+            materials.append("BRICK")
+    return boxes, materials
+
+
 # ---------------------------------------------------------------- writing
+
+
+def write_obj(path: Path, boxes: list[tuple[tuple, tuple]], materials: list[str]) -> None:
+    """One object per box (eight vertices, six quadrilaterals turned outward), its material named."""
+    lines = ["# drawn-corner: one object per brick, metres (masonryfw datasets/drawings/generate.py)"]
+    faces = ((1, 4, 3, 2), (5, 6, 7, 8), (1, 2, 6, 5), (2, 3, 7, 6), (3, 4, 8, 7), (4, 1, 5, 8))
+    for number, ((x0, y0, z0), (x1, y1, z1)) in enumerate(boxes):
+        first = 8 * number
+        lines += [f"o brick {number + 1}", f"usemtl {materials[number]}"]
+        lines += [f"v {x:.6f} {y:.6f} {z:.6f}" for z in (z0, z1) for x, y in ((x0, y0), (x1, y0), (x1, y1), (x0, y1))]
+        lines += ["f " + " ".join(str(first + v) for v in face) for face in faces]
+    path.write_text("\n".join(lines) + "\n")
+
 
 def write_dxf(path: Path, polygons: list, layers: list[str], insunits: int = 4, points: bool = False) -> None:
     """One LWPOLYLINE per block (``(x, y)`` or ``(x, y, bulge)`` vertices). A polygon whose last vertex
@@ -306,6 +368,7 @@ def write_all(folder: Path = HERE) -> None:
     write_dxf(folder / "arch-settlement.dxf", *settling_arch())
     write_geojson(folder / "stepped-units.geojson", *stepped_wall())
     write_dxf(folder / "gable-house.dxf", *gable_house())
+    write_obj(folder / "drawn-corner.obj", *drawn_corner())
 
 
 if __name__ == "__main__":

@@ -133,3 +133,23 @@ def test_a_house_drawn_in_3d_builds_checks_and_solves_from_a_spec_file(tmp_path)
         building.block_volume.values[masonry].sum(), rel=1e-12)
     assert (drawn.block_role.values == mfp.flags("block_role")["lintel"]).sum() == layers.count("LINTEL")
     assert 0 < float(mf.solve(drawn, "la").collapse_multiplier) < 1
+
+
+def test_the_bundled_3d_drawing_is_the_corner_its_generator_describes(tmp_path):
+    """``drawn-corner`` (datasets/drawings): the file bundled is what its generator writes, and the model read
+    from it holds the corner's masonry (two walls 2.4 and 1.8 m on their outer faces, 0.12 m thick, 1.2 m high,
+    less a 0.48 x 0.36 m window) with its one lintel, stands on moving ground, and solves."""
+    from importlib import resources
+
+    from masonryfw.datasets.drawings import generate
+
+    generate.write_obj(tmp_path / "corner.obj", *generate.drawn_corner())
+    bundled = resources.files("masonryfw.datasets").joinpath("drawings", "drawn-corner.obj").read_text()
+    assert bundled == (tmp_path / "corner.obj").read_text()
+    model = mf.open_model("drawn-corner")
+    masonry = mfp.masonry_blocks(model.block_role.values)
+    assert model.block_volume.values[masonry].sum() == pytest.approx(0.12 * (2.4 + 1.8 - 0.12) * 1.2 - 0.12 * 0.48
+                                                                     * 0.36, rel=1e-12)
+    assert (model.block_role.values == mfp.flags("block_role")["lintel"]).sum() == 1
+    assert (model.block_role.values == mfp.flags("block_role")["moving_support"]).sum() > 0
+    assert 0 < float(mf.solve(model, "la").collapse_multiplier) < 1
