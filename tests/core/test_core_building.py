@@ -442,3 +442,26 @@ def test_two_walls_in_line_are_one_wall():
             "material": MATERIAL, "settlement": {"profile": "gaussian", "width": 0.8, "center_x": 1.9}}
     with pytest.raises(mf.SpecError, match="walls 'a', 'b' continue each other in a line at \\(1.2, 0\\): make them one"):
         mf.build(spec)
+
+
+def test_a_slanted_flemish_house_over_a_tunnel_face_in_millimetres_is_the_house_in_metres():
+    """Every new length at once in mm (walls at 77 to 103 degrees, two leaves in Flemish bond, a door, a tunnel
+    with its face under the house): the same blocks and alpha as in metres (scaled inputs are
+    non-dimensionalised inside)."""
+    def spec(scale: float) -> dict:
+        points = [(0, 0), (2.4, 0), (2.0, 1.8), (0.3, 1.8)]
+        walls = [wall(name, [scale * c for c in points[i]], [scale * c for c in points[(i + 1) % 4]],
+                      height=1.2 * scale, thickness=0.24 * scale) for i, name in enumerate("senw")]
+        walls[0]["openings"] = [{"x": 0.96 * scale, "y": 0.0, "width": 0.48 * scale, "height": 0.72 * scale}]
+        return {"title": "t", "length_unit": "mm" if scale == 1000 else "m",
+                "building": {"unit": {"length": 0.24 * scale, "height": 0.12 * scale, "depth": 0.12 * scale},
+                             "walls": walls, "bond": "flemish"},
+                "material": MATERIAL, "settlement": {"profile": "tunnel", "volume_loss": 2.0, "diameter": 3.0 * scale,
+                                                     "depth": 6.0 * scale, "axis_angle": 60.0, "center_x": 2.0 * scale,
+                                                     "center_y": 0.5 * scale, "face": 1.0 * scale}}
+
+    metres, millimetres = mf.build(spec(1.0)), mf.build(spec(1000.0))
+    assert millimetres.sizes == metres.sizes
+    np.testing.assert_allclose(millimetres.node_x.values, metres.node_x.values, rtol=1e-12, atol=1e-12)
+    assert float(mf.solve(millimetres, "la").collapse_multiplier) == pytest.approx(
+        float(mf.solve(metres, "la").collapse_multiplier), rel=1e-9)
