@@ -296,6 +296,18 @@ def plan_polygons(model):
     return np.array(hulls, dtype=object), low[:, 2]
 
 
+def assert_no_two_blocks_of_a_course_share_area(hulls, bottom) -> None:
+    """Blocks of one course (one bottom level) whose plans overlap by any area."""
+    import shapely
+
+    for level in np.unique(np.round(bottom, 9)):
+        course = np.flatnonzero(np.isclose(bottom, level))
+        pairs = shapely.STRtree(hulls[course]).query(hulls[course], predicate="intersects")
+        pairs = pairs[:, pairs[0] < pairs[1]]
+        common = shapely.area(shapely.intersection(hulls[course][pairs[0]], hulls[course][pairs[1]]))
+        assert common.max(initial=0.0) < 1e-12, level
+
+
 @pytest.mark.parametrize("bond, thickness", [("running", 0.12), ("flemish", 0.24)])
 def test_walls_meeting_at_other_angles_are_mitred_and_toothed(bond, thickness):
     """A house whose plan is a trapezoid (corners of 77, 103, 97 and 83 degrees), with a door: its masonry fills
@@ -319,13 +331,7 @@ def test_walls_meeting_at_other_angles_are_mitred_and_toothed(bond, thickness):
     assert model.block_volume.values[masonry].sum() == pytest.approx(ring.area * 1.2 - thickness * 0.48 * 0.72,
                                                                      rel=1e-12)
     hulls, bottom = plan_polygons(model)
-    for level in np.unique(np.round(bottom, 9)):
-        course = np.flatnonzero(np.isclose(bottom, level))
-        tree = shapely.STRtree(hulls[course])
-        pairs = tree.query(hulls[course], predicate="intersects")
-        pairs = pairs[:, pairs[0] < pairs[1]]
-        common = shapely.area(shapely.intersection(hulls[course][pairs[0]], hulls[course][pairs[1]]))
-        assert common.max(initial=0.0) < 1e-12, level
+    assert_no_two_blocks_of_a_course_share_area(hulls, bottom)
     outer = np.asarray(plan.buffer(thickness / 2, join_style="mitre").exterior.coords)[:-1]
     centre = np.array(plan.centroid.coords[0])
     for corner in outer:
@@ -379,12 +385,7 @@ def test_a_slanted_inner_wall_is_toothed_into_the_walls_it_meets(extra):
     assert model.block_volume.values[masonry].sum() == pytest.approx(shapely.union_all([ring, *strips]).area * 1.2,
                                                                      rel=1e-12)
     hulls, bottom = plan_polygons(model)
-    for level in np.unique(np.round(bottom, 9)):
-        course = np.flatnonzero(np.isclose(bottom, level))
-        pairs = shapely.STRtree(hulls[course]).query(hulls[course], predicate="intersects")
-        pairs = pairs[:, pairs[0] < pairs[1]]
-        assert shapely.area(shapely.intersection(hulls[course][pairs[0]], hulls[course][pairs[1]])).max(
-            initial=0.0) < 1e-12, level
+    assert_no_two_blocks_of_a_course_share_area(hulls, bottom)
     assert 0 < float(mf.solve(model, "la").collapse_multiplier) < 1
 
 
@@ -408,12 +409,7 @@ def test_walls_drawn_to_a_common_point_make_the_t_and_the_crossing_of_the_walls_
     hulls, bottom = plan_polygons(model)
     import shapely
 
-    for level in np.unique(np.round(bottom, 9)):
-        course = np.flatnonzero(np.isclose(bottom, level))
-        pairs = shapely.STRtree(hulls[course]).query(hulls[course], predicate="intersects")
-        pairs = pairs[:, pairs[0] < pairs[1]]
-        assert shapely.area(shapely.intersection(hulls[course][pairs[0]], hulls[course][pairs[1]])).max(
-            initial=0.0) < 1e-12, level
+    assert_no_two_blocks_of_a_course_share_area(hulls, bottom)
     for point in ((1.21, 0.01), (0.61, 0.91), (0.63, 0.93)):
         for course in range(10):
             covering = [b for b in np.flatnonzero(masonry & np.isclose(bottom, course * 0.12))
