@@ -24,9 +24,9 @@ CASE_NAMES = (
 DRAWN_NAMES = ("lact3-wall", "lact3-portal", "lact3-arch", "arch-settlement", "stepped-units", "gable-house")
 #: Walls over a settlement profile (``[settlement]``, docs/settlements.md and docs/tunnels.md).
 PROFILE_NAMES = ("facade-1-trough", "tunnel-facade")
-#: Buildings in 3D: laid from a ``[building]`` spec (docs/buildings.md), and drawn block by block as an OBJ mesh
-#: (``datasets/drawings``, docs/import.md section 7).
+#: Buildings in 3D laid from a ``[building]`` spec (docs/buildings.md).
 BUILDING_NAMES = ("house-tunnel",)
+#: Buildings in 3D drawn block by block as an OBJ mesh (``datasets/drawings``, docs/import.md section 7).
 DRAWN_3D_NAMES = ("drawn-corner",)
 #: Every name :func:`bundled_spec_path` knows.
 BUNDLED_NAMES = CASE_NAMES + DRAWN_NAMES + PROFILE_NAMES + BUILDING_NAMES + DRAWN_3D_NAMES
