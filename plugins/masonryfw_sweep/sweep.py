@@ -156,9 +156,12 @@ SHUTDOWN_LOGGERS = ("tornado", "distributed", "asyncio")
 
 def quiet_shutdown() -> None:
     """After Ctrl-C the cluster closes with its workers already stopping: a comm closed under a pending callback is
-    logged with its traceback (once in a CI run, the interrupted sweep's message came with one). The user asked
-    it to stop and is told what the store kept: nothing else is worth saying."""
-    for name in SHUTDOWN_LOGGERS:
+    logged with its traceback (twice in CI runs, the interrupted sweep's message came with one). The user asked
+    it to stop and is told what the store kept: nothing else is worth saying. Every logger under these names is
+    quieted, not only the top ones: distributed's configuration gives ``tornado.application``, which reports a
+    failed callback, its own level (ERROR) and handler, so quieting ``tornado`` alone left it talking."""
+    names = [name for name in list(logging.root.manager.loggerDict) if name.split(".")[0] in SHUTDOWN_LOGGERS]
+    for name in {*SHUTDOWN_LOGGERS, *names}:
         logging.getLogger(name).setLevel(logging.CRITICAL + 1)
 
 

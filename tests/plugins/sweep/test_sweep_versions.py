@@ -66,3 +66,24 @@ def test_a_changed_solver_is_solved_again_and_an_unchanged_one_is_reused(tmp_pat
     assert fixed.attrs["solver_version"] != version and fixed.attrs["solver_version"].startswith("1.0+")
     np.testing.assert_array_equal(fixed.alpha.values, [0.25, 0.25])
     assert (first.key.values != fixed.key.values).all()
+
+
+def test_after_ctrl_c_no_logger_of_the_event_loop_or_dask_reports_a_failed_callback():
+    """An interrupted sweep's message came with tornado's 'Exception in callback' traceback in CI: quieting the
+    'tornado' logger left 'tornado.application', which distributed's configuration gives its own level (ERROR)
+    and handler. Every logger under tornado, distributed and asyncio is quiet after quiet_shutdown."""
+    import logging
+
+    import distributed  # noqa: F401  (configures its loggers and tornado's, as a sweep's cluster does)
+
+    from masonryfw_sweep.sweep import SHUTDOWN_LOGGERS, quiet_shutdown
+
+    names = [n for n in logging.root.manager.loggerDict if n.split(".")[0] in SHUTDOWN_LOGGERS]
+    assert "tornado.application" in names and logging.getLogger("tornado.application").isEnabledFor(logging.ERROR)
+    saved = {name: logging.getLogger(name).level for name in names}
+    try:
+        quiet_shutdown()
+        assert not any(logging.getLogger(name).isEnabledFor(logging.CRITICAL) for name in names)
+    finally:
+        for name, level in saved.items():
+            logging.getLogger(name).setLevel(level)
