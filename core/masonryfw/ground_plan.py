@@ -24,7 +24,6 @@ from dataclasses import dataclass
 from typing import NamedTuple
 
 import numpy as np
-from scipy.special import ndtr
 
 from .errors import SpecError
 from .profiles import SETTLEMENT_KEYS, Profile, beyond_cutoff, model_profile, read_profile
@@ -63,6 +62,8 @@ class GroundInPlan(NamedTuple):
         horizontal = self.profile.horizontal(u)[:, None] * self.across
         if self.face is None:
             return rate, horizontal
+        from scipy.special import ndtr  # here: building a wall need not import scipy.special
+
         v = (xy - self.point) @ self.axis
         width = self.profile.width
         behind = ndtr((self.face - v) / width)

@@ -17,11 +17,9 @@ from pathlib import Path
 from typing import NamedTuple
 
 import numpy as np
-from scipy.sparse import coo_matrix
-from scipy.sparse.csgraph import connected_components
-from scipy.spatial import cKDTree
 
 from .errors import SpecError
+from .inputs import read_text
 from .polyhedra import Polyhedra, polygon_normals, volumes_centroids
 
 
@@ -71,7 +69,7 @@ def read_obj(path: Path, snap: float | None) -> MeshDrawing:
 
 
 def _parse(path: Path) -> tuple[np.ndarray, list[_Face], dict[str, int]]:
-    text = path.read_text(encoding="utf-8", errors="replace")
+    text = read_text(path, "3D drawing (an OBJ mesh)")  # a regular file of UTF-8, at most TEXT_LIMIT bytes
     has_objects = any(line.lstrip().startswith("o ") for line in text.splitlines())
     vertices: list[list[float]] = []
     faces: list[_Face] = []
@@ -125,6 +123,10 @@ def _face_nodes(path: Path, number: int, raw: str, words: list[str], count: int)
 
 def _snapped(vertices: np.ndarray, tol: float) -> np.ndarray:
     """Every vertex's representative: the first drawn of those within ``tol`` of it (transitively)."""
+    from scipy.sparse import coo_matrix  # here, as in the two functions below: building a wall reads no mesh
+    from scipy.sparse.csgraph import connected_components
+    from scipy.spatial import cKDTree
+
     pairs = cKDTree(vertices).query_pairs(tol, output_type="ndarray")
     n = len(vertices)
     graph = coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), shape=(n, n))
@@ -136,6 +138,9 @@ def _snapped(vertices: np.ndarray, tol: float) -> np.ndarray:
 
 def _blocks_of(faces: list[_Face], same: np.ndarray) -> tuple[list[str], dict[str, list[int]]]:
     """The blocks' names and their faces: objects or groups as named; without either, the mesh's pieces."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
     if all(face.block for face in faces):
         groups: dict[str, list[int]] = {}
         for i, face in enumerate(faces):

@@ -153,3 +153,11 @@ def test_the_bundled_3d_drawing_is_the_corner_its_generator_describes(tmp_path):
     assert (model.block_role.values == mfp.flags("block_role")["lintel"]).sum() == 1
     assert (model.block_role.values == mfp.flags("block_role")["moving_support"]).sum() > 0
     assert 0 < float(mf.solve(model, "la").collapse_multiplier) < 1
+
+
+def test_a_mesh_that_is_not_text_is_refused_naming_the_file_before_it_is_read_whole(tmp_path):
+    """The OBJ is read like every drawing (masonryfw.inputs.read_text): bounded, UTF-8, a regular file."""
+    path = tmp_path / "box.obj"
+    path.write_bytes(b"o box\nv 0 0 0\n\xff\xfe not text\n")
+    with pytest.raises(mf.MasonryError, match="box.obj.*UTF-8"):
+        mf.build(drawn_spec(path))
