@@ -1,6 +1,11 @@
 """What the tests share to run ``python -m masonryfw`` as a user would and look at it from outside: its exit
 status and stderr (:func:`cli`, :func:`refused`), its peak memory (:func:`peak_memory`), the hidden files it
-leaves (:func:`hidden`), and a command signalled when its stderr says a phase has begun (:class:`Command`)."""
+leaves (:func:`hidden`), a command signalled when its stderr says a phase has begun (:class:`Command`), and a
+process held still (:func:`stopped`) while a test looks at what it is doing and signals it there.
+
+No test here depends on winning a race against the scheduler: a signal is sent at a point the test has seen
+the process reach (a line on its stderr), while the process is stopped where the test has looked at it (its
+open files, the files in its folder), never after a delay."""
 from __future__ import annotations
 
 import os
@@ -10,6 +15,8 @@ import signal
 import subprocess
 import sys
 import time
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
 
@@ -81,6 +88,40 @@ class Command:
         if self.process.poll() is None:
             self.process.kill()
             self.process.communicate()
+
+
+def process_state(pid: int) -> str:
+    """The state letter of process ``pid`` in /proc (R, S, D, T, Z, ...), or "" once it is gone."""
+    try:
+        return Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
+    except (FileNotFoundError, ProcessLookupError, IndexError):
+        return ""
+
+
+def open_files(pid: int) -> list[str]:
+    """The paths of the files process ``pid`` holds open."""
+    names = []
+    for fd in Path(f"/proc/{pid}/fd").iterdir() if Path(f"/proc/{pid}/fd").is_dir() else ():
+        try:
+            names.append(os.readlink(fd))
+        except OSError:  # closed since
+            pass
+    return names
+
+
+@contextmanager
+def stopped(process: subprocess.Popen) -> Iterator[bool]:
+    """Hold ``process`` still (SIGSTOP) for the block; yield whether it was still running (not ended) when it
+    stopped; let it go on (SIGCONT) after. A signal sent inside the block reaches the process at the very point
+    where the block saw it, the moment it goes on."""
+    process.send_signal(signal.SIGSTOP)
+    while process_state(process.pid) not in ("T", "t", "Z", "X", ""):
+        time.sleep(0.0002)
+    try:
+        yield process_state(process.pid) in ("T", "t")
+    finally:
+        if process.poll() is None:
+            process.send_signal(signal.SIGCONT)
 
 
 def tilted_drawing_spec(drawing, key: str = "dxf", unit: str | None = None, thickness: float = 0.1,

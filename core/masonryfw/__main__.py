@@ -19,7 +19,7 @@ def main(argv: list[str] | None = None) -> None:
     try:
         run(argv)
     except SystemExit as end:
-        signals.exiting(f"the command had ended (status {end.code})")
+        signals.exiting(end.code if isinstance(end.code, int) else int(end.code is not None))
         raise
 
 

@@ -365,6 +365,8 @@ def write_atomically(writes: dict[Path, Callable[[Path], object]], shown: str | 
                 write(temporaries[target])
                 if target.exists():
                     shutil.copymode(target, temporaries[target])
+            if signals.settles(writes):  # the command's last output: a signal from here on changes nothing
+                signals.settle()
             for target, temporary in temporaries.items():
                 os.replace(temporary, target)
                 signals.WRITTEN.append(target)

@@ -131,6 +131,11 @@ def _not_a_lock(path: Path, what: str, problem: str) -> str:
             "masonryfw process is writing there")
 
 
+def held_claims() -> set[Path]:
+    """The outputs this process has claimed and not yet released (written or given up)."""
+    return set(_HELD)
+
+
 def release(target: Path) -> None:
     """Give up the claim on ``target`` (nothing when not held), removing its lock file (the one still ours)."""
     fd = _HELD.pop(target, None)

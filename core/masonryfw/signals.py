@@ -1,14 +1,19 @@
 """What Ctrl-C (SIGINT) and SIGTERM do: the command line's handlers, signals held where an exception would do
-harm, interrupts that are not lost.
+harm, interrupts that are not lost, and the moment a command's outcome is settled.
 
 **The command line** (:func:`install`) takes both signals alike from its first line: SIGINT raises
 ``KeyboardInterrupt``, SIGTERM :class:`Terminated` (one), and each is remembered, so the command ends with
 ``128 + signal`` (:func:`exit_status`) and a line saying what was kept. A signal the process inherited as
 ignored stays ignored, as Python itself leaves it: a shell script's background job ignores SIGINT, so that a
-Ctrl-C meant for the foreground does not stop it; SIGTERM still does. Once the command is over
-(:func:`exiting`), a signal ends the process at once with that status; in the last instants of the
-interpreter's shutdown, after its exit functions, when Python no longer handles signals, they are ignored
-(a signal there killed the process, status -2, after its work was done and said).
+Ctrl-C meant for the foreground does not stop it; SIGTERM still does.
+
+**Settled** (:func:`settle`): a command's outcome is settled when the last of the outputs it claimed before
+its work (:mod:`masonryfw.locks`) is about to be renamed into place, or when the command ends. From then on a
+signal changes nothing: the command says what it did and exits with its own status (0 with a complete result;
+during the interpreter's shutdown the process ends at once with that status). The boundary is the rename of
+the last output, which a test can observe from outside, so what a signal does never depends on how fast the
+process runs: a signal while the file is still being written gives 130 (143) and the complete file; one
+once it is in place gives exit 0 and the same file.
 
 **Held** (:func:`held`): some code must not be cut at an arbitrary instruction. A ``KeyboardInterrupt``
 raised inside the netCDF library's close (xarray holds a lock there) left the process waiting for that lock
@@ -18,7 +23,7 @@ held, the two signals are only noted; the first is acted on, as the handler befo
 checkpoint the code chooses or when the block ends. :func:`deferred` holds a write until the file is
 complete and renamed onto its target, then raises :class:`WriteInterrupted` (a ``KeyboardInterrupt`` that
 names the file written) where Python's handler or the command line's is installed, and takes the signal's
-own action otherwise.
+own action otherwise. A signal noted once the outcome is settled is dropped.
 
 **Dropped** interrupts: Python code run from a finalizer, a weakref callback or a C callback cannot raise; a
 ``KeyboardInterrupt`` raised there is printed and dropped. The command line's hook of unraisable exceptions
@@ -46,6 +51,13 @@ RECEIVED: list[int] = []
 WRITTEN: list[Path] = []
 
 
+class _Command:
+    """Whether the command line's handlers are installed, and whether its outcome is settled."""
+
+    answering = False
+    settled = False
+
+
 class Terminated(KeyboardInterrupt):
     """SIGTERM, taken as Ctrl-C is: what an interrupted command keeps, it keeps; temporary files are removed."""
 
@@ -68,6 +80,7 @@ def install() -> None:
     requires), its hook of dropped interrupts, nothing received or written yet."""
     RECEIVED.clear()
     WRITTEN.clear()
+    _Command.answering, _Command.settled = True, False
     for signum in _answered():
         signal.signal(signum, _take)
     if not isinstance(sys.unraisablehook, _SendAgain):
@@ -86,13 +99,42 @@ def kept() -> str:
         "interrupted: nothing written"
 
 
-def exiting(done: str) -> None:
-    """The command is over (``done`` says how it ended): a signal now, while the interpreter shuts down, ends the
-    process at once with ``128 + signal`` and one line, rather than a traceback from a finalizer."""
-    def end(signum: int, frame) -> None:
-        os.write(2, f"interrupted while exiting: {done}\n".encode())
-        os._exit(128 + signum)
+def settle() -> None:
+    """The command's outcome is settled (see the module docstring): SIGINT and SIGTERM, where answered, are
+    dropped from now on, and a signal noted while a write is held is dropped. Outside the command line (no
+    :func:`install`), nothing changes: a script's Ctrl-C is never dropped."""
+    if not _Command.answering or threading.current_thread() is not threading.main_thread():
+        return
+    _Command.settled = True
+    for signum in _answered():
+        signal.signal(signum, _dropped)
 
+
+def _dropped(signum: int, frame) -> None:
+    """A signal once the outcome is settled: nothing to do. (A handler rather than ``SIG_IGN``: a signal that
+    came just before the switch would otherwise be reported by Python as "ignored due to race condition".)"""
+
+
+def settles(targets) -> bool:
+    """Whether writing ``targets`` puts the command's last claimed output in place (:mod:`masonryfw.locks`)."""
+    from .locks import held_claims
+
+    return _Command.answering and held_claims() <= set(targets)
+
+
+def exiting(status: int) -> None:
+    """The command is over with ``status``: its outcome is settled, and a signal now, while the interpreter
+    shuts down, ends the process at once with that same status (what is written and said stands), rather
+    than with a traceback from a finalizer."""
+    def end(signum: int, frame) -> None:
+        for stream in (sys.stdout, sys.stderr):
+            try:
+                stream.flush()
+            except Exception:  # noqa: BLE001 - interrupted inside a write of that stream: what it holds is lost
+                pass
+        os._exit(status)
+
+    _Command.settled = True
     for signum in _answered():
         signal.signal(signum, end)
 
@@ -158,8 +200,11 @@ def _holding() -> Iterator[tuple[list[int], Callable[[int, Path | None], None]]]
     if threading.current_thread() is not threading.main_thread():
         yield noted, lambda signum, path: None
         return
-    previous: dict[int, Any] = {signum: signal.signal(signum, lambda signum, frame: noted.append(signum))
-                                for signum in DEFERRED}
+    def note(signum: int, frame) -> None:
+        if not _Command.settled:
+            noted.append(signum)
+
+    previous: dict[int, Any] = {signum: signal.signal(signum, note) for signum in DEFERRED}
 
     def act(signum: int, path: Path | None) -> None:
         handler = previous[signum]
@@ -176,4 +221,4 @@ def _holding() -> Iterator[tuple[list[int], Callable[[int, Path | None], None]]]
         yield noted, act
     finally:
         for signum, handler in previous.items():
-            signal.signal(signum, handler)
+            signal.signal(signum, _dropped if _Command.settled and callable(handler) else handler)

@@ -3,7 +3,6 @@ from __future__ import annotations
 
 import copy
 import math
-import time
 
 import numpy as np
 import pytest
@@ -267,16 +266,13 @@ def test_a_missing_spec_file_is_a_spec_error(tmp_path):
         load_spec(str(tmp_path / "nothing.toml"))
 
 
-def test_a_hundred_by_hundred_wall_builds_in_well_under_two_seconds():
+def test_a_hundred_by_hundred_wall_has_its_units_counted_by_hand():
+    """Its build time is a benchmark (benchmarks/bench_interfaces.py), not a timed test."""
     spec = wall_spec(width=100 * 0.2, height=100 * 0.05, loading={"type": "settlement"},
                      supports={"f": {"kind": "fixed", "start": 0.0, "end": 10.0},
                                "m": {"kind": "moving", "start": 10.0, "end": 20.0}})
-    build(wall_spec())  # warm up lazy imports
-    start = time.perf_counter()
     ds = build(spec)
-    elapsed = time.perf_counter() - start
     assert int(np.sum(ds.block_role.values == ROLE["unit"])) == 50 * 100 + 50 * 101
-    assert elapsed < 1.0
 
 
 # --------------------------------------------------------------------------- spec errors

@@ -465,4 +465,4 @@ def test_ctrl_c_is_answered_within_seconds_however_long_a_record_of_the_run_is(t
     finally:
         running.stop()
     assert status == 130 and "Traceback" not in stderr and "nothing written" in stderr, stderr[-2000:]
-    assert answered < 30, f"answered {answered:.1f} s after the signal"
+    assert answered < 60, f"answered {answered:.1f} s after the signal"

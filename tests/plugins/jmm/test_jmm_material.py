@@ -151,13 +151,9 @@ def test_vertex_tangent_is_the_stated_fraction_of_elasticity():
     np.testing.assert_allclose(tangent[0], 1e-3 * D, atol=1e-14)
 
 
-def test_vectorised_return_handles_many_points_quickly():
-    import time
-
+def test_vectorised_return_puts_many_points_on_or_inside_the_yield_surface():
     D = elastic_matrix(2.4, 0.2)
     rmap = ReturnMap(JointStrength(MU, MU, beta=0.8), D)
     trials = np.random.default_rng(3).normal(size=(100_000, 3))
-    start = time.perf_counter()
     stress, _, _, _ = rmap(trials)
-    assert time.perf_counter() - start < 5.0
     assert (yield_values(rmap, stress) <= 1e-9 * (1 + np.abs(trials).max(axis=1, keepdims=True))).all()
