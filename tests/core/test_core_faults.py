@@ -17,7 +17,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from support import cli, hidden, open_files, peak_memory, refused, stopped, tilted_drawing_spec
+from support import Command, cli, hidden, open_files, peak_memory, refused, stopped, tilted_drawing_spec
 
 import masonryfw as mf
 import masonryfw.plugin_api as mfp
@@ -56,8 +56,7 @@ def _signal_the_writer(folder: Path, signum: int, moment: str) -> tuple[int, str
     ``"writing"``, its temporary output open in the netCDF library; ``"in place"``, its output renamed into place
     (the process not yet ended). The status, stdout and stderr."""
     for _ in range(20):
-        process = subprocess.Popen([sys.executable, "-m", "masonryfw", "build", "big.toml", "-o", "out.nc"],
-                                   cwd=folder, stderr=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
+        process = Command(["build", "big.toml", "-o", "out.nc"], folder).process
         sent = False
         while process.poll() is None and not sent:
             temporaries = [n for n in os.listdir(folder) if n.startswith(".out.nc.") and n.endswith(".tmp.nc")]
@@ -441,9 +440,8 @@ def test_a_sweep_refuses_a_store_another_sweep_is_using(tmp_path):
 
 def test_an_interrupted_sweep_says_what_its_store_kept(tmp_path):
     """It said "interrupted: nothing written" while its store kept the points solved so far."""
-    sweep = subprocess.Popen([sys.executable, "-m", "masonryfw", "sweep", "panel-1", "--plugin", "fdem", "--param",
-                              "wall.thickness=0.05,0.06,0.07,0.08,0.09,0.1", "--workers", "1", "--no-progress",
-                              "-o", "s.nc"], cwd=tmp_path, stderr=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
+    sweep = Command(["sweep", "panel-1", "--plugin", "fdem", "--param", "wall.thickness=0.05,0.06,0.07,0.08,0.09,0.1",
+                     "--workers", "1", "--no-progress", "-o", "s.nc"], tmp_path).process
     results = tmp_path / "s.store" / "results"
     while not list(results.glob("*.json")):  # five fdem runs to go: far more than the test needs to answer
         assert sweep.poll() is None, sweep.communicate()[1]

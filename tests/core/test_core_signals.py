@@ -15,6 +15,7 @@ from masonryfw import signals
 def command_line():
     """The command line's handlers installed in this process for one test, then this process's own restored."""
     before = {signum: signal.getsignal(signum) for signum in signals.DEFERRED}
+    signal.signal(signal.SIGINT, signal.default_int_handler)  # as a terminal leaves it (a background job ignores it)
     signals.install()
     yield
     signals._Command.answering = signals._Command.settled = False
@@ -55,8 +56,12 @@ def test_the_last_claimed_output_settles_the_outcome_and_a_signal_after_it_chang
 
 def test_outside_the_command_line_nothing_is_ever_dropped(tmp_path):
     """A script's Ctrl-C after its last write still interrupts it."""
-    target = mfp.check_output_path(tmp_path / "a.txt")
-    mfp.write_atomically({target: _writing("whole")})
-    assert not signals._Command.settled
-    with pytest.raises(KeyboardInterrupt):
-        signal.raise_signal(signal.SIGINT)
+    inherited = signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        target = mfp.check_output_path(tmp_path / "a.txt")
+        mfp.write_atomically({target: _writing("whole")})
+        assert not signals._Command.settled
+        with pytest.raises(KeyboardInterrupt):
+            signal.raise_signal(signal.SIGINT)
+    finally:
+        signal.signal(signal.SIGINT, inherited)
