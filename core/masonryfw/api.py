@@ -13,7 +13,7 @@ import numpy as np
 import xarray as xr
 
 from .checks import check
-from .damage import DERIVED_STEP_VARIABLES, damage_variables
+from .damage import DERIVED_STEP_VARIABLES, damage_variables, refuse_not_standing
 from .dofs import block_motion
 from .errors import MasonryError, ModelError, PluginError, SolveError
 from .io import CONVENTIONS, add_history, content_sha256
@@ -258,7 +258,8 @@ def compare(
     """Compare two results with the comparator called ``comparator`` (default: the only one installed).
 
     Returns a ``comparison`` dataset: the comparator's variables plus the
-    attributes ``schemas/comparison-2.json`` requires. ``input_a_sha256`` /
+    attributes ``schemas/comparison-2.json`` requires. A result whose masonry did not stand under its own weight
+    is refused (:func:`masonryfw.damage.standing_text`): its cracks are no settlement's damage. ``input_a_sha256`` /
     ``input_b_sha256`` are the files' hashes when the results were read from
     files, otherwise their content hashes.
     """
@@ -268,6 +269,7 @@ def compare(
     resolved = resolve_options(f"comparator {record.name!r}", record.options, dict(options or {}))
     for label, ds in (("A", a), ("B", b)):
         _require_valid_input(ds, f"result {label}", kind="result")
+    refuse_not_standing((a, b), f"comparator {record.name}: no damage to compare")
     produced = _call_plugin("comparator", record.name, record.compare, a, b, resolved)
     comparison = _merge_result("comparator", record.name, xr.Dataset(), xr.Dataset(), produced)
     title_a, title_b = a.attrs.get("title", ""), b.attrs.get("title", "")

@@ -42,6 +42,9 @@ from .schema import FORMAT_VERSION, flags, variable_attrs
 DOF_NAMES = ("ux", "uy", "rz")
 #: Position tolerance of the interface kinds, relative to the interface length.
 KIND_TOLERANCE = 1.0e-9
+#: Memory a built 2D block takes (measured: 1.3 kB at 23,090 units, the build's peak less the start-up's; 1.1 kB a
+#: block between the gable house's outline laid in 4,364 and in 17,793 blocks).
+BYTES_PER_BLOCK = 2048
 LOADINGS = ("settlement", "tilt")
 
 

@@ -103,19 +103,44 @@ def lay(outline: Polygon, openings: list[Polygon], bond: Bond, heads: list[Head]
     masonry = _polygonal(shapely.difference(outline, voids, grid_size=grid)) if not voids.is_empty else outline
     pieces = [_course_pieces(masonry, edges[k], edges[k + 1], _joints(k, bond, outline.bounds, tol), clean, grid)
               for k in range(len(edges) - 1)]
-    merged = _merge_slivers(pieces, bond, clean, grid)
+    heads_laid = [part for parts, _ in head_parts for part in parts]
+    merged = _merge_slivers(pieces, heads_laid, bond, clean, grid)
     if merged:
         laid.notes.append(f"{merged} piece(s) shorter than {bond.min_piece:g} of a unit length merged with a "
                           "neighbour (in their course, or the one below)")
-    for course in pieces:
-        for piece in course:
-            laid.polygons.append(_ring(piece, clean))
-            laid.roles.append(ROLE["unit"])
-    for parts, role in head_parts:
-        for part in parts:
-            laid.polygons.append(_ring(part, clean))
-            laid.roles.append(role)
+    blocks = [piece for course in pieces for piece in course] + heads_laid
+    roles = [ROLE["unit"]] * sum(map(len, pieces)) + [role for parts, role in head_parts for _ in parts]
+    rings = [_ring(block) for block in shared_boundaries(blocks, grid, clean)]
+    laid.polygons = [_without_straight(ring, tol) for ring in _settled_junctions(rings, tol, clean)]
+    laid.roles = roles
     return laid
+
+
+def shared_boundaries(blocks: list[Polygon], grid: float, clean: float) -> list[Polygon]:
+    """``blocks`` (they tile a region) with every boundary they share laid once: their boundaries noded into one
+    network on the overlays' ``grid`` (lines the overlays left a grid step apart become one), each run of it
+    between two junctions cleaned once (its vertices within ``clean`` of the chord dropped: a curve's chord
+    vertex a hair from where a joint meets the curve), and the blocks made again as the faces of that network, in
+    their order. Two neighbours then have exactly the same boundary: cleaned one by one, a unit and the voussoir
+    beside it kept different vertices along their curve and overlapped by tens of micrometres. A face keeps the
+    vertices where its neighbours' joints meet its edges only where they turn it (:func:`_ring`)."""
+    network = shapely.line_merge(shapely.union_all([block.boundary for block in blocks], grid_size=grid))
+    runs = shapely.simplify(shapely.get_parts(network), clean, preserve_topology=False)
+    faces = [face for face in shapely.get_parts(shapely.polygonize(runs)) if face.area > 0]
+    owner = shapely.STRtree(blocks).query(shapely.point_on_surface(faces), predicate="within")
+    made: list[list[Polygon]] = [[] for _ in blocks]
+    for face, block in zip(owner[0], owner[1]):
+        made[int(block)].append(faces[int(face)])
+    return [pieces[0] if len(pieces) == 1 else _joined(pieces, block, grid) for pieces, block in zip(made, blocks)]
+
+
+def _joined(pieces: list[Polygon], block: Polygon, grid: float) -> Polygon:
+    """A block made of several faces of the network (a block that touched itself), or the block as it was where
+    the network has none of it."""
+    if not pieces:
+        return block
+    joined = shapely.union_all(pieces, grid_size=grid)
+    return joined if isinstance(joined, Polygon) else max(shapely.get_parts(joined), key=lambda p: p.area)
 
 
 # ---------------------------------------------------------------- courses and openings
@@ -216,18 +241,25 @@ def _flat_arch(region, x0: float, x1: float, soffit: float, bond: Bond, grid: fl
 
 def _arch(opening: Polygon, depth: float, outline: Polygon, name: str, grid: float) -> list[Polygon]:
     """A ring of voussoirs ``depth`` deep on the circular head of ``opening`` (a circle fitted to the points of
-    its boundary above its springing, where its straight sides end)."""
+    its boundary above its springing, where its straight sides end); all round a round window (an oculus: no
+    straight side), its voussoirs radiating from its centre (it was laid over three quarters of its
+    circumference and bricks cut round the rest, which carried nothing in fdem)."""
     x, y = np.asarray(opening.exterior.coords)[:-1].T
-    upright = np.abs(np.diff(np.append(x, x[0]))) <= 1e-6 * opening.length
-    springing = max((max(y[k], y[(k + 1) % x.size]) for k in np.flatnonzero(upright)), default=y.min())
-    on_head = y >= springing - 1e-9 * opening.length
-    if on_head.sum() < 3:
-        raise SpecError(f"{name}: head = 'arch' needs a curved head (an arched opening); use 'lintel' or 'flat_arch'")
-    left, right = x[on_head].min(), x[on_head].max()
-    cx, cy, radius = _circle_through(x[on_head], y[on_head], left, right, springing)
-    start, end = math.atan2(springing - cy, right - cx), math.atan2(springing - cy, left - cx)
-    if end < start:
-        end += 2 * math.pi
+    if _is_round(x, y):
+        cx, cy, radius = _circle_fit(x, y)
+        springing, start, end = cy - 2 * (radius + depth), -0.5 * math.pi, 1.5 * math.pi
+    else:
+        upright = np.abs(np.diff(np.append(x, x[0]))) <= 1e-6 * opening.length
+        springing = max((max(y[k], y[(k + 1) % x.size]) for k in np.flatnonzero(upright)), default=y.min())
+        on_head = y >= springing - 1e-9 * opening.length
+        if on_head.sum() < 3:
+            raise SpecError(f"{name}: head = 'arch' needs a curved head (an arched opening); use 'lintel' or "
+                            "'flat_arch'")
+        left, right = x[on_head].min(), x[on_head].max()
+        cx, cy, radius = _circle_through(x[on_head], y[on_head], left, right, springing)
+        start, end = math.atan2(springing - cy, right - cx), math.atan2(springing - cy, left - cx)
+        if end < start:
+            end += 2 * math.pi
     mid = radius + 0.5 * depth
     count = max(3, int(round((end - start) * mid / depth)) | 1)
     parts = []
@@ -244,6 +276,19 @@ def _arch(opening: Polygon, depth: float, outline: Polygon, name: str, grid: flo
         voussoir = shapely.difference(sector, opening, grid_size=grid)
         parts += _parts(shapely.intersection(voussoir, outline, grid_size=grid))
     return parts
+
+
+def _circle_fit(x: np.ndarray, y: np.ndarray) -> tuple[float, float, float]:
+    """The circle through the points ``(x, y)`` by least squares (Kasa's algebraic fit): centre and radius."""
+    design = np.c_[2 * x, 2 * y, np.ones_like(x)]
+    (cx, cy, c), *_ = np.linalg.lstsq(design, x * x + y * y, rcond=None)
+    return float(cx), float(cy), math.sqrt(c + cx * cx + cy * cy)
+
+
+def _is_round(x: np.ndarray, y: np.ndarray) -> bool:
+    """Whether the points lie on one circle (within 1 % of its radius): a round window, not a polygon."""
+    cx, cy, radius = _circle_fit(x, y)
+    return bool(np.abs(np.hypot(x - cx, y - cy) - radius).max() <= 0.01 * radius) and x.size >= 8
 
 
 def _circle_through(x: np.ndarray, y: np.ndarray, left: float, right: float, springing: float
@@ -296,7 +341,7 @@ def _course_pieces(masonry, y0: float, y1: float, joints: np.ndarray, clean: flo
     if band.is_empty:
         return []
     cells = shapely.intersection(shapely.box(joints[:-1], y0, joints[1:], y1), band, grid_size=grid)
-    pieces = [part for cell in cells for part in _parts(cell) if part.area > clean * part.length]
+    pieces = [part for cell in cells for part in _parts(cell)]  # a hair of a piece is merged, not lost
     return sorted(pieces, key=lambda p: p.bounds[0])
 
 
@@ -312,11 +357,12 @@ def _parts(geometry) -> list[Polygon]:
     return [p for p in shapely.get_parts(geometry) if isinstance(p, Polygon) and p.area > 0]
 
 
-def _merge_slivers(courses: list[list[Polygon]], bond: Bond, clean: float, grid: float) -> int:
+def _merge_slivers(courses: list[list[Polygon]], heads: list[Polygon], bond: Bond, clean: float, grid: float) -> int:
     """Merge every sliver (narrower than ``min_piece`` unit lengths, or of a tenth of that piece's area) with its
     neighbour across a head joint (the right one first), or, alone in its course (a gable's tip) or a mere
-    fleck, with the piece below (module docstring); how many were merged. A narrow piece with neither (a pier
-    between an opening and the outline) stays."""
+    fleck, with the piece below (module docstring); a fleck with none of those (a hair of masonry between an
+    arch's extrados and a bed joint) joins the piece above or the head it borders. How many were merged. A
+    narrow piece with neither (a pier between an opening and the outline) stays."""
     merged = 0
     narrow = bond.min_piece * bond.unit_length - clean
     fleck = 0.1 * bond.min_piece * bond.unit_length * bond.unit_height
@@ -328,13 +374,20 @@ def _merge_slivers(courses: list[list[Polygon]], bond: Bond, clean: float, grid:
             if piece.bounds[2] - piece.bounds[0] >= narrow and not small:
                 j += 1
                 continue
-            neighbour = _touching(course, j, clean)
+            neighbour = _touching(course, j, 0.0 if small else 10 * clean)  # a fleck joins any neighbour it borders
             alone = len(course) == 1 or small
             below = _longest_bed(courses[k - 1], piece, clean) if neighbour is None and alone and k else None
+            above = _longest_bed(courses[k + 1], piece, 0.0) if small and neighbour is below is None and \
+                k + 1 < len(courses) else None
+            head = _longest_bed(heads, piece, 0.0) if small and neighbour is below is above is None else None
             if neighbour is not None:
                 course[neighbour] = _union(course[neighbour], piece, grid)
             elif below is not None:
                 courses[k - 1][below] = _union(courses[k - 1][below], piece, grid)
+            elif above is not None:
+                courses[k + 1][above] = _union(courses[k + 1][above], piece, grid)
+            elif head is not None:
+                heads[head] = _union(heads[head], piece, grid)
             else:
                 j += 1
                 continue
@@ -344,12 +397,13 @@ def _merge_slivers(courses: list[list[Polygon]], bond: Bond, clean: float, grid:
     return merged
 
 
-def _touching(course: list[Polygon], j: int, clean: float) -> int | None:
-    """The neighbour of piece ``j`` in its course sharing the longest boundary with it (across a head joint),
-    or None."""
+def _touching(course: list[Polygon], j: int, least: float) -> int | None:
+    """The neighbour of piece ``j`` in its course sharing the longest boundary with it (across a head joint), if
+    longer than ``least``; or None."""
     shared = [other.intersection(course[j]).length if other is not course[j] else 0.0 for other in course]
-    best = max(range(len(course)), key=lambda i: (round(shared[i] / clean), i > j))  # a tie: the right one
-    return best if shared[best] > 10 * clean else None
+    unit = max(least / 10, 1e-300)
+    best = max(range(len(course)), key=lambda i: (round(shared[i] / unit), i > j))  # a tie: the right one
+    return best if shared[best] > least else None
 
 
 def _longest_bed(course: list[Polygon], piece: Polygon, tol: float) -> int | None:
@@ -363,20 +417,69 @@ def _union(a: Polygon, b: Polygon, grid: float) -> Polygon:
     return joined if isinstance(joined, Polygon) else max(shapely.get_parts(joined), key=lambda p: p.area)
 
 
-def _ring(polygon: Polygon, clean: float) -> np.ndarray:
-    """The exterior of ``polygon`` counter-clockwise, without its repeated last point, every vertex within
-    ``clean`` of its neighbours' chord (or of a neighbour) dropped."""
-    simplified = shapely.simplify(polygon, clean)
-    if isinstance(simplified, Polygon) and simplified.is_valid and not simplified.is_empty:
-        polygon = simplified
-    ring = np.asarray(shapely.geometry.polygon.orient(polygon, 1.0).exterior.coords)[:-1]
-    while len(ring) > 3:  # what a simplification left for its result's validity: a straight vertex, one by one
-        before, after = np.roll(ring, 1, axis=0), np.roll(ring, -1, axis=0)
-        chord = after - before
-        away = ring - before
-        offset = np.abs(chord[:, 0] * away[:, 1] - chord[:, 1] * away[:, 0]) / np.maximum(np.hypot(*chord.T), 1e-300)
-        straight = int(np.argmin(offset))
-        if offset[straight] > clean:
+def _ring(polygon: Polygon) -> np.ndarray:
+    """The exterior of ``polygon`` counter-clockwise, without its repeated last point."""
+    return np.asarray(shapely.geometry.polygon.orient(polygon, 1.0).exterior.coords)[:-1]
+
+
+def _offsets(ring: np.ndarray) -> np.ndarray:
+    """How far each vertex of ``ring`` lies from the chord of its two neighbours."""
+    before, after = np.roll(ring, 1, axis=0), np.roll(ring, -1, axis=0)
+    chord, away = after - before, ring - before
+    return np.abs(chord[:, 0] * away[:, 1] - chord[:, 1] * away[:, 0]) / np.maximum(np.hypot(*chord.T), 1e-300)
+
+
+def _settled_junctions(rings: list[np.ndarray], tol: float, clean: float) -> list[np.ndarray]:
+    """The blocks' vertices within ``clean`` of their neighbours' chord (but not within ``tol``: a neighbour's joint
+    meeting an edge, which :func:`_without_straight` drops from that block alone) settled in every block that has
+    them alike, so that neighbours stay alike: a vertex two blocks share at most (along a curve, or on the outline)
+    is dropped; where it is a junction (three blocks or more meet there: a bed joint meeting an arch's extrados a
+    hair from a chord vertex), the nearer of its neighbours is dropped if that one is not a junction, else the two
+    junctions (a voussoir's joint and a bed joint meeting the extrados a hair apart) become one point. A block
+    keeps three vertices at least."""
+    for _ in range(8):
+        owners: dict[tuple[float, float], int] = {}
+        for ring in rings:
+            for point in map(tuple, ring.tolist()):
+                owners[point] = owners.get(point, 0) + 1
+        dropped: set[tuple[float, float]] = set()
+        merged: dict[tuple[float, float], tuple[float, float]] = {}
+        for ring in rings:
+            offset = _offsets(ring)
+            for k in np.flatnonzero((offset > tol) & (offset <= clean)):
+                point = tuple(ring[k].tolist())
+                if point in dropped or point in merged:
+                    continue
+                if owners[point] <= 2:
+                    dropped.add(point)
+                    continue
+                near = tuple(min((ring[k - 1], ring[(k + 1) % len(ring)]),
+                                 key=lambda n: float(np.hypot(*(n - ring[k])))).tolist())
+                if owners[near] <= 2:
+                    dropped.add(near)
+                elif near not in merged and near not in dropped:
+                    merged[point] = near
+        if not dropped and not merged:
             break
-        ring = np.delete(ring, straight, axis=0)
+        rings = [_settled(ring, dropped, merged) for ring in rings]
+    return rings
+
+
+def _settled(ring: np.ndarray, dropped: set, merged: dict) -> np.ndarray:
+    """``ring`` less its ``dropped`` points, its ``merged`` ones moved onto their partners (no point twice in a
+    row); as it was if fewer than three would be left."""
+    points = [merged.get(p, p) for p in map(tuple, ring.tolist()) if p not in dropped]
+    points = [p for k, p in enumerate(points) if p != points[k - 1]]
+    return np.array(points) if len(points) >= 3 else ring
+
+
+def _without_straight(ring: np.ndarray, tol: float) -> np.ndarray:
+    """``ring`` without its vertices within ``tol`` of their neighbours' chord (where a neighbour's joint meets its
+    edge, or a meeting point :func:`_settled_junctions` moved onto it)."""
+    while len(ring) > 3:
+        straight = _offsets(ring) <= tol
+        if not straight.any():
+            break
+        straight &= ~np.roll(straight, 1)  # never two neighbours in one pass: each is judged against its own chord
+        ring = ring[~straight]
     return ring

@@ -38,8 +38,10 @@ from . import polyhedra
 from .bond import pattern_cells
 from .errors import SpecError
 from .ground_plan import SETTLEMENT_3D_KEYS, GroundInPlan, profile_in_plan
+from .inputs import fits_in_memory
 from .on_ground import model_on_ground
-from .profiles import with_profile
+from .profiles import refuse_fine_segments, with_profile
+from .resources import count_text
 from .roles import ROLE
 from .spec import LENGTH_UNITS, SpecTable, read_material
 
@@ -53,6 +55,11 @@ TOP_KEYS = ("title", "description", "space", "length_unit", "building", "materia
 SLIVER = 0.25
 #: Walls meeting at less than this angle [degrees] are refused: a slanted end would run far along the wall.
 MIN_ANGLE = 30.0
+#: Bytes of memory a block of a building takes while it is laid and made a model (the house at 1,126 to 9,663
+#: blocks took 20-27 kB a block at its peak, ``/usr/bin/time``): what :func:`refuse_too_big` counts.
+BYTES_PER_BLOCK = 32 * 2**10
+#: The least depth of the ground blocks, in courses: a thinner block has faces closer than the contacts' tolerance.
+MIN_SUPPORT_DEPTH = 0.01
 
 
 @dataclass(frozen=True)
@@ -530,10 +537,17 @@ def build_building(spec: dict, text: str) -> xr.Dataset:
         raise SpecError("spec table 'settlement' is missing: a building stands on ground that moves by a profile "
                         "in plan ([settlement] with profile, axis_angle, center_x, center_y)")
     settlement = top.sub("settlement", SETTLEMENT_3D_KEYS)
-    ground_plan = profile_in_plan(settlement, unit_length)
+    ground_plan = profile_in_plan(settlement, unit_length, max(w.length for w in walls))
     profile = ground_plan.profile
     depth = building.number("support_depth", unit_height / top.scale, length=True, positive=True)
+    if depth < MIN_SUPPORT_DEPTH * unit_height:
+        raise SpecError(f"spec key {building.key('support_depth')!r} = {building.raw('support_depth')!r}: the ground "
+                        f"blocks would be {depth:.3g} m deep, less than {MIN_SUPPORT_DEPTH:g} of a course "
+                        f"({unit_height:.4g} m); give at least {MIN_SUPPORT_DEPTH * unit_height / top.scale:.3g}")
     segment = building.number("segment", profile.segment / top.scale, length=True, positive=True)
+    if building.has("segment"):
+        refuse_fine_segments(max(w.length for w in walls), segment, unit_length, f"spec key {building.key('segment')!r}")
+    refuse_too_big(walls, unit_length, unit_height, segment, building, top)
     tol = 1e-6 * max(w.length for w in walls)
     joins = junctions(walls, tol)
     laid = lay_masonry(walls, joins, unit_length, unit_height, notes)
@@ -563,6 +577,33 @@ def build_building(spec: dict, text: str) -> xr.Dataset:
              **({"comment": top.text("description")} if top.has("description") else {})}
     model = _dataset(walls, laid, n_masonry, poly, material, ground_plan, depth, attrs, tol)
     return with_profile(model, profile)
+
+
+def expected_blocks(walls: list[Wall], unit_length: float, unit_height: float) -> float:
+    """About how many units and lintels the walls lay (a bound within about twice the count): per course, a leaf's
+    row of stretchers on each leaf, and a row of headers where the bond has them."""
+    count = 0.0
+    for wall in walls:
+        courses = wall.height / unit_height
+        row = wall.length / unit_length + 2.0
+        headers = wall.length / wall.depth + 2.0 if wall.bond != "running" else 0.0
+        count += courses * (row * wall.leaves + headers)
+    return count
+
+
+def refuse_too_big(walls: list[Wall], unit_length: float, unit_height: float, segment: float, building: SpecTable,
+                   top: SpecTable) -> None:
+    """Refuse, before any laying, a building whose blocks and ground segments (counted from its keys) would not fit
+    in the memory available (:func:`masonryfw.inputs.fits_in_memory`), naming the keys that size it."""
+    blocks = expected_blocks(walls, unit_length, unit_height)
+    segments = sum(wall.length / segment + 2.0 for wall in walls)
+    unit = building.sub("unit", ("length", "height", "depth"))
+    sized = (f"spec: {len(walls)} wall(s) of {sum(w.length for w in walls):.4g} m in all, up to "
+             f"{max(w.height for w in walls):.4g} m high, in units of {building.key('unit')} = "
+             f"{unit.raw('length')!r} x {unit.raw('height')!r} {top.raw('length_unit', 'm')}, on ground segments "
+             f"{segment:.3g} m long ({count_text(blocks)} blocks and {count_text(segments)} ground segments)")
+    fits_in_memory((blocks + segments) * BYTES_PER_BLOCK, sized,
+                   "are the unit, the walls and length_unit what was meant?")
 
 
 def add_floors(building: SpecTable, walls: list[Wall], laid: Laid, unit_height: float) -> None:
@@ -598,6 +639,7 @@ def _dataset(walls, laid, n_masonry, poly, material, ground_plan, depth, attrs, 
     s = np.array([[c.at for c in laid.s0[n_masonry:]], [c.at for c in laid.s1[n_masonry:]]]).T
     ends = starts[:, None, :] + s[..., None] * along[:, None, :]
     motion = segment_motion(ground_plan, ends, along, across, depth)
-    footprint = (s[:, 1] - s[:, 0]) * np.array([w.thickness for w in walls])[wall]
-    return model_on_ground(poly, np.array(laid.role[:n_masonry]), weight, motion, footprint, material, attrs, tol,
-                           "segment of every wall")
+    z0 = np.asarray(laid.z0)
+    return model_on_ground(poly, np.array(laid.role[:n_masonry]), weight, motion, material, attrs, tol,
+                           "segment of every wall", lambda b: f"wall {walls[laid.wall[b]].name!r}'s block {b} "
+                                                          f"({z0[b]:.4g} m up)")

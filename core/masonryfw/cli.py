@@ -24,7 +24,7 @@ import masonryfw.plugin_api as mfp
 from masonryfw import inputs, signals
 from masonryfw.command_kit import FIGURE, OPTIONS, PROGRESS, command_line
 from masonryfw.locks import release_all
-from masonryfw.registry import command_plugin, installed_plugins, plugin_commands
+from masonryfw.registry import command_plugin, installed_plugins, installed_solvers, plugin_commands
 
 LONG_RUN = 60.0  # seconds: the solve command prints the estimate of a run longer than this
 #: Seconds: a run estimated longer starts only with --force or its end set (--option settlement=): a volume loss typed
@@ -213,10 +213,12 @@ def _solved(model: str, solver: str, output: str | None, options: dict[str, str]
     mfp.check_output_path(out, inputs)
     plan = mf.solve_plan(mf.open_model(model), solver, options)  # checked, looked up, resolved, estimated: once
     expected = plan.estimate
-    if expected is not None and expected.seconds > UNASKED_RUN and not force and "settlement" not in options:
+    if expected is not None and not expected.seconds <= UNASKED_RUN and not force:
+        sooner = "a smaller settlement" if "settlement" in options else "--option settlement=..."
         raise mf.MasonryError(f"{solver}: expect about {mfp.duration_text(expected.seconds)} ({expected.basis}), over "
-                              f"the {UNASKED_RUN / 3600:g} h a run starts without asking; is the model what was meant "
-                              f"(see its warnings)? Run it with --force, or end it sooner with --option settlement=...")
+                              f"the {UNASKED_RUN / 3600:g} h a run starts without asking; is the model (see its "
+                              f"warnings) and the settlement what was meant? Run it with --force, or end it sooner "
+                              f"with {sooner}")
     if expected is not None and expected.seconds > LONG_RUN:
         click.echo(f"{solver}: expect about {mfp.duration_text(expected.seconds)} and "
                    f"{mfp.size_text(expected.memory)} ({expected.basis}); Ctrl-C keeps what is computed", err=True)
@@ -265,6 +267,10 @@ def solve(model: str, solver: str, output: str | None, options: dict[str, str], 
         click.echo(f"stages {stages}")
 
 
+#: A solver option that spaces its records (la-incremental's steps grow while its mechanism holds): capacity asks
+#: for at least this many over the run, so that the settlement of each category is known to a hundredth of it.
+RECORDS = "records"
+CAPACITY_RECORDS = 100
 #: A solver option that ends a run at its reaction plateau, before the damage the capacity asks for.
 PLATEAU_STOP = "plateau_tolerance"
 
@@ -274,8 +280,9 @@ PLATEAU_STOP = "plateau_tolerance"
 @click.option("--plugin", "solver", default="fdem", show_default=True,
               help="An incremental solver with crack widths: fdem or la-incremental.")
 @click.option("--category", type=click.IntRange(1, 5), help="Say first where this damage category is reached.")
-@click.option("--settlement", type=float, help="Run to this settlement parameter [m] (a tunnel's S_max).")
-@click.option("--volume-loss", "volume_loss", type=float, help="Run a tunnel to this volume loss [%].")
+@click.option("--settlement", type=mfp.LENGTH, help="Run to this settlement parameter [m] (a tunnel's S_max).")
+@click.option("--volume-loss", "volume_loss", type=mfp.Number("%", above=0.0, at_most=100.0),
+              help="Run a tunnel to this volume loss [%].")
 @click.option("-o", "--output", type=click.Path(dir_okay=False), help="[default: <model>.<plugin>.nc]")
 @OPTIONS
 @PROGRESS
@@ -298,12 +305,17 @@ def capacity(model: str, solver: str, category: int | None, settlement: float | 
             raise mf.InputError(f"--volume-loss: {model} is not over a tunnel's trough; give --settlement [m]")
         settlement = volume_loss / per_metre
     if settlement is not None:
-        if not settlement > 0:
-            raise mf.InputError(f"--settlement {settlement:g}: the run's settlement must be positive")
         options = {**options, "settlement": repr(settlement)}
-    if any(o.name == PLATEAU_STOP for o in mf.get_solver(solver).options) and PLATEAU_STOP not in options:
+    if not mf.get_solver(solver).history:
+        raise mf.SolveError(f"{solver}: its result has no history of crack widths to find the damage categories in; "
+                            f"use one of {', '.join(s.name for s in installed_solvers() if s.history)}")
+    declared = {o.name: o for o in mf.get_solver(solver).options}
+    if PLATEAU_STOP in declared and PLATEAU_STOP not in options:
         options = {**options, PLATEAU_STOP: "0"}  # the categories past a reaction plateau are what is asked
+    if RECORDS in declared and RECORDS not in options and declared[RECORDS].default < CAPACITY_RECORDS:
+        options = {**options, RECORDS: str(CAPACITY_RECORDS)}  # each category's settlement known to a hundredth
     result, out, _ = _solved(model, solver, output, options, progress, force)
+    mfp.refuse_not_standing([result], f"capacity (the result is written to {out})")
     text = mf.capacity_text(result, category)
     if not text:
         raise mf.SolveError(f"{solver}: its result has no crack-width history to find the damage categories in; "
@@ -347,7 +359,7 @@ def compare(
     if output:
         mf.save(comparisons[0], output, command=command_line(), protect=list(results))
     if as_json:
-        click.echo(json.dumps(_comparison_json(results, pairs, comparisons), default=str))
+        click.echo(json.dumps(_comparison_json(results, pairs, comparisons), default=str, allow_nan=False))
         return
     letters = [chr(ord("A") + i) if i < 26 else f"R{i + 1}" for i in range(len(results))]
     for letter, path, ds in zip(letters, results, datasets):
@@ -365,9 +377,14 @@ def compare(
         click.echo(f"comparison: {output}")
 
 
+def _json_number(value):
+    """A score as JSON has it: a number, or null where it is not one (NaN and inf are not JSON)."""
+    return None if isinstance(value, float) and not np.isfinite(value) else value
+
+
 def _comparison_json(results, pairs, comparisons) -> dict:
     """``{"comparator", "scores"}`` for two results; with more, ``"pairs"`` of ``{"a", "b", "scores"}``."""
-    scores = [{str(n): c[n].values.item() for n in c.data_vars if c[n].ndim == 0} for c in comparisons]
+    scores = [{str(n): _json_number(c[n].values.item()) for n in c.data_vars if c[n].ndim == 0} for c in comparisons]
     out: dict[str, Any] = {"comparator": comparisons[0].attrs["comparator"]}
     if len(results) == 2:
         out["scores"] = scores[0]

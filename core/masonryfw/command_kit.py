@@ -42,6 +42,49 @@ class Length(click.ParamType):
 #: ``type=LENGTH``: a positive, finite length in metres.
 LENGTH = Length()
 
+
+class Number(click.ParamType):
+    """A finite number within bounds (``nan`` and ``inf`` refused by name, unlike click's FloatRange): ``above``
+    (strictly) or ``at_least``, and ``at_most``; ``unit`` says what it is in."""
+
+    def __init__(self, unit: str, *, above: float | None = None, at_least: float | None = None,
+                 at_most: float | None = None):
+        self.name, self.unit, self.above, self.at_least, self.at_most = unit, unit, above, at_least, at_most
+
+    def convert(self, value, param, ctx) -> float:
+        try:
+            number = float(value)
+        except (TypeError, ValueError):
+            self.fail(f"{value!r} is not a number", param, ctx)
+        wanted = [f"> {self.above:g}" if self.above is not None else "",
+                  f">= {self.at_least:g}" if self.at_least is not None else "",
+                  f"<= {self.at_most:g}" if self.at_most is not None else ""]
+        if not (math.isfinite(number) and (self.above is None or number > self.above)
+                and (self.at_least is None or number >= self.at_least)
+                and (self.at_most is None or number <= self.at_most)):
+            self.fail(f"{value!r}: a finite number {' and '.join(w for w in wanted if w)} ({self.unit})", param, ctx)
+        return number
+
+
+class Address(click.ParamType):
+    """A dask scheduler's address: ``tcp://host:port`` (or ``tls://``, ``ws://``...), or ``host:port``."""
+
+    name = "ADDRESS"
+    SCHEMES = ("tcp", "tls", "ws", "wss", "inproc", "ucx")
+
+    def convert(self, value, param, ctx) -> str:
+        text = str(value).strip()
+        scheme, _, rest = text.rpartition("://")
+        host, _, port = rest.rpartition(":")
+        if (scheme and scheme not in self.SCHEMES) or not host or not port.isdigit() or not 0 < int(port) < 65536:
+            self.fail(f"{value!r} is not a scheduler's address: tcp://host:port, as the scheduler prints it "
+                      f"(schemes: {', '.join(self.SCHEMES)})", param, ctx)
+        return text if scheme else f"tcp://{text}"
+
+
+#: ``type=ADDRESS``: a dask scheduler's address.
+ADDRESS = Address()
+
 #: Inches per unit a figure's ``--size`` may be given in.
 SIZE_UNITS = {"in": 1.0, "cm": 1 / 2.54, "mm": 1 / 25.4}
 

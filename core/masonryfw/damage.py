@@ -31,7 +31,11 @@ categories and the distortion of the imposed settlement profile.
 - the engineers' **stage 2** on the continuous greenfield profile a model was
   built over, the LTSM strain and its category (``step_ltsm_strain``,
   ``step_ltsm_category``, :mod:`masonryfw.assessment`), beside the model's own
-  damage.
+  damage;
+- **a wall that does not stand**: a result whose ``stood = 0`` (a block moved more than a tenth of a unit
+  height before any settlement, ``gravity_motion`` at ``gravity_motion_x``, ``gravity_motion_y``) holds no
+  settlement's damage: :func:`standing_text` says so, and ``capacity``, ``compare`` and the report read no
+  damage from it.
 """
 from __future__ import annotations
 
@@ -41,6 +45,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from .assessment import ltsm_thresholds, ltsm_variables, screen_threshold, volume_loss_per_settlement
+from .errors import SolveError
 from .roles import masonry_blocks, support_blocks
 from .schema import variable_attrs
 from .semantics import relative_motion
@@ -53,7 +58,8 @@ DAMAGE_LIMITS = (1.0e-4, 1.0e-3, 5.0e-3, 15.0e-3, 25.0e-3)
 #: Variables the core derives from a result's history (a solver must not return them).
 DERIVED_STEP_VARIABLES = ("step_damage_category", "step_deflection_ratio", "step_angular_distortion",
                           "step_ltsm_strain", "step_ltsm_category", "category", "category_settlement",
-                          "category_ltsm_settlement", "screen_settlement", "category_volume_loss",
+                          "category_settlement_resolution", "category_ltsm_settlement", "screen_settlement",
+                          "category_volume_loss",
                           "category_ltsm_volume_loss", "screen_volume_loss")
 
 
@@ -116,27 +122,32 @@ def distortion(x: np.ndarray, v: np.ndarray) -> tuple[float, float]:
     return float(offset[largest] / span), float(np.abs(slopes - tilt).max(initial=0.0))
 
 
-def first_exceeding(settlement: np.ndarray, width: np.ndarray, limit: float) -> float:
-    """The settlement at which ``width`` first exceeds ``limit``, linear between the records around it (NaN
-    when it never does; the first record's settlement when it already does)."""
+def first_exceeding(settlement: np.ndarray, width: np.ndarray, limit: float) -> tuple[float, float]:
+    """The settlement at which ``width`` first exceeds ``limit``, linear between the records around it, and the
+    spacing of those two records, to which it is known (NaN when it never does; the first record's settlement,
+    known exactly, when it already does)."""
     over = np.flatnonzero(width > limit)
     if over.size == 0:
-        return float("nan")
+        return float("nan"), float("nan")
     k = int(over[0])
-    if k == 0 or width[k] == width[k - 1]:
-        return float(settlement[k])
+    if k == 0:
+        return float(settlement[k]), 0.0
+    spacing = float(settlement[k] - settlement[k - 1])
+    if width[k] == width[k - 1]:
+        return float(settlement[k]), spacing
     share = (limit - width[k - 1]) / (width[k] - width[k - 1])
-    return float(settlement[k - 1] + share * (settlement[k] - settlement[k - 1]))
+    return float(settlement[k - 1] + share * (settlement[k] - settlement[k - 1])), spacing
 
 
 def category_variables(model: xr.Dataset, settlement: np.ndarray, width: np.ndarray) -> dict[str, tuple]:
     """Where the run first reaches damage categories 1 to 5 (stage 3), beside stage 2 and stage 1 and, of a
     tunnel, their volume losses (module docstring)."""
     categories = np.arange(1, len(DAMAGE_LIMITS) + 1, dtype=np.int8)
-    reached = np.array([first_exceeding(settlement, width, limit) for limit in DAMAGE_LIMITS])
+    reached, spacing = np.array([first_exceeding(settlement, width, limit) for limit in DAMAGE_LIMITS]).T
     derived: dict[str, tuple] = {
         "category": ("category", categories, variable_attrs("category")),
         "category_settlement": ("category", reached, variable_attrs("category_settlement")),
+        "category_settlement_resolution": ("category", spacing, variable_attrs("category_settlement_resolution")),
     }
     ltsm = ltsm_thresholds(model)
     screen = screen_threshold(model)
@@ -172,3 +183,26 @@ def damage_variables(model: xr.Dataset, produced: xr.Dataset) -> dict[str, tuple
             derived.update(category_variables(model, settlement, np.asarray(produced.step_crack_width_max.values)))
     return derived
 
+
+
+def standing_text(result: xr.Dataset) -> str | None:
+    """What a result whose masonry did not stand under its own weight says about it (``stood = 0``: the block that
+    moved most before any settlement, how far and from where), or None when it stood (or says nothing)."""
+    if int(result.attrs.get("stood", 1)):
+        return None
+    where = (f" (block {int(result.attrs['gravity_motion_block'])}, which started at x "
+             f"{float(result.attrs['gravity_motion_x']):.4g} m, {'z' if int(result.attrs.get('masonryfw_space', 2)) == 3 else 'y'} "
+             f"{float(result.attrs['gravity_motion_y']):.4g} m)") if "gravity_motion_block" in result.attrs else ""
+    moved = f"moved {float(result.attrs['gravity_motion']) * 1e3:.3g} mm" if "gravity_motion" in result.attrs else "moved"
+    return (f"the masonry did not stand under its own weight: a block {moved}{where} before any settlement; its "
+            "cracks are not the settlement's damage (is the wall as built stable? la's collapse multiplier, or "
+            "fdem's gravity phase alone, --option settlement=0, tell)")
+
+
+def refuse_not_standing(results, what: str) -> None:
+    """Raise a :class:`masonryfw.SolveError` naming the first of ``results`` whose masonry did not stand: ``what``
+    (capacity, a comparison of damage) cannot be read from it."""
+    for result in results:
+        text = standing_text(result)
+        if text:
+            raise SolveError(f"{what}: {result.attrs.get('solver', 'the run')}: {text}")

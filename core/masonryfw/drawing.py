@@ -75,6 +75,7 @@ class _Ring:
     layer: str
     source: str
     closed: bool = True  # False: a polyline not flagged closed, closed only if it ends where it starts (snapped)
+    curved: bool = False  # arcs (bulges) or a circle, made chords
 
 
 def read_drawing(path: str | Path, drawing_unit: str | None = None, chord_tolerance: float | None = None,
@@ -104,7 +105,7 @@ def read_drawing(path: str | Path, drawing_unit: str | None = None, chord_tolera
         raise SpecError(f"drawing {str(path)!r}: no closed polyline or polygon in it"
                         + (f" (left out: {_counted(ignored)})" if ignored else ""))
     scale = DRAWING_UNITS[unit]
-    rings = [_Ring(r.x * scale, r.y * scale, r.layer, r.source, r.closed) for r in rings]
+    rings = [_Ring(r.x * scale, r.y * scale, r.layer, r.source, r.closed, r.curved) for r in rings]
     snap = None if snap_tolerance is None else snap_tolerance * scale
     return clean(rings, snap, ignored)
 
@@ -122,6 +123,7 @@ class Elevation:
     outline_source: str
     openings: tuple[np.ndarray, ...]
     opening_sources: tuple[str, ...]
+    notes: tuple[str, ...] = ()  # what reading did (arcs made chords by the default tolerance)
 
 
 def read_elevation(path: str | Path, drawing_unit: str | None, outline_layer: str, openings_layer: str | None,
@@ -135,7 +137,8 @@ def read_elevation(path: str | Path, drawing_unit: str | None, outline_layer: st
     if kind is None:
         raise SpecError(f"drawing {str(path)!r}: unknown file type {path.suffix!r}; use {', '.join(sorted(SUFFIXES))}")
     if kind == "dxf":
-        rings, unit, _ = _read_dxf(path, drawing_unit, chord_tolerance, ELEVATION_CHORD)
+        rings, unit, _ = _read_dxf(path, drawing_unit, chord_tolerance, ELEVATION_CHORD,
+                                   {outline_layer, openings_layer} - {None})
     else:
         if drawing_unit is None:
             raise SpecError(f"drawing {str(path)!r}: a {kind.upper()} file carries no unit; "
@@ -155,8 +158,26 @@ def read_elevation(path: str | Path, drawing_unit: str | None, outline_layer: st
 
         shape = shapely.Polygon(outline / scale)
         chosen = [r for r in rings if r is not outlines[0] and shapely.Polygon(np.c_[r.x, r.y]).within(shape)]
+    for ring in [outlines[0], *chosen]:
+        _refuse_open_ring(ring, scale, path)
+    notes = []
+    if chord_tolerance is None and any(r.curved for r in [outlines[0], *chosen]):
+        notes.append(f"arcs and circles of {path.name!r} made chords within {ELEVATION_CHORD * 1e3:g} mm (the "
+                     "default; geometry.chord_tolerance sets it)")
     return Elevation(outline, outlines[0].source, tuple(np.c_[r.x, r.y] * scale for r in chosen),
-                     tuple(r.source for r in chosen))
+                     tuple(r.source for r in chosen), tuple(notes))
+
+
+def _refuse_open_ring(ring: _Ring, scale: float, path: Path) -> None:
+    """An elevation's outline or opening drawn as a polyline that is not closed and does not come back to its
+    start: refused, with its ends (it used to be closed silently by its last edge)."""
+    size = max(float(np.ptp(ring.x)), float(np.ptp(ring.y)), 1e-300)
+    gap = float(np.hypot(ring.x[-1] - ring.x[0], ring.y[-1] - ring.y[0]))
+    if ring.closed or gap <= RELATIVE_SNAP * size:
+        return
+    start, end = _told_apart((ring.x[0] * scale, ring.y[0] * scale), (ring.x[-1] * scale, ring.y[-1] * scale))
+    raise SpecError(f"drawing {path.name!r}: {ring.source} on layer {ring.layer}: open: it starts at {start} m and "
+                    f"ends at {end} m; an outline or an opening is one closed polyline (close it)")
 
 
 def _counted(ignored: dict[str, int]) -> str:
@@ -232,9 +253,13 @@ def read_dxf_lines(path: str | Path, layer: str | None = None) -> DxfLines:
     return DxfLines(tuple(lines), tuple(sources), int(doc.header.get("$INSUNITS", 0)))
 
 
-def _read_dxf(path: Path, drawing_unit: str | None, chord_tolerance: float | None, default_chord: float | None = None):
-    """The closed polylines of a DXF drawing, its unit and the entities left out. An arc needs a chord
-    tolerance (drawing units): ``chord_tolerance``, else ``default_chord`` metres, else an error."""
+def _read_dxf(path: Path, drawing_unit: str | None, chord_tolerance: float | None, default_chord: float | None = None,
+              outlined: set[str] = frozenset()):
+    """The closed polylines of a DXF drawing (and, in an elevation, its circles and ellipses), its unit and the
+    entities left out. An arc needs a chord tolerance (drawing units): ``chord_tolerance``, else ``default_chord``
+    metres, else an error. On the ``outlined`` layers (an elevation's outline and openings) nothing else may be
+    drawn: a line or an arc there is refused, named (it was left out silently, and an opening drawn so
+    vanished)."""
     doc = _open_dxf(path)
     unit = drawing_unit
     if unit is None:
@@ -249,11 +274,26 @@ def _read_dxf(path: Path, drawing_unit: str | None, chord_tolerance: float | Non
     ignored: Counter = Counter()
     for entity in _flat_entities(doc.modelspace()):
         kind = entity.dxftype()
-        if kind in ("LWPOLYLINE", "POLYLINE"):
+        if kind in POLYLINES or outlined and kind in CURVES:
             rings.append(_polyline_ring(entity, path, chord_tolerance))
+        elif entity.dxf.get("layer", "0") in outlined and kind not in ANNOTATIONS:
+            raise SpecError(f"drawing {path.name!r}: {kind} #{entity.dxf.get('handle', '?')} on layer "
+                            f"{entity.dxf.get('layer', '0')}: an outline or an opening is one closed polyline (its "
+                            "arcs drawn as bulges) or a circle; join its pieces into a closed polyline")
         else:
             ignored[kind] += 1
     return rings, unit, dict(ignored)
+
+
+#: The DXF entities read as closed outlines: polylines (their arcs as bulges); in an elevation also circles and
+#: ellipses (a round window: :func:`read_elevation`).
+POLYLINES = ("LWPOLYLINE", "POLYLINE")
+CURVES = ("CIRCLE", "ELLIPSE")
+#: Entities that draw no geometry (left out on any layer).
+ANNOTATIONS = ("TEXT", "MTEXT", "DIMENSION", "POINT", "LEADER", "MLEADER", "HATCH")
+#: The finest chord tolerance of an arc, relative to the size of the entity it is in: finer, an arc of the size of
+#: the entity would become more than about 10,000 chords (and ezdxf's flattening recurses past Python's limit).
+FINEST_CHORD = 1e-7
 
 
 def _flat_entities(layout):
@@ -274,18 +314,30 @@ def _polyline_ring(entity, path: Path, chord_tolerance: float | None) -> _Ring:
     where = f"drawing {path.name!r}: {source} on layer {layer}"
     if entity.dxftype() == "POLYLINE" and not entity.is_2d_polyline:
         raise SpecError(f"{where}: a 3D polyline or mesh, not a block outline; draw each block as a closed 2D polyline")
-    has_arcs = entity.has_arc
-    if has_arcs and chord_tolerance is None:
-        raise SpecError(f"{where}: has arc segments (bulges); give geometry.chord_tolerance (drawing units) "
-                        "to replace them by chords, or draw straight segments")
+    curved = entity.dxftype() in ("CIRCLE", "ELLIPSE") or entity.has_arc
+    if curved and chord_tolerance is None:
+        raise SpecError(f"{where}: has arc segments (bulges, or is a circle); give geometry.chord_tolerance (drawing "
+                        "units) to replace them by chords, or draw straight segments")
     if chord_tolerance is not None and not chord_tolerance > 0:
         raise SpecError(f"geometry.chord_tolerance = {chord_tolerance!r}: must be > 0")
     outline = dxf_path.make_path(entity)
-    points = np.array([(v.x, v.y, v.z) for v in outline.flattening(distance=chord_tolerance or 1.0)])
+    corners = np.array([(v.x, v.y, v.z) for v in outline.control_vertices()])
+    size = float(np.ptp(corners[:, :2], axis=0).max()) if corners.size else 0.0
+    if not np.isfinite(corners).all() or not np.isfinite(size):
+        raise SpecError(f"{where}: its coordinates are not finite numbers")
+    if curved and chord_tolerance < FINEST_CHORD * size:
+        raise SpecError(f"geometry.chord_tolerance = {chord_tolerance:.3g} (drawing units) is finer than "
+                        f"{FINEST_CHORD:g} of the size of {source} on layer {layer} ({size:.4g}): its arcs would "
+                        f"become millions of chords; give at least {FINEST_CHORD * size:.3g}")
+    try:
+        points = np.array([(v.x, v.y, v.z) for v in outline.flattening(distance=chord_tolerance or 1.0)])
+    except (RecursionError, ValueError, OverflowError) as exc:
+        raise SpecError(f"{where}: its arcs cannot be made chords ({exc}); are its coordinates what was meant?") from None
     if points.shape[0] and np.ptp(points[:, 2]) > 0:
         raise SpecError(f"{where}: its vertices are not in one plane parallel to the drawing (z varies)")
     x, y = points[:, 0], points[:, 1]
-    return _Ring(x, y, layer, source, bool(entity.closed))
+    closed = entity.dxftype() in ("CIRCLE", "ELLIPSE") or bool(entity.closed)
+    return _Ring(x, y, layer, source, closed, curved)
 
 
 def _number(text: str, where: str, column: str) -> float:

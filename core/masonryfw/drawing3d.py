@@ -34,6 +34,7 @@ from .errors import SpecError
 from .geometry import block_offsets
 from .ground_plan import SETTLEMENT_3D_KEYS, GroundInPlan, profile_in_plan
 from .imported import LAYER_ROLES as DRAWN_LAYER_ROLES
+from .inputs import InputError, regular_file
 from .mesh_drawing import MeshDrawing, read_obj
 from .on_ground import model_on_ground, plane_motion
 from .profiles import with_profile
@@ -66,21 +67,30 @@ def build_drawn_3d(spec: dict, text: str, base_dir: Path | None) -> xr.Dataset:
         raise SpecError(f"spec key 'space' = {top.raw('space')!r}: a mesh is 3D (space = 3, or leave it out)")
     geometry = top.sub("geometry", GEOMETRY_KEYS)
     unit = DRAWING_UNITS[geometry.choice("drawing_unit", tuple(DRAWING_UNITS), "m")]
+    if not isinstance(geometry.raw("mesh"), str):
+        raise SpecError(f"spec key 'geometry.mesh' = {geometry.raw('mesh')!r}: must be the path of an OBJ file")
     path = mesh_path(spec, base_dir)
-    if not isinstance(geometry.raw("mesh"), str) or not path.is_file():
-        raise SpecError(f"spec key 'geometry.mesh' = {geometry.raw('mesh')!r}: no such file ({path})")
+    try:
+        regular_file(path, "3D drawing (an OBJ mesh)", f"spec key 'geometry.mesh' = {geometry.raw('mesh')!r}")
+    except InputError as exc:
+        raise SpecError(str(exc)) from None
     if path.suffix.lower() != ".obj":
         raise SpecError(f"spec key 'geometry.mesh' = {geometry.raw('mesh')!r}: a Wavefront OBJ file (.obj) is read")
     snap = geometry.number("snap_tolerance", None, positive=True)
     drawing = read_obj(path, snap)
     roles = _layer_roles(geometry, drawing)
     masonry = _scaled(polyhedra.subset(drawing.blocks, roles >= 0), unit)
+    names = [name for name, role in zip(drawing.names, roles) if role >= 0]
+    lines = [line for line, role in zip(drawing.lines, roles) if role >= 0]
+    label = lambda b: f"block {names[b]!r} (line {lines[b]})"  # noqa: E731 - how messages name a drawn block
+    _refuse_overlaps(masonry, path.name, label)
     material = read_material(top)
     if not top.has("settlement"):
         raise SpecError("spec table 'settlement' is missing: a drawn 3D model stands on ground that moves by a "
                         "profile in plan ([settlement] with profile, axis_angle, center_x, center_y)")
     length, height = _typical_unit(masonry)
-    ground_plan = profile_in_plan(top.sub("settlement", SETTLEMENT_3D_KEYS), length)
+    ground_plan = profile_in_plan(top.sub("settlement", SETTLEMENT_3D_KEYS), length,
+                                  float(np.ptp(masonry.vertices[:, :2], axis=0).max()))
     depth = geometry.number("ground_depth", height / top.scale, length=True, positive=True)
     tol = 1e-6 * float(np.ptp(masonry.vertices, axis=0).max())
     pieces, level = _ground_pieces(masonry, ground_plan.profile.segment, tol, path.name)
@@ -92,8 +102,29 @@ def build_drawn_3d(spec: dict, text: str, base_dir: Path | None) -> xr.Dataset:
              **({"laying_notes": "\n".join(drawing.notes)} if drawing.notes else {}),
              **({"comment": top.text("description")} if top.has("description") else {})}
     model = model_on_ground(polyhedra.joined(masonry, ground), roles[roles >= 0], material.unit_weight * volume,
-                            motion, shapely.area(pieces), material, attrs, tol, "piece of the ground")
+                            motion, material, attrs, tol, "piece of the ground",
+                            lambda b: f"drawing {path.name!r}: {label(b)}")
     return with_profile(model, ground_plan.profile)
+
+
+def _refuse_overlaps(masonry: polyhedra.Polyhedra, name: str, label) -> None:
+    """Refuse blocks that interpenetrate (:func:`masonryfw.polyhedra.overlapping_blocks`), naming the first pair and
+    what it looks like: the same block twice, one inside the other, or two laid into one another."""
+    size = float(np.ptp(masonry.vertices, axis=0).max())
+    found = polyhedra.overlapping_blocks(masonry, 1e-6 * size, most=1)
+    if not found:
+        return
+    a, b, depth, shared, point = found[0]
+    volume, _ = polyhedra.volumes_centroids(masonry)
+    if np.isfinite(shared) and shared >= (1 - 1e-6) * max(volume[a], volume[b]):
+        what = "the same block drawn twice"
+    elif np.isfinite(shared) and shared >= (1 - 1e-6) * min(volume[a], volume[b]):
+        what = "one inside the other"
+    else:
+        what = "laid into one another"
+    common = f"{shared:.3g} m3 in common" if np.isfinite(shared) else "a point of one inside the other"
+    raise SpecError(f"drawing {name!r}: {label(a)} and {label(b)} interpenetrate ({what}: {common}, at "
+                    f"({', '.join(f'{c:.6g}' for c in point)}) m); blocks may touch, never overlap")
 
 
 def _layer_roles(geometry: SpecTable, drawing: MeshDrawing) -> np.ndarray:

@@ -82,10 +82,11 @@ class GroundInPlan(NamedTuple):
         return down, horizontal * share[:, None]
 
 
-def profile_in_plan(table: SpecTable, unit_length: float) -> GroundInPlan:
+def profile_in_plan(table: SpecTable, unit_length: float, ground: float) -> GroundInPlan:
     """The ``[settlement]`` profile over the coordinate across its axis in plan: ``axis_angle`` degrees from x (90:
     the axis along y, the profile along x) through (``center_x``, ``center_y``); a trough's tunnel ``face`` along
-    the axis from that point, driven towards ``axis_angle`` (:mod:`masonryfw.ground_plan`)."""
+    the axis from that point, driven towards ``axis_angle`` (:mod:`masonryfw.ground_plan`). Its ``segment`` is
+    checked against the ``ground`` it cuts [m] (a building's longest wall, a drawing's extent in plan)."""
     angle = math.radians(table.number("axis_angle", 90.0))
     point = np.array([table.number("center_x", 0.0, length=True), table.number("center_y", 0.0, length=True)])
     plain = {k: v for k, v in table.table.items() if k not in ("axis_angle", "center_x", "center_y", "face")}
@@ -94,7 +95,7 @@ def profile_in_plan(table: SpecTable, unit_length: float) -> GroundInPlan:
     elif table.has("face"):
         raise SpecError(f"spec key {table.key('face')!r}: a tunnel's face bounds a trough; profile = "
                         f"{plain.get('profile')!r} has none (use 'tunnel' or 'gaussian')")
-    profile = read_profile(SpecTable(plain, table.path, SETTLEMENT_KEYS, table.scale), 0.0, 1.0, unit_length)
+    profile = read_profile(SpecTable(plain, table.path, SETTLEMENT_KEYS, table.scale), 0.0, 1.0, unit_length, ground)
     face = table.number("face", length=True) if table.has("face") else None
     return GroundInPlan(profile, point, np.array([math.sin(angle), -math.cos(angle)]), face)
 

@@ -69,19 +69,21 @@ def file_kind(mode: int) -> str:
     return next((name for test, name in _KINDS if test(mode)), "a regular file")
 
 
-def regular_file(path: str | os.PathLike, what: str) -> Path:
-    """``path`` if it is (or links to) a regular file; else an :class:`InputError` saying what it is."""
+def regular_file(path: str | os.PathLike, what: str, named: str | None = None) -> Path:
+    """``path`` if it is (or links to) a regular file; else an :class:`InputError` saying what it is, about
+    ``named`` (how the user gave it: a spec key) or the path."""
     file = Path(path)
+    about = named or str(path)
     try:
         info = file.stat()
         mode = info.st_mode
     except FileNotFoundError:
         broken = " (a broken symbolic link)" if file.is_symlink() else ""
-        raise InputError(f"{path}: no such file{broken}") from None
+        raise InputError(f"{about}: no such file{broken}") from None
     except OSError as exc:
-        raise InputError(f"{path}: cannot be read ({exc.strerror or exc})") from None
+        raise InputError(f"{about}: cannot be read ({exc.strerror or exc})") from None
     if not stat.S_ISREG(mode):
-        raise InputError(f"{path}: is {file_kind(mode)}, not a regular file; a {what} must be a file")
+        raise InputError(f"{about}: is {file_kind(mode)}, not a regular file; a {what} must be a file")
     _note_read(info)
     return file
 
@@ -89,8 +91,9 @@ def regular_file(path: str | os.PathLike, what: str) -> Path:
 def fits_in_memory(nbytes: float, what: str, advice: str = "") -> None:
     """Refuse work that would need more than the memory available (``MASONRYFW_MEMORY_LIMIT``)."""
     available = available_memory()
-    if nbytes > available:
-        raise InputError(f"{what} needs about {size_text(nbytes)} of memory and {size_text(available)} is available "
+    if not nbytes <= available:
+        needed = f"about {size_text(nbytes)}" if nbytes < float("inf") else "more than any machine has"
+        raise InputError(f"{what} needs {needed} of memory and {size_text(available)} is available "
                          f"({MEMORY_LIMIT_VARIABLE} sets the limit){'; ' + advice if advice else ''}")
 
 

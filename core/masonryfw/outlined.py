@@ -9,7 +9,8 @@ An outline comes from
 * a **parametric spec** whose ``[wall]`` has ``width`` and ``height`` (the eaves) and a ``gable_height`` (the
   ridge, over the middle), or an ``outline`` of ``[x, y]`` points, with ``[[openings]]`` of ``shape``
   rectangle, ``arched`` (a rectangle and a circular head of ``rise``, half the width by default: a
-  semicircle) or ``polygon`` (``points``).
+  semicircle), ``round`` (a round window of diameter ``width``, its box's lower left corner at ``x``, ``y``) or
+  ``polygon`` (``points``).
 
 ``[unit]`` gives the unit's length and course height; ``[bond]`` its ``pattern`` (running, stack, english,
 flemish), ``first_course`` and ``min_piece``; ``[heads]`` the head over every opening (``kind``: lintel,
@@ -33,10 +34,12 @@ from . import blocks
 from .bond import HEADS, PATTERNS, Bond, Head, Laid, lay
 from .drawing import DRAWING_UNITS, read_elevation
 from .errors import SpecError
+from .inputs import fits_in_memory
 from .model import checked_model
 from .profiles import SETTLEMENT_KEYS, read_profile, with_profile
+from .resources import count_text
 from .roles import ROLE
-from .spec import LENGTH_UNITS, SpecTable, read_loading, read_material
+from .spec import LENGTH_UNITS, SpecTable, is_finite_number, read_loading, read_material, shown
 from .supports import profile_supports, read_supports, support_blocks
 
 if TYPE_CHECKING:  # annotations only
@@ -48,7 +51,7 @@ _TOP_KEYS = ("title", "description", "space", "length_unit", "geometry", "wall",
 _GEOMETRY_KEYS = ("dxf", "polygons", "drawing_unit", "chord_tolerance", "outline_layer", "openings_layer")
 _WALL_KEYS = ("width", "height", "thickness", "gable_height", "outline")
 _OPENING_KEYS = ("x", "y", "width", "height", "lintel_bearing", "shape", "rise", "points", "head", "head_courses")
-_SHAPES = ("rectangle", "arched", "polygon")
+_SHAPES = ("rectangle", "arched", "polygon", "round")
 #: Chord tolerance of an arched opening's head, in its radii.
 ARC_CHORD = 1e-3
 
@@ -88,6 +91,7 @@ class Elevation:
     heads: list[Head]
     names: list[str]
     source: Path | None  # the drawing, if any
+    notes: tuple[str, ...] = ()  # what reading the drawing did
 
 
 def build_outlined(spec_dict: dict, text: str, base_dir: Path | None, validate: bool = True) -> xr.Dataset:
@@ -101,6 +105,7 @@ def build_outlined(spec_dict: dict, text: str, base_dir: Path | None, validate: 
                 bond_table.choice("first_course", ("full", "half"), "full"),
                 bond_table.number("min_piece", 0.5, minimum=0.0, below=1.0))
     elevation = _drawn(top, base_dir, bond) if top.has("geometry") else _parametric(top, bond)
+    _refuse_too_big(elevation, bond, top)
     laid = lay(elevation.outline, elevation.openings, bond, elevation.heads, elevation.names)
     _refuse_one_block(laid, elevation)
     x0, y0, x1, _ = elevation.outline.bounds
@@ -118,7 +123,7 @@ def build_outlined(spec_dict: dict, text: str, base_dir: Path | None, validate: 
     rectangles = [np.array([[a, c], [b, c], [b, d], [a, d]]) for a, b, c, d in zip(s_x0, s_x1, s_y0, s_y1)]
     rings = laid.polygons + rectangles
     roles = np.array(laid.roles + [ROLE["fixed_support"]] * len(rectangles), dtype=np.int8)
-    attrs = {"title": top.text("title"), "source_spec": text, "laying_notes": "\n".join(laid.notes)}
+    attrs = {"title": top.text("title"), "source_spec": text, "laying_notes": "\n".join([*elevation.notes, *laid.notes])}
     if top.text("description", ""):
         attrs["comment"] = top.text("description")
     if elevation.source is not None:
@@ -131,6 +136,20 @@ def build_outlined(spec_dict: dict, text: str, base_dir: Path | None, validate: 
                                   loading, direction, attrs)
     ds = with_profile(ds, profile)
     return checked_model(ds, repr(attrs["title"])) if validate else ds
+
+
+def _refuse_too_big(elevation: Elevation, bond: Bond, top: SpecTable) -> None:
+    """Refuse, before any laying, an outline whose units (counted from its extent) would not fit in the memory
+    available, naming what sizes it: a drawing in mm read as metres, a unit in the wrong unit."""
+    x0, y0, x1, y1 = elevation.outline.bounds
+    with np.errstate(over="ignore", invalid="ignore"):
+        units = np.float64(x1 - x0) * np.float64(y1 - y0) / (bond.unit_length * bond.unit_height)
+    where = f"the drawing {elevation.source.name!r}" if elevation.source is not None else "spec table 'wall'"
+    fits_in_memory((units + 2.0 * (x1 - x0) / bond.unit_length) * blocks.BYTES_PER_BLOCK,
+                   f"the outline of {where} ({x1 - x0:.4g} x {y1 - y0:.4g} m) in units of [unit] = {bond.unit_length:.4g}"
+                   f" x {bond.unit_height:.4g} m ({count_text(units)} blocks)",
+                   "are [unit] and the drawing's unit (geometry.drawing_unit) what was meant?" if elevation.source
+                   else "are [unit], [wall] and length_unit what was meant?")
 
 
 def _refuse_one_block(laid: Laid, elevation: Elevation) -> None:
@@ -164,19 +183,21 @@ def _drawn(top: SpecTable, base_dir: Path | None, bond: Bond) -> Elevation:
                             "its shape)")
     drawn = read_elevation(path, unit, geometry.text("outline_layer"), geometry.text("openings_layer", "") or None,
                            geometry.number("chord_tolerance", None, positive=True))
-    heads = _heads(top, len(drawn.openings), bond)
+    heads = _heads(top, len(drawn.openings), bond, _extent(drawn.outline))
     names = [f"opening {k} ({source} in {path.name!r})" for k, source in enumerate(drawn.opening_sources)]
     return Elevation(_valid(Polygon(drawn.outline), f"the outline ({drawn.outline_source} in {path.name!r})"),
                      [_valid(Polygon(o), name) for o, name in zip(drawn.openings, names)],
-                     [_arched_default(h, o) for h, o in zip(heads, drawn.openings)], names, path)
+                     [_arched_default(h, o) for h, o in zip(heads, drawn.openings)], names, path, drawn.notes)
 
 
-def _heads(top: SpecTable, count: int, bond: Bond, entries: list[SpecTable] | None = None) -> list[Head]:
-    """Every opening's head: ``[heads]`` as the default, an opening's own keys over it."""
+def _heads(top: SpecTable, count: int, bond: Bond, extent: tuple[float, float],
+           entries: list[SpecTable] | None = None) -> list[Head]:
+    """Every opening's head: ``[heads]`` as the default, an opening's own keys over it; courses a whole number no
+    more than the wall's, a bearing no longer than the wall (``extent``: its width and height in metres)."""
     table = top.sub("heads", ("kind", "courses", "bearing"), {})
     kind = table.choice("kind", HEADS, "lintel")
-    courses = int(table.number("courses", 1, minimum=1))
-    bearing = table.number("bearing", 0.5 * bond.unit_length / top.scale, length=True, minimum=0.0)
+    courses = _head_courses(table, "courses", 1, bond, extent)
+    bearing = _bearing(table, "bearing", 0.5 * bond.unit_length / top.scale, extent)
     heads = []
     for k in range(count):
         entry = entries[k] if entries else None
@@ -184,9 +205,26 @@ def _heads(top: SpecTable, count: int, bond: Bond, entries: list[SpecTable] | No
             heads.append(Head(kind, courses, bearing))
             continue
         own = entry.choice("head", HEADS, kind if entry.has("head") or not _is_arched(entry) else "arch")
-        heads.append(Head(own, int(entry.number("head_courses", courses, minimum=1)),
-                          entry.number("lintel_bearing", bearing / top.scale, length=True, minimum=0.0)))
+        heads.append(Head(own, _head_courses(entry, "head_courses", courses, bond, extent),
+                          _bearing(entry, "lintel_bearing", bearing / top.scale, extent)))
     return heads
+
+
+def _head_courses(table: SpecTable, key: str, default: int, bond: Bond, extent: tuple[float, float]) -> int:
+    courses = table.integer(key, default, minimum=1)
+    most = max(1, math.ceil(extent[1] / bond.unit_height))
+    if courses > most:
+        raise SpecError(f"spec key {table.key(key)!r} = {shown(courses)}: a head deeper than the wall's {most} "
+                        "courses")
+    return courses
+
+
+def _bearing(table: SpecTable, key: str, default: float, extent: tuple[float, float]) -> float:
+    bearing = table.number(key, default, length=True, minimum=0.0)
+    if bearing > extent[0]:
+        raise SpecError(f"spec key {table.key(key)!r} = {shown(table.raw(key))}: bears {bearing:.4g} m into the "
+                        f"masonry, more than the wall is wide ({extent[0]:.4g} m)")
+    return bearing
 
 
 def _arched_default(head: Head, ring: np.ndarray) -> Head:
@@ -225,20 +263,27 @@ def _parametric(top: SpecTable, bond: Bond) -> Elevation:
     names = [f"spec key {t.path!r}" for t in tables]
     openings = [_valid(_opening(t), name) for t, name in zip(tables, names)]
     return Elevation(_valid(Polygon(outline), "spec key 'wall.outline'"), openings,
-                     _heads(top, len(tables), bond, tables), names, None)
+                     _heads(top, len(tables), bond, _extent(outline), tables), names, None)
+
+
+def _extent(points: list[tuple[float, float]]) -> tuple[float, float]:
+    """The width and height of the box around ``points``."""
+    xy = np.asarray(points, dtype=float)
+    return tuple(np.ptp(xy, axis=0).tolist())  # type: ignore[return-value]
 
 
 def _points(table: SpecTable, key: str) -> list[tuple[float, float]]:
     raw = table.raw(key)
     if (not isinstance(raw, list) or len(raw) < 3 or any(not isinstance(p, list) or len(p) != 2 for p in raw)
-            or any(isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v) for p in raw
+            or any(isinstance(v, bool) or not is_finite_number(v) for p in raw
                    for v in p)):
         raise SpecError(f"spec key {table.key(key)!r}: must be at least three [x, y] points (numbers)")
     return [(float(x) * table.scale, float(y) * table.scale) for x, y in raw]
 
 
 def _is_arched(entry: SpecTable) -> bool:
-    return entry.raw("shape", "rectangle") == "arched"
+    """Whether the opening has a circular head (arched, round): its head is an arch by default."""
+    return entry.raw("shape", "rectangle") in ("arched", "round")
 
 
 def _opening(entry: SpecTable) -> Polygon:
@@ -248,6 +293,14 @@ def _opening(entry: SpecTable) -> Polygon:
     if shape == "polygon":
         return Polygon(_points(entry, "points"))
     x0, y0 = entry.number("x", length=True), entry.number("y", length=True)
+    if shape == "round":  # a round window (an oculus): x, y its box's lower left corner, width its diameter
+        if entry.has("height") or entry.has("rise"):
+            raise SpecError(f"spec key {entry.key('height' if entry.has('height') else 'rise')!r}: a round opening "
+                            "is given by its width (the diameter) alone")
+        radius = 0.5 * entry.number("width", length=True, positive=True)
+        steps = 4 * max(4, int(math.ceil(0.5 * math.pi / math.sqrt(8 * ARC_CHORD))))  # its box: the diameter
+        angles = np.linspace(0.0, 2 * math.pi, steps, endpoint=False)
+        return Polygon(np.c_[x0 + radius * (1 + np.cos(angles)), y0 + radius * (1 + np.sin(angles))])
     width, height = entry.number("width", length=True, positive=True), entry.number("height", length=True,
                                                                                     positive=True)
     if shape == "rectangle":

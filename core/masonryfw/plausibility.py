@@ -15,7 +15,9 @@ from, what it is and the nearest plausible reading:
   recognised);
 - Young's modulus 0.1-100 GPa (MPa or GPa typed as Pa is recognised);
 - a tunnel's volume loss 0.1-5 % (a fraction typed for a percentage is recognised), its diameter 1-20 m, and
-  its greenfield S_max at most the wall's height.
+  its greenfield S_max at most the wall's height;
+- a building's floor loads 0.1-200 kN/m on the walls (kN/m typed as N/m is recognised) and its walls 50 mm to
+  3 m thick.
 
 They are warnings, not errors: a laboratory model or a deliberately extreme
 study may step outside. ``masonryfw build`` and ``solve`` print them,
@@ -35,6 +37,7 @@ from .geometry import block_bounds
 from .model3d import space
 from .profiles import model_profile
 from .roles import masonry_blocks
+from .spec import read_spec
 
 if TYPE_CHECKING:  # annotations only
     import xarray as xr
@@ -47,6 +50,8 @@ FRICTION_ANGLE = (10.0, 60.0)  # degrees
 YOUNG_MODULUS = (0.1e9, 100.0e9)  # Pa
 VOLUME_LOSS = (0.1, 5.0)  # %: 0.5-3 % is common, soft ground up to about 5 % (Mair et al. 1996)
 TUNNEL_DIAMETER = (1.0, 20.0)  # m: a micro-tunnel to the largest bored tunnels
+FLOOR_LOAD = (100.0, 200.0e3)  # N/m: a light roof on a short span to heavy floors of many storeys on one wall
+WALL_THICKNESS = (0.05, 3.0)  # m: a half-brick partition to a castle's wall
 GRAVITY = 9.81  # m s-2
 
 
@@ -112,6 +117,7 @@ def plausibility(model: xr.Dataset) -> list[str]:
                             f"metres){unit}")
     messages += _friction(model)
     messages += _tunnel(model, extent["height"])
+    messages += _building(model)
     if "block_young_modulus" in model:
         young = float(np.median(model.block_young_modulus.values[masonry]))
         if young > 0 and not _within(young, YOUNG_MODULUS):
@@ -182,6 +188,32 @@ def _tunnel(model: xr.Dataset, height: float) -> list[str]:
     if profile.target > height:
         messages.append(f"the greenfield S_max = {profile.target:.6g} m of the tunnel (settlement.volume_loss, "
                         f"diameter, depth, trough_width_factor) is more than the wall's height ({height:.6g} m)")
+    return messages
+
+
+def _building(model: xr.Dataset) -> list[str]:
+    """A building's keys that the blocks do not show: the floors' line loads and the walls' thicknesses (read from
+    the spec the model was built from)."""
+    try:
+        spec = read_spec(str(model.attrs.get("source_spec", "")))[0]
+    except Exception:  # noqa: BLE001 - a model written by hand, or from an older spec: nothing to read
+        return []
+    building = spec.get("building") if isinstance(spec, dict) else None
+    if not isinstance(building, dict):
+        return []
+    messages = []
+    for k, floor in enumerate(building.get("floors", []) if isinstance(building.get("floors"), list) else []):
+        load = floor.get("load") if isinstance(floor, dict) else None
+        if isinstance(load, (int, float)) and load > 0 and not _within(load, FLOOR_LOAD):
+            advice = _reading(load, FLOOR_LOAD, [(1e3, "kN/m were meant, in N/m")])
+            messages.append(f"building.floors[{k}].load = {load:.6g} N/m: floors bear on walls with "
+                            f"{FLOOR_LOAD[0] / 1e3:g}-{FLOOR_LOAD[1] / 1e3:g} kN/m{advice}")
+    scale = {"m": 1.0, "cm": 0.01, "mm": 0.001}.get(spec.get("length_unit", "m"), 1.0)
+    for k, wall in enumerate(building.get("walls", []) if isinstance(building.get("walls"), list) else []):
+        thickness = wall.get("thickness") if isinstance(wall, dict) else None
+        if isinstance(thickness, (int, float)) and not _within(thickness * scale, WALL_THICKNESS):
+            messages.append(f"building.walls[{k}].thickness = {thickness:.6g} {spec.get('length_unit', 'm')}: "
+                            f"masonry walls are {WALL_THICKNESS[0] * 1e3:g} mm to {WALL_THICKNESS[1]:g} m thick")
     return messages
 
 

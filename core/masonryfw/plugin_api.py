@@ -11,9 +11,9 @@ import lazy_loader
 
 __getattr__, __dir__, __all__ = lazy_loader.attach("masonryfw", submod_attrs={
     "assessment": ["LTSM_LIMITS", "POISSON", "Part", "assess", "deep_beam_strains", "ltsm_category", "volume_loss_per_settlement", "wall_extent"],
-    "command_kit": ["LENGTH", "OPTIONS", "PROGRESS", "command_line"],
+    "command_kit": ["ADDRESS", "LENGTH", "Number", "OPTIONS", "PROGRESS", "command_line"],
     "cores": ["core_share", "cores", "free_cores", "machine_load"],
-    "damage": ["distortion", "support_profile"],
+    "damage": ["distortion", "refuse_not_standing", "standing_text", "support_profile"],
     "dofs": ["block_loads", "block_motion", "load_variables", "motion_variables"],
     "drawing": ["DxfLines", "Elevation", "read_drawing", "read_dxf_lines", "read_elevation"],
     "errors": ["listed"],
@@ -34,7 +34,7 @@ __getattr__, __dir__, __all__ = lazy_loader.attach("masonryfw", submod_attrs={
     "provenance": ["core_version", "options_json", "solver_version"],
     "records": ["Comparator", "Estimate", "Plotter", "Solver", "Variant"],
     "registry": ["plugin_manager"],
-    "resources": ["duration_text", "size_text"],
+    "resources": ["count_text", "duration_text", "size_text"],
     "roles": ["ROLE", "jointed_blocks", "masonry_blocks", "masonry_joints", "support_blocks"],
     "schema": ["FORMAT_VERSION", "flags", "load_schema", "variable_attrs"],
     "semantics": ["ModelScales", "connected_components", "crack_indicator", "indicator_at", "interface_states", "joint_motion", "macro_blocks", "model_scales", "nearest_interface", "plastic_crack_indicator", "point_motion", "polar_moment", "refuse_rigid_settlement", "relative_motion", "rigid_fit", "settlement_weights"],

@@ -17,6 +17,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from .boxes import box_pairs
 from .geometry import block_offsets, next_node
 
 #: Two faces are parallel when their unit normals differ by less than this (rounded to it).
@@ -231,13 +232,12 @@ def find_contacts(poly: Polyhedra, tol: float) -> Contacts:
     low = np.minimum.reduceat(uv, starts, axis=0)
     high = np.maximum.reduceat(uv, starts, axis=0)
 
-    plus, minus = np.flatnonzero(sign > 0), np.flatnonzero(sign < 0)
-    minus = minus[np.argsort(plane[minus], kind="stable")]
-    first = np.searchsorted(plane[minus], plane[plus], side="left")
-    last = np.searchsorted(plane[minus], plane[plus], side="right")
-    counts = last - first
-    a = np.repeat(plus, counts)
-    b = minus[np.repeat(last - counts.cumsum(), counts) + np.arange(counts.sum())] if counts.sum() else minus[:0]
+    a, b = box_pairs(low, high, -0.5 * tol, plane)  # faces of one plane whose boxes overlap by more than tol
+    facing = sign[a] != sign[b]
+    a, b = a[facing], b[facing]
+    a, b = np.where(sign[a] > 0, a, b), np.where(sign[a] > 0, b, a)  # side 0: the face along the plane's normal
+    order = np.lexsort((b, a))  # by the face on side 0, then the other: the interfaces in face order
+    a, b = a[order], b[order]
     overlap = np.minimum(high[a], high[b]) - np.maximum(low[a], low[b])
     keep = (block[a] != block[b]) & (overlap > tol).all(axis=1)
     a, b = a[keep], b[keep]
@@ -272,3 +272,129 @@ def _contacts(parts, plus_face, minus_face, block, direction, frame, centre) -> 
     area = np.asarray(shapely.area(parts), dtype=float) if len(parts) else np.zeros(0)
     sides = np.c_[block[plus_face], block[minus_face]].astype(np.int64).reshape(-1, 2)
     return Contacts(sides, normal.reshape(-1, 3), tangent.reshape(-1, 2, 3), count, points.reshape(-1, 3), area)
+
+
+class Overlap(NamedTuple):
+    """Two blocks that interpenetrate: how deep (the radius of the largest ball inside both, for convex blocks;
+    ``nan`` where one is not convex and a point of one was found inside the other) and the volume they share
+    (``nan`` where not convex)."""
+
+    a: int
+    b: int
+    depth: float
+    volume: float
+    point: np.ndarray  # (3,) a point inside both
+
+
+def overlapping_blocks(poly: Polyhedra, tol: float, most: int = 10) -> list[Overlap]:
+    """Pairs of blocks of ``poly`` that interpenetrate by more than ``tol`` (two identical blocks, one inside another,
+    two laid into one another), at most ``most`` of them. Blocks that touch on a face, an edge or a corner do not.
+
+    The broad phase (:func:`masonryfw.boxes.box_pairs`) keeps pairs whose boxes overlap by more than ``tol`` on
+    every axis: for blocks that are boxes that is the answer. Other pairs are looked at exactly when both blocks
+    are convex (the largest ball inside both faces' half-spaces, by a linear programme; the volume of their
+    intersection), else by points of one (its vertices, edge and face middles, centroid, each moved ``tol``
+    inwards) found inside the other (a winding number)."""
+    n = poly.n_block
+    owner = np.repeat(np.arange(n), poly.block_node_count)
+    low = np.full((n, 3), np.inf)
+    high = np.full((n, 3), -np.inf)
+    np.minimum.at(low, owner, poly.vertices)
+    np.maximum.at(high, owner, poly.vertices)
+    a, b = box_pairs(low, high, -0.5 * tol)
+    if not a.size:
+        return []
+    normal, area, centre = face_normals_areas(poly)
+    volume, centroid = volumes_centroids(poly)
+    is_box = np.abs(volume - np.prod(high - low, axis=1)) <= tol * np.max(high - low, axis=1) ** 2
+    face_first = block_offsets(poly.block_face_count)
+    found = []
+    for p, q in zip(a.tolist(), b.tolist()):
+        if is_box[p] and is_box[q]:
+            lo, hi = np.maximum(low[p], low[q]), np.minimum(high[p], high[q])
+            found.append(Overlap(p, q, 0.5 * float(np.min(hi - lo)), float(np.prod(hi - lo)), 0.5 * (lo + hi)))
+        else:
+            planes = [(normal[face_first[k]:face_first[k + 1]], centre[face_first[k]:face_first[k + 1]]) for k in (p, q)]
+            overlap = _convex_overlap(planes, tol) if all(_convex(poly, k, planes[i], tol) for i, k in
+                                                           enumerate((p, q))) else _points_inside(poly, p, q, tol)
+            if overlap is not None:
+                found.append(Overlap(p, q, *overlap))
+        if len(found) >= most:
+            break
+    return found
+
+
+def _convex(poly: Polyhedra, block: int, plane: tuple[np.ndarray, np.ndarray], tol: float) -> bool:
+    """Whether every vertex of ``block`` lies on the inner side of each of its faces' planes (within ``tol``)."""
+    first = block_offsets(poly.block_node_count)
+    points = poly.vertices[first[block]:first[block + 1]]
+    normal, centre = plane
+    return bool(np.all(np.einsum("fj,vj->fv", normal, points) - np.einsum("fj,fj->f", normal, centre)[:, None]
+                       <= tol))
+
+
+def _convex_overlap(planes, tol: float) -> tuple[float, float, np.ndarray] | None:
+    """``(depth, volume, point)`` of two convex blocks given by their faces' planes (outward normals, points on
+    them) when the largest ball inside both has a radius over ``tol / 2``, else None."""
+    from scipy.optimize import linprog
+    from scipy.spatial import ConvexHull, HalfspaceIntersection
+
+    normal = np.concatenate([p[0] for p in planes])
+    offset = np.einsum("ij,ij->i", normal, np.concatenate([p[1] for p in planes]))
+    origin = np.concatenate([p[1] for p in planes]).mean(axis=0)
+    offset = offset - normal @ origin  # about the blocks' middle: the programme's numbers stay small
+    norms = np.linalg.norm(normal, axis=1)
+    ball = linprog(np.r_[0.0, 0.0, 0.0, -1.0], A_ub=np.c_[normal, norms], b_ub=offset,
+                   bounds=[(None, None)] * 3 + [(0.0, None)], method="highs")
+    if ball.status != 0 or ball.x[3] <= 0.5 * tol:
+        return None
+    inside = ball.x[:3]
+    hull = ConvexHull(HalfspaceIntersection(np.c_[normal, -offset], inside).intersections)
+    return float(ball.x[3]), float(hull.volume), inside + origin
+
+
+def _points_inside(poly: Polyhedra, p: int, q: int, tol: float) -> tuple[float, float, np.ndarray] | None:
+    """A point of either block (its vertices, edge and face middles, centroid, each moved ``tol`` towards its
+    centroid) inside the other by the winding number of the other's faces; None when there is none."""
+    for one, other in ((p, q), (q, p)):
+        samples = _samples(poly, one, tol)
+        number = winding_numbers(subset(poly, np.arange(poly.n_block) == other), samples)
+        inside = np.flatnonzero(number > 0.5)
+        if inside.size:
+            return float("nan"), float("nan"), samples[inside[0]]
+    return None
+
+
+def _samples(poly: Polyhedra, block: int, tol: float) -> np.ndarray:
+    one = subset(poly, np.arange(poly.n_block) == block)
+    index = one.face_vertex_index()
+    following = index[next_node(one.face_node_count)]
+    _, _, face_centre = face_normals_areas(one)
+    _, centroid = volumes_centroids(one)
+    points = np.concatenate([one.vertices, 0.5 * (one.vertices[index] + one.vertices[following]), face_centre,
+                             centroid])
+    towards = centroid[0] - points
+    length = np.linalg.norm(towards, axis=1)
+    return points + towards * (np.minimum(tol, length) / np.where(length > 0, length, 1.0))[:, None]
+
+
+def winding_numbers(poly: Polyhedra, points: np.ndarray) -> np.ndarray:
+    """How many times the closed surface of ``poly``'s faces winds around each of ``points``: 1 inside a block, 0
+    outside (the solid angles of the faces' fan triangles, Van Oosterom and Strackee, over 4 pi)."""
+    index = poly.face_vertex_index()
+    starts = block_offsets(poly.face_node_count)[:-1]
+    apex = np.repeat(index[starts], poly.face_node_count - 2)
+    keep = np.ones(index.size, dtype=bool)
+    keep[starts] = False
+    keep[block_offsets(poly.face_node_count)[1:] - 1] = False
+    second = index[keep]
+    third = index[np.flatnonzero(keep) + 1]
+    total = np.zeros(len(points))
+    for tri in np.array_split(np.arange(apex.size), max(1, apex.size // 4096)):
+        r = [poly.vertices[corner[tri]][None] - points[:, None] for corner in (apex, second, third)]
+        size = [np.linalg.norm(v, axis=2) for v in r]
+        top = np.einsum("ptj,ptj->pt", r[0], np.cross(r[1], r[2]))
+        bottom = (size[0] * size[1] * size[2] + np.einsum("ptj,ptj->pt", r[0], r[1]) * size[2]
+                  + np.einsum("ptj,ptj->pt", r[1], r[2]) * size[0] + np.einsum("ptj,ptj->pt", r[2], r[0]) * size[1])
+        total += 2.0 * np.arctan2(top, bottom).sum(axis=1)
+    return total / (4.0 * np.pi)

@@ -47,7 +47,7 @@ import numpy as np
 
 from .errors import SpecError
 from .schema import variable_attrs
-from .spec import SpecTable
+from .spec import SpecTable, is_finite_number
 
 if TYPE_CHECKING:  # annotations only
     import xarray as xr
@@ -124,16 +124,17 @@ class Segment:
         return max(self.down) > 0
 
 
-def read_profile(table: SpecTable, x0: float, x1: float, unit_length: float) -> Profile:
+def read_profile(table: SpecTable, x0: float, x1: float, unit_length: float, ground: float | None = None) -> Profile:
     """A spec's ``[settlement]`` table (with its length scale) under a wall from ``x0`` to ``x1`` [m]; ``segment``
-    defaults to :data:`DEFAULT_SEGMENT_UNITS` unit lengths."""
+    defaults to :data:`DEFAULT_SEGMENT_UNITS` unit lengths and is checked against the length of ``ground`` it
+    cuts (``x1 - x0`` unless given: a building's longest wall)."""
     kind = table.choice("profile", PROFILES)
     for key, kinds in _ONLY.items():
         if table.has(key) and kind not in kinds:
             raise SpecError(f"spec key {table.key(key)!r} only applies to profile = "
                             f"{' or '.join(map(repr, kinds))}")
     segment = table.number("segment", DEFAULT_SEGMENT_UNITS * unit_length / table.scale, length=True, positive=True)
-    segment_count(x1 - x0, segment, unit_length, f"spec key {table.key('segment')!r}")
+    segment_count(x1 - x0 if ground is None else ground, segment, unit_length, f"spec key {table.key('segment')!r}")
     cutoff = table.number("cutoff", DEFAULT_CUTOFF, minimum=0.0, below=1.0)
     if kind == "gaussian":
         return Profile(kind, segment, cutoff, center=table.number("center", length=True),
@@ -191,7 +192,7 @@ def _table_points(table: SpecTable) -> tuple[tuple[float, float], ...]:
     shown = f"spec key {table.key('points')!r}"
     if (not isinstance(raw, list) or len(raw) < 2
             or any(not isinstance(p, list) or len(p) != 2 for p in raw)
-            or any(isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v)
+            or any(isinstance(v, bool) or not is_finite_number(v)
                    for p in raw for v in p)):
         raise SpecError(f"{shown} = {raw!r}: must be at least two pairs [x, rate] of numbers")
     x = np.array([p[0] for p in raw], dtype=float) * table.scale
@@ -241,17 +242,24 @@ def segment_count(length: float, segment: float, unit_length: float, key: str) -
     body) or is finer than :data:`MAX_SEGMENTS_PER_UNIT` a unit length ``unit_length``."""
     if not (math.isfinite(segment) and segment > 0):
         raise SpecError(f"{key} = {segment!r}: must be a positive, finite length")
+    refuse_fine_segments(length, segment, unit_length, key)
     count = round(length / segment)
     if count < 2:
         raise SpecError(f"{key} = {segment:.6g} m: the {length:.6g} m ground would be {max(count, 1)} piece, moving "
                         f"as one body; give at most {length / 2:.6g} m")
+    return count
+
+
+def refuse_fine_segments(length: float, segment: float, unit_length: float, key: str) -> None:
+    """Refuse, naming ``key``, ground segments finer than :data:`MAX_SEGMENTS_PER_UNIT` a unit length: they would cut
+    a ground ``length`` long into more pieces than any convergence needs."""
     finest = unit_length / MAX_SEGMENTS_PER_UNIT
     if segment < finest * (1 - 1e-9):
-        shown = f"{count:,}" if count < 1e12 else f"{count:.3g}"
+        count = length / segment
+        shown = f"{count:,.0f}" if count < 1e12 else f"{count:.3g}"
         raise SpecError(f"{key} = {segment:.3g} m: it would cut the {length:.6g} m ground into {shown} segments, "
                         f"finer than a hundredth of a unit ({unit_length:.6g} m), which no convergence needs (a "
                         f"quarter unit is the default); give at least {finest:.3g} m")
-    return count
 
 
 def segment_motions(profile: Profile, edges: np.ndarray) -> list[Segment]:

@@ -56,6 +56,10 @@ class Solver:
     ``spaces``: the model dimensions it solves (2D walls, 3D models: ``masonryfw_space``); the core refuses
     any other before the solve starts.
 
+    ``history``: whether its result is a history of steps (``step_settlement``, ``step_reaction``,
+    ``step_crack_width_max``) that damage can be read from: ``masonryfw capacity`` refuses a solver without one
+    before any work.
+
     ``estimate`` (optional): ``estimate(model, options) -> Estimate``, cheap (counts,
     no factorisation, no time stepping). The core refuses a run whose memory does
     not fit before it starts, and the CLI prints the estimate of a run longer than a
@@ -71,6 +75,7 @@ class Solver:
     gallery: bool = True
     estimate: Callable[[xr.Dataset, Mapping[str, Any]], Estimate] | None = None
     spaces: tuple[int, ...] = (2,)
+    history: bool = False
 
 
 @dataclass(frozen=True)

@@ -60,18 +60,30 @@ def available_memory() -> float:
 
 
 def size_text(nbytes: float) -> str:
-    """``300 MiB``, ``1.5 GiB``, ``7.0 PiB``."""
+    """``300 MiB``, ``1.5 GiB``, ``7.0 PiB`` (``more than any machine has`` past what a float counts)."""
+    if not nbytes < float("inf"):
+        return "more than any machine has"
     for power, unit in ((50, "PiB"), (40, "TiB"), (30, "GiB")):
         if nbytes >= 2**power:
-            return f"{nbytes / 2**power:.1f} {unit}"
+            return f"{nbytes / 2**power:.1f} {unit}" if nbytes < 2**60 else f"{nbytes / 2**power:.3g} {unit}"
     return f"{nbytes / 2**20:.0f} MiB"
+
+
+def count_text(count: float) -> str:
+    """``about 12,345`` (``about 1.2e+13`` past ten digits, ``more than 1e+308`` past what a float counts): a count
+    estimated before the work."""
+    if not count < float("inf"):
+        return "more than 1e+308"
+    return f"about {count:,.0f}" if count < 1e10 else f"about {count:.3g}"
 
 
 def duration_text(seconds: float) -> str:
     """``40 s``, ``12 min``, ``3.1 h``."""
     if seconds < 120:
         return f"{seconds:.0f} s"
-    return f"{seconds / 60:.0f} min" if seconds < 7200 else f"{seconds / 3600:.1f} h"
+    if seconds < 7200:
+        return f"{seconds / 60:.0f} min"
+    return f"{seconds / 3600:.1f} h" if seconds < 3.6e7 else f"{seconds / 3600:.3g} h"
 
 
 def require_memory(solver: str, estimate: Estimate) -> None:

@@ -115,13 +115,6 @@ def _dropped(signum: int, frame) -> None:
     came just before the switch would otherwise be reported by Python as "ignored due to race condition".)"""
 
 
-def settles(targets) -> bool:
-    """Whether writing ``targets`` puts the command's last claimed output in place (:mod:`masonryfw.locks`)."""
-    from .locks import held_claims
-
-    return _Command.answering and held_claims() <= set(targets)
-
-
 def exiting(status: int) -> None:
     """The command is over with ``status``: its outcome is settled, and a signal now, while the interpreter
     shuts down, ends the process at once with that same status (what is written and said stands), rather

@@ -57,6 +57,20 @@ def _read_text(path) -> str:
     return read_text(path, "spec (a TOML file)")
 
 
+def is_finite_number(value) -> bool:
+    """An int or float that is a finite float (an integer of 400 digits is not: it has no float)."""
+    try:
+        return isinstance(value, (int, float)) and math.isfinite(float(value))
+    except OverflowError:
+        return False
+
+
+def shown(value, width: int = 60) -> str:
+    """``repr(value)`` cut to ``width`` characters (a key holding a number of 400 digits is named, not printed)."""
+    text = repr(value)
+    return text if len(text) <= width else f"{text[:width - 12]}...({len(text)} characters)"
+
+
 class SpecTable:
     """One table of a spec: typed access to its keys; unknown keys are rejected up front."""
 
@@ -90,8 +104,8 @@ class SpecTable:
             return None
         if isinstance(value, bool) or not isinstance(value, (int, float)):
             raise SpecError(f"spec key {self.key(name)!r} = {value!r}: must be a number")
-        if not math.isfinite(value):
-            raise SpecError(f"spec key {self.key(name)!r} = {value!r}: must be finite")
+        if not is_finite_number(value):
+            raise SpecError(f"spec key {self.key(name)!r} = {shown(value)}: must be finite (at most 1.8e308)")
         if positive and value <= 0:
             raise SpecError(f"spec key {self.key(name)!r} = {value!r}: must be positive")
         if minimum is not None and value < minimum:
@@ -131,8 +145,8 @@ class SpecTable:
     def point(self, name: str) -> tuple[float, float]:
         value = self.raw(name)
         if (not isinstance(value, list) or len(value) != 2
-                or any(isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v) for v in value)):
-            raise SpecError(f"spec key {self.key(name)!r} = {value!r}: must be a pair of numbers [x, y]")
+                or any(isinstance(v, bool) or not is_finite_number(v) for v in value)):
+            raise SpecError(f"spec key {self.key(name)!r} = {shown(value)}: must be a pair of finite numbers [x, y]")
         return float(value[0]) * self.scale, float(value[1]) * self.scale
 
     def sub(self, name: str, allowed: tuple[str, ...], default=_REQUIRED) -> SpecTable:
@@ -214,7 +228,7 @@ def read_direction(entry: SpecTable) -> tuple[float, float]:
         return DOWN
     value = entry.raw("direction")
     if (not isinstance(value, list) or len(value) != 2
-            or any(isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v) for v in value)
+            or any(isinstance(v, bool) or not is_finite_number(v) for v in value)
             or math.hypot(*value) == 0):
         raise SpecError(f"spec key {entry.key('direction')!r} = {value!r}: must be a non-zero pair [dx, dy] "
                         "(the direction the support moves in; [0, -1] down, [1, 0] to the right)")

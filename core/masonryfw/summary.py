@@ -17,9 +17,10 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from .assessment import assess
-from .roles import masonry_blocks
+from .damage import standing_text
+from .roles import masonry_blocks, moving_blocks
 from .schema import flags
-from .semantics import CRACK_THRESHOLD, at_threshold, dead_reaction
+from .semantics import CRACK_THRESHOLD, at_threshold, dead_reaction, model_scales
 
 if TYPE_CHECKING:  # annotations only
     import xarray as xr
@@ -61,6 +62,54 @@ def plateau_start(settlement: np.ndarray, reaction: np.ndarray, band: float) -> 
     """Index of the first record after which the reaction stays within ``band`` of its final value."""
     outside = np.flatnonzero(np.abs(reaction - reaction[-1]) > band)
     return int(outside[-1] + 1) if outside.size else 0
+
+
+def load_word(result: xr.Dataset) -> str:
+    """What moves the masonry, in a word: ``settlement`` (supports moving down), ``spread`` (moving sideways: an
+    arch's springings moving apart) or ``tilt`` (no moving support: a live load on the masonry, a tilting
+    table)."""
+    moving = moving_blocks(result.block_role.values)
+    if not moving.any():
+        return "tilt"
+    direction = np.asarray(result.settlement_direction.values, dtype=float)[moving]
+    vertical = np.abs(direction[:, 2 if direction.shape[1] == 6 else 1])
+    horizontal = np.hypot(direction[:, 0], direction[:, 1]) if direction.shape[1] == 6 else np.abs(direction[:, 0])
+    return "spread" if horizontal.sum() > vertical.sum() else "settlement"
+
+
+def collapse_record(result: xr.Dataset) -> int | None:
+    """The first record of a history at which the masonry has collapsed: its widest crack wider than the ground has
+    moved by more than a unit (the square root of the median block area): a block fallen away from the rest. None
+    when it did not, and for a history that says its own collapse (la-incremental's ``settlement_capacity``)."""
+    if "settlement_capacity" in result or not {"step_crack_width_max", "step_settlement"} <= set(result.variables) \
+            or int(result.attrs.get("masonryfw_space", 2)) == 3:
+        return None
+    moving = moving_blocks(result.block_role.values)
+    direction = np.asarray(result.settlement_direction.values, dtype=float)[moving]
+    rate = float(np.hypot(direction[:, 0], direction[:, 1]).max(initial=0.0))
+    ground = np.asarray(result.step_settlement.values, dtype=float) * rate
+    over = np.flatnonzero(np.asarray(result.step_crack_width_max.values, dtype=float) - ground
+                          > model_scales(result).block)
+    return int(over[0]) if over.size else None
+
+
+def _collapse_numbers(result: xr.Dataset, fell: int) -> list[KeyNumber]:
+    """The settlement at collapse from a history (:func:`collapse_record`): the last record that still carries
+    itself, its reaction, and where the masonry broke away (the widest crack at the record it had)."""
+    last = max(fell - 1, 0)
+    numbers = [KeyNumber("settlement_capacity", float(result.step_settlement.values[last]), "m",
+                         f"settlement at collapse: the last record before a block fell away (the next at "
+                         f"{float(result.step_settlement.values[fell]) * 1e3:.4g} mm)")]
+    if "step_reaction" in result:
+        numbers.append(KeyNumber("capacity_reaction", float(result.step_reaction.values[last]), "N",
+                                 "settlement reaction of the last record before the collapse"))
+    interface = int(result.step_crack_interface.values[fell]) if "step_crack_interface" in result else -1
+    if interface >= 0:
+        numbers += [KeyNumber("collapse_x", float(result.interface_x.values[interface].mean()), "m",
+                              "where the masonry broke away: x of the joint that opened"),
+                    KeyNumber("collapse_y", float(result.interface_y.values[interface].mean()), "m",
+                              "where the masonry broke away: y of the joint that opened")]
+    return numbers
 
 
 def _history_numbers(result: xr.Dataset) -> list[KeyNumber]:
@@ -175,8 +224,12 @@ def key_numbers(result: xr.Dataset) -> list[KeyNumber]:
         elif r0 > 0:
             numbers.append(KeyNumber("collapse_reaction", (1.0 - alpha) * r0, "N",
                                      "settlement reaction at collapse, (1 - alpha) R0"))
+    fell = collapse_record(result)
+    history = result if fell is None else result.isel(step=slice(0, max(fell, 1)))  # the records before a collapse
     if "step_reaction" in result and "step_settlement" in result:
-        numbers += _history_numbers(result)
+        numbers += _history_numbers(history)
+    if fell is not None:
+        numbers += _collapse_numbers(result, fell)
     for name, unit, what in (("settlement_capacity", "m", "settlement at collapse (the last moved configuration "
                                                           "that carries its dead load)"),
                              ("capacity_reaction", "N", "settlement reaction of the configuration at collapse"),
@@ -185,7 +238,7 @@ def key_numbers(result: xr.Dataset) -> list[KeyNumber]:
         if name in result:
             numbers.append(KeyNumber(name, float(result[name].values), unit, what))
     if "step_crack_width_max" in result:
-        numbers += _crack_numbers(result)
+        numbers += _crack_numbers(history)
     for name, what in (("deflection_ratio", "deflection ratio of the imposed profile at the last record "
                                               "(sagging positive, Burland & Wroth 1974)"),
                        ("angular_distortion", "angular distortion of the imposed profile at the last record [rad]")):
@@ -286,10 +339,15 @@ def short_of_target(result: xr.Dataset) -> float | None:
     return reached if reached < target * (1 - 1e-3) else None
 
 
-def _at(result: xr.Dataset, settlement: float, loss: float | None) -> str:
+def _at(result: xr.Dataset, settlement: float, loss: float | None, resolution: float | None = None) -> str:
+    """``12.3 mm (V_L 1.4 %)``, with ``+- 0.5 mm`` where the records it lies between are that far apart, or
+    ``0 mm (under its own weight)`` for what the first record already had."""
     if not np.isfinite(settlement):
         return "not reached"
-    return _mm(settlement) + ("" if loss is None else f" (V_L {loss:.3g} %)")
+    if settlement == 0 and resolution == 0:
+        return "0 mm (under its own weight, before any settlement)"
+    known = f" +- {_mm(resolution)}" if resolution else ""
+    return _mm(settlement) + known + ("" if loss is None else f" (V_L {loss:.3g} %)")
 
 
 def _per_category(result: xr.Dataset, name: str) -> np.ndarray:
@@ -306,6 +364,7 @@ def capacity_text(result: xr.Dataset, category: int | None = None) -> str:
     tunnel = "category_volume_loss" in result
     names = {value: name.replace("_", " ") for name, value in flags("step_damage_category").items()}
     model, ltsm = _per_category(result, "category_settlement"), _per_category(result, "category_ltsm_settlement")
+    resolution = _per_category(result, "category_settlement_resolution")
     model_loss = _per_category(result, "category_volume_loss")
     ltsm_loss = _per_category(result, "category_ltsm_volume_loss")
     solver = result.attrs.get("solver", "the run")
@@ -314,11 +373,16 @@ def capacity_text(result: xr.Dataset, category: int | None = None) -> str:
     reach = _mm(last) + ("" if per_metre is None else f" (V_L {per_metre * last:.3g} %)")
     rows = []
     for k, n in enumerate(result.category.values.astype(int)):
-        stage3 = _at(result, model[k], model_loss[k] if tunnel else None)
+        stage3 = _at(result, model[k], model_loss[k] if tunnel else None, resolution[k])
         stage2 = "lumped with 4" if n == 5 and "category_ltsm_settlement" in result else \
             _at(result, ltsm[k], ltsm_loss[k] if tunnel else None) if "category_ltsm_settlement" in result else "-"
         rows.append(Row(f"{n} {names.get(n, '')}", (stage3, stage2), "", (model[k], ltsm[k])))
     lines = [text_table(("category", f"stage 3: {solver} (to {reach})", "stage 2: LTSM"), rows, note=False)]
+    numbers = {n.name: n.value for n in key_numbers(result)}
+    if "settlement_capacity" in numbers:
+        capacity = numbers["settlement_capacity"]
+        lines.insert(0, f"the masonry collapsed at a {load_word(result)} of {_at(result, capacity, per_metre * capacity if per_metre else None)}: "
+                        "the categories not reached by then are not reached; the run holds nothing past its collapse")
     if "screen_settlement" in result:
         loss = float(result.screen_volume_loss.values) if "screen_volume_loss" in result else None
         lines.append(f"stage 1: the greenfield screen (slope 1/500 or 10 mm under the wall) fails at "
@@ -327,7 +391,8 @@ def capacity_text(result: xr.Dataset, category: int | None = None) -> str:
         k = int(category) - 1
         if not 0 <= k < model.size:
             raise ValueError(f"--category {category}: the damage categories are 1 to {model.size}")
-        found = (f"first reached at {_at(result, model[k], model_loss[k] if tunnel else None)} in the {solver} run"
+        found = (f"first reached at {_at(result, model[k], model_loss[k] if tunnel else None, resolution[k])} in "
+                 f"the {solver} run"
                  if np.isfinite(model[k]) else
                  f"not reached in the {solver} run, which went to {reach}: run it further (--settlement"
                  f"{' or --volume-loss' if tunnel else ''})")
@@ -414,9 +479,24 @@ def result_label(result: xr.Dataset) -> str:
 
 
 def headline_text(result: xr.Dataset) -> str:
-    """A result's headline in a few words (a figure's title): alpha, what it means, and the collapse reaction
-    (limit analysis), else R0 and the smallest and plateau reactions (incremental solvers); empty for a model."""
-    numbers = {n.name: n.value for n in key_numbers(result)} if "solver" in result.attrs else {}
+    """A result's headline in a few words (a figure's title), the answer first in the words of the load
+    (:func:`load_word`): a masonry that did not stand under its own weight says so; limit analysis: alpha, what it
+    means, and the collapse reaction; an incremental run that collapsed: where and at what settlement (spread,
+    tilt), then R0 and the smallest and plateau reactions before it; empty for a model."""
+    if "solver" not in result.attrs:
+        return ""
+    fallen = standing_text(result)
+    if fallen:
+        return fallen[0].upper() + fallen[1:]
+    numbers = {n.name: n.value for n in key_numbers(result)}
+    word = load_word(result)
+    force = "thrust" if word == "spread" else "reaction"
+    collapse = ""
+    if "settlement_capacity" in numbers and "alpha" not in numbers:
+        where = (f" (the masonry broke away at x {_place(numbers['collapse_x'])} m, y {_place(numbers['collapse_y'])} m)"
+                 if "collapse_x" in numbers else "")
+        collapse = (f"collapses at a {word} of {_mm(numbers['settlement_capacity'])}{where}, {force} "
+                    f"{force_text(numbers.get('capacity_reaction', float('nan')))}; ")
     if "alpha" in numbers:
         if "dead_reaction" not in numbers:
             return f"alpha = {numbers['alpha']:.4f} (the live load's multiplier at collapse)"
@@ -426,10 +506,17 @@ def headline_text(result: xr.Dataset) -> str:
                 f"settling ground sheds before collapse){reaction}")
     if "minimum_reaction" in numbers:
         dynamic = numbers.get("unbalanced_ratio", 0.0) > QUASI_STATIC_RATIO
-        return (f"R0 {force_text(numbers['dead_reaction'])}, min {force_text(numbers['minimum_reaction'])} at "
-                f"{_mm(numbers['minimum_reaction_settlement'])}, plateau {force_text(numbers['plateau_reaction'])}"
+        before = " before it" if collapse else ""
+        return (f"{collapse}R0 {force_text(numbers['dead_reaction'])}, min {force_text(numbers['minimum_reaction'])}"
+                f" at {_mm(numbers['minimum_reaction_settlement'])}, plateau "
+                f"{force_text(numbers['plateau_reaction'])}{before}"
                 + (f" (DYNAMIC: unbalanced force ratio {numbers['unbalanced_ratio']:.2g})" if dynamic else ""))
-    return ""
+    return collapse.rstrip("; ")
+
+
+def _place(coordinate: float) -> str:
+    """A coordinate [m] to the millimetre, without round-off's -0 or 6e-17."""
+    return f"{round(coordinate, 3) + 0.0:.4g}"
 
 
 def quasi_static_text(numbers: dict) -> str:

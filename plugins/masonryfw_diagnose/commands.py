@@ -99,18 +99,19 @@ def _table_lines(table: dict) -> list[str]:
 @click.option("--plugin", "solver", default="la", show_default=True,
               help="The solver whose cracks are matched (la: its collapse mechanism).")
 @click.option("--option", "options", multiple=True, metavar="KEY=VALUE", help="A solver option (repeatable).")
-@click.option("--levelling-sigma", "sigma_mm", type=click.FloatRange(min=0.0, min_open=True), metavar="MM",
+@click.option("--levelling-sigma", "sigma_mm", type=mfp.Number("mm", above=0.0, at_most=1000.0), metavar="MM",
               help="The levelling's noise, its standard deviation [mm] [default: read from the data, the median "
                    "absolute deviation of its second differences].")
 @click.option("--rerank", type=click.IntRange(min=0), metavar="N",
               help="Re-rank the best N candidates by forward fdem runs to their settlements, scored on fdem's "
                    "cracks (0: rank by the search's solver alone) [default: as many of the best 5 as fit in "
                    "--budget].")
-@click.option("--budget", type=click.FloatRange(min=0.0), default=120.0, show_default=True, metavar="SECONDS",
+@click.option("--budget", type=mfp.Number("seconds", at_least=0.0, at_most=1e7), default=120.0, show_default=True,
+              metavar="SECONDS",
               help="The time the default re-ranking may take, by fdem's estimate.")
 @click.option("--workers", type=click.IntRange(min=1), default=1, show_default=True,
               help="Solve the scenarios on this many local processes.")
-@click.option("--scheduler", metavar="ADDRESS",
+@click.option("--scheduler", type=mfp.ADDRESS,
               help="Solve the scenarios on the running dask cluster at ADDRESS (tcp://host:port); left running.")
 @click.option("--verify", "verify_with", metavar="SOLVER",
               help="Run the best candidates (at most 3, at most --top) forward with SOLVER (e.g. fdem) to their "

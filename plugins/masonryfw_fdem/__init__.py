@@ -26,5 +26,6 @@ def masonryfw_solvers():
             version=__version__,
             options=OPTIONS,
             estimate=mfp.lazy("masonryfw_fdem.estimate:estimate"),
+            history=True,
         )
     ]

@@ -1,10 +1,10 @@
 """The ``fdem`` solve's time and peak memory, known before it starts (``Solver.estimate``).
 
 The number of time steps to the target settlement is known from the controls (target /
-(rate x dt)); the gravity phase lasts about ``GRAVITY_TIME`` times sqrt(H / g) of simulated
-time (H the masonry's height; measured 0.23-0.68 on six bundled walls, from the 0.6 m Test 12C
-to the 6 m tunnel facade: a fixed share of the settlement steps was 5 % where it is 25-80 % for a
-short target); a step costs about ``STEP_SECONDS_PER_BLOCK`` a block on one thread (the 2-core
+(rate x dt)); the gravity phase lasts about ``controls.GRAVITY_TIME`` times sqrt(H / g) of simulated
+time (H the masonry's height; a fixed share of the settlement steps was 5 % where it is 25-80 % for a
+short target; a wall that does not come to rest runs longer, up to ``simulation.GRAVITY_TIME_LIMIT``, and the
+run says so when it passes five times this estimate); a step costs about ``STEP_SECONDS_PER_BLOCK`` a block on one thread (the 2-core
 machine, ``costs.py`` says which day and host: the same VM ran 1.5x faster on an Intel Xeon host than on an
 AMD EPYC one the same day), ``PARALLEL_EFFICIENCY`` of that less per added thread (the count the run will
 most likely settle on, :mod:`.threads`), divided by the share of a core the run gets on a busy machine, times
@@ -18,17 +18,15 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import Any
 
-import numpy as np
 import xarray as xr
 
 import masonryfw.plugin_api as mfp
 
-from .controls import make_controls, masonry_height
+from .controls import make_controls
 from .costs import DEFORMABLE_FACTOR, STEP_SECONDS_PER_BLOCK
 from .scene import build_scene
 
 PARALLEL_EFFICIENCY = 0.55  # two threads 1.53x one on the 2,432-block wall (2026-11-27 evening; 1.59x on Facade 3)
-GRAVITY_TIME = 0.4  # the gravity phase in units of sqrt(masonry height / g)
 BASE_MEMORY = 250 * 2**20
 MEMORY_PER_BLOCK = 20e3
 
@@ -37,8 +35,7 @@ def estimate(model: xr.Dataset, options: Mapping[str, Any]) -> mfp.Estimate:
     scene = mfp.made_once(model, "fdem scene", build_scene)
     controls = make_controls(scene, options)
     blocks = model.sizes["block"]
-    gravity = GRAVITY_TIME * np.sqrt(masonry_height(scene)) / controls.dt  # scaled time: sqrt(length / g)
-    steps = gravity + (controls.target / (controls.rate * controls.dt) if controls.rate > 0 else 0.0)
+    steps = controls.gravity_steps_expected + (controls.target / (controls.rate * controls.dt) if controls.rate > 0 else 0.0)
     if options["mode"] == "deformable":
         seconds = steps * blocks * STEP_SECONDS_PER_BLOCK * DEFORMABLE_FACTOR
     else:
@@ -46,6 +43,6 @@ def estimate(model: xr.Dataset, options: Mapping[str, Any]) -> mfp.Estimate:
         seconds = steps * blocks * STEP_SECONDS_PER_BLOCK / (1 + PARALLEL_EFFICIENCY * (count - 1)) \
             / mfp.core_share(mfp.cores(), mfp.machine_load())
     return mfp.Estimate(seconds=seconds, memory=BASE_MEMORY + MEMORY_PER_BLOCK * blocks,
-                       basis=f"at most {steps:,.0f} time steps of {blocks:,} blocks, as fitted on the 2-core machine "
+                       basis=f"{mfp.count_text(steps)} time steps, of {blocks:,} blocks, as fitted on the 2-core machine "
                              "of docs/benchmarks.md",
                        advice="fewer blocks (fdem's memory grows with the blocks and their contacts, not the options)")

@@ -39,6 +39,11 @@ GRAVITY_PHASE, SETTLEMENT_PHASE, SEARCH_PHASE = 0, 1, 2
 # the whole wall falling a thousand times its own size. Beyond it the integration has blown up.
 UNSTABLE_KINETIC_ENERGY = 1e3
 GRAVITY_TIME_LIMIT = 20.0  # scaled time units (sqrt(length / g)) for the gravity phase to come to rest
+#: The gravity phase running this many times its estimated steps (:mod:`.estimate`) is said, once.
+OVERRUN = 5.0
+#: A block that moves more than this share of the median unit height in the gravity phase: the masonry does not
+#: stand under its own weight as built (elastic settling is a few thousandths of a unit).
+STAND_SHARE = 0.1
 
 
 @dataclass(frozen=True)
@@ -107,6 +112,7 @@ class State:
     settlement_start: float = 0.0
     stop_reason: str = ""
     interrupted: bool = False
+    gravity_motion: np.ndarray | None = None  # (block,) how far each block moved in the gravity phase (scaled)
     collapse_bracket: tuple = ()  # (largest stable, smallest unstable load factor) of the search
     last_stable: State | None = None  # the search's state at rest under the largest stable load factor
     trials: list = field(default_factory=list)  # (load factor, stable, motion) of the load-factor search
@@ -230,16 +236,29 @@ def gravity_phase(scene, controls, state, history, progress) -> None:
         total = int(np.ceil(controls.gravity_time / controls.dt))
     else:  # a wall settles in a few sqrt(length / g); one that has not after 20 never will
         total = min(controls.max_steps, int(np.ceil(GRAVITY_TIME_LIMIT / controls.dt)))
+    expected = controls.gravity_steps_expected
+    warned = False
     while state.gravity_steps < total:
         n = min(controls.record_steps, total - state.gravity_steps)
         before = state.steps
         out = chunk(scene, controls, state, n, 0.0, 0.0)
         state.gravity_steps += state.steps - before
         history.add(GRAVITY_PHASE, state, out)
+        state.gravity_motion = block_motions(scene, state.pos, scene.pos0)
+        if state.gravity_motion.max(initial=0.0) > STAND_SHARE * scene.unit_height:
+            state.stop_reason = "did not stand under its own weight"
+            return
         ramped = state.acc[kernels.TIME] >= controls.load_ramp
         if controls.gravity_time <= 0 and ramped and out.report.unbalanced < controls.rest_tolerance:
             state.stop_reason = "at rest"
             break
+        if not warned and state.gravity_steps > OVERRUN * expected:
+            warned = True
+            LOG.warning("fdem: the gravity phase has run %d steps, %.0f times its estimate, and the masonry is not at "
+                        "rest yet (unbalanced force ratio %.2e, rest at %g); it stops at %d steps, or sooner if a "
+                        "block moves a tenth of a unit. Moving fastest: %s", state.gravity_steps,
+                        state.gravity_steps / expected, out.report.unbalanced, controls.rest_tolerance, total,
+                        fastest_blocks(scene, state))
         progress(0.05 * min(1.0, state.gravity_steps / max(total, 1)),
                  f"fdem: gravity, unbalanced force ratio {out.report.unbalanced:.2e}")
     else:
@@ -248,7 +267,8 @@ def gravity_phase(scene, controls, state, history, progress) -> None:
                 f"fdem: the wall did not come to rest under its loads within {state.gravity_steps} steps "
                 f"(unbalanced force ratio {history.table()['unbalanced'][-1]:.2e} > rest_tolerance "
                 f"{controls.rest_tolerance:g}): it is not stable as built, or the integration is "
-                "(lower dt_safety); set gravity_time to run a fixed time instead"
+                f"(lower dt_safety); set gravity_time to run a fixed time instead. Moving fastest: "
+                f"{fastest_blocks(scene, state)}"
             )
         state.stop_reason = "gravity time reached"
 
@@ -297,12 +317,24 @@ def settlement_phase(scene, controls, state, history, progress) -> None:
     state.stop_reason = "target settlement"
 
 
+def block_motions(scene: Scene, pos: np.ndarray, reference: np.ndarray) -> np.ndarray:
+    """``(block,)``: every free block's motion from ``reference`` (centroid displacement plus rotation times the
+    block radius), 0 for the driven ones."""
+    moved = np.hypot(*(pos[:, :2] - reference[:, :2]).T) + np.abs(pos[:, 2] - reference[:, 2]) * scene.radius
+    return np.where(scene.driven, 0.0, moved)
+
+
 def largest_motion(scene: Scene, pos: np.ndarray, reference: np.ndarray) -> float:
-    """Largest block motion from ``reference`` (centroid displacement plus rotation times the block radius)."""
-    free = ~scene.driven
-    moved = np.hypot(*(pos[free, :2] - reference[free, :2]).T) + np.abs(pos[free, 2] - reference[free, 2]) * \
-        scene.radius[free]
-    return float(moved.max(initial=0.0))
+    """Largest block motion from ``reference`` (:func:`block_motions`)."""
+    return float(block_motions(scene, pos, reference).max(initial=0.0))
+
+
+def fastest_blocks(scene: Scene, state: State, count: int = 3) -> str:
+    """The ``count`` free blocks moving fastest, with where they are [m] and their speed [m/s], for a message."""
+    speed = np.where(scene.driven, 0.0, np.hypot(*state.vel[:, :2].T) + np.abs(state.vel[:, 2]) * scene.radius)
+    length, time = scene.scales.length, scene.scales.time
+    return ", ".join(f"block {b} at ({state.pos[b, 0] * length:.4g}, {state.pos[b, 1] * length:.4g}) m, "
+                     f"{speed[b] * length / time:.3g} m/s" for b in np.argsort(-speed)[:count])
 
 
 def hold(scene: Scene, controls: Controls, state: State, reference: np.ndarray, history: History,
@@ -386,7 +418,9 @@ def run(scene: Scene, controls: Controls, state: State, load: np.ndarray, progre
     state.set_loads(scene, load)
     try:
         gravity_phase(scene, controls, state, history, progress)
-        if controls.search:
+        if state.stop_reason == "did not stand under its own weight":
+            pass  # its damage is not the settlement's: nothing more to run (the result says so)
+        elif controls.search:
             search_phase(scene, controls, state, history, progress)
         elif controls.target > 0 and scene.moving.any():
             settlement_phase(scene, controls, state, history, progress)

@@ -81,6 +81,9 @@ def _solve(model: xr.Dataset, options: Mapping[str, Any], progress) -> xr.Datase
         fdem_asleep_blocks=int((~scene.driven & (state.active == 0)).sum()),
         fdem_target_settlement=controls.target * scene.scales.length,
     )
+    result.attrs.update(standing(scene, state))
+    if not result.attrs["stood"]:
+        LOG.warning("fdem: %s", mfp.standing_text(result))
     result.attrs.update(quasi_static_ratios(result))
     if result.attrs.get("unbalanced_ratio", 0.0) > mfp.QUASI_STATIC_RATIO:
         LOG.warning("fdem: the reaction history is dynamic, not quasi-static: the median unbalanced force ratio of "
@@ -101,6 +104,20 @@ def opening_meter(scene: Scene):
     def widest(pos: np.ndarray) -> mf.Cracks:
         return mf.widest_crack(scene.model, postprocess.block_displacement(scene, pos), "finite")
     return widest
+
+
+def standing(scene: Scene, state) -> dict:
+    """Whether the masonry stood under its own weight (``stood``) and the gravity phase's largest block motion,
+    the block and where it started (docs/format.md): a run whose masonry fell is no settlement's damage."""
+    motion = getattr(state, "gravity_motion", None)
+    if motion is None:  # interrupted before the first record of gravity
+        return {"stood": 1}
+    worst = int(np.argmax(motion))
+    length = scene.scales.length
+    return {"stood": int(state.stop_reason != "did not stand under its own weight"),
+            "gravity_motion": float(motion[worst] * length), "gravity_motion_block": worst,
+            "gravity_motion_x": float(scene.pos0[worst, 0] * length),
+            "gravity_motion_y": float(scene.pos0[worst, 1] * length)}
 
 
 def quasi_static_ratios(result: xr.Dataset) -> dict[str, float]:

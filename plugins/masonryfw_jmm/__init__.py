@@ -26,6 +26,7 @@ def masonryfw_solvers():
             solve=mfp.lazy("masonryfw_jmm.solver:solve"),
             options=INCREMENTAL_OPTIONS,
             estimate=mfp.lazy("masonryfw_jmm.estimate:estimate"),
+            history=True,
         ),
         mfp.Solver(
             name="jmm-limit",

@@ -32,7 +32,8 @@ OPTIONS = (
               "3D models: 0, Coulomb's friction cone itself (Clarabel's second-order cone: exact; on the bundled house "
               "4.9 s against 7.2 s for 8 sides, which are 4.2 % below it); N >= 3, a pyramid of N sides inscribed in "
               "the cone, its first side along the joint's horizontal tangent (exact along and across a wall's joints "
-              "for a multiple of 4), solved by the option solver (docs/la.md, \"In 3D\")", at_least=0),
+              "for a multiple of 4), solved by the option solver (docs/la.md, \"In 3D\"); at most 64 (32 sides are "
+              "within 0.1 % of the cone)", at_least=0, at_most=64),
     mfp.Option("flow_iterations", int, 100, "nonassociative: the largest number of LPs", above=0),
     mfp.Option("flow_relaxation", float, 1.0,
               "nonassociative: share of the change of the normal forces taken from one LP to the next",

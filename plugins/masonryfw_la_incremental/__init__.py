@@ -24,5 +24,6 @@ def masonryfw_solvers():
             options=OPTIONS,
             gallery=False,
             estimate=mfp.lazy("masonryfw_la_incremental.estimate:estimate"),
+            history=True,
         )
     ]

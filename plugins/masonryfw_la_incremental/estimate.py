@@ -36,6 +36,6 @@ def estimate(model: xr.Dataset, options: Mapping[str, Any]) -> mfp.Estimate:
     increments = max(1.0, INCREMENTS_PER_STEP_OF_GROUND * target / (options["step"] * unit_height))
     seconds = increments * (SECONDS_PER_INCREMENT + SECONDS_PER_INCREMENT_AT_2432_BLOCKS * (blocks / 2432) ** 2)
     return mfp.Estimate(seconds=seconds, memory=BASE_MEMORY + MEMORY_PER_BLOCK * blocks * (1 + increments / 100),
-                        basis=f"{blocks:,} blocks, about {increments:.0f} increments to {target * 1e3:.3g} mm, as "
+                        basis=f"{blocks:,} blocks, {mfp.count_text(increments)} increments to {target * 1e3:.3g} mm, as "
                               "fitted on the 2-core machine of docs/la.md (\"Speed\")",
                         advice="--option step=... larger than " + f"{options['step']:g}")

@@ -25,6 +25,10 @@ OPTIONS = (
               "contacts after a few increments",
               ("nonassociative", "associative")),
     mfp.Option("increments", int, 5000, "the largest number of increments", above=0),
+    mfp.Option("records", int, 0,
+              "at least this many records over the target settlement (each increment at most target / records; 0: "
+              "as the adaptive steps go); masonryfw capacity asks for 100, so that the settlement at which each "
+              "damage category is reached is known to a hundredth of the run", at_least=0),
     mfp.Option("solver", str, "ipm", "la's LP backend for each increment (masonryfw solve --plugin la)", BACKENDS),
     mfp.Option("tolerance", float, 1e-9, "feasibility / optimality tolerance of the backend", above=0.0, below=1.0),
 )

@@ -32,11 +32,13 @@ def solve(model: xr.Dataset, options: Mapping[str, Any], progress=mfp.no_progres
     """Follow ``model`` from its configuration to collapse or to the target (module docstring)."""
     clock = time.perf_counter()
     ref = reference(model, options["gap"])
+    target = options["settlement"] or default_target(model)
     controls = stepping.Controls(
-        target=options["settlement"] or default_target(model),
+        target=target,
         step=options["step"] * ref.unit_height,
         max_increments=options["increments"],
         solver=options["solver"],
+        record_spacing=target / options["records"] if options["records"] else 0.0,
         tolerance=options["tolerance"],
         flow=options["flow"],
     )

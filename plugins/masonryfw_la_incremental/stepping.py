@@ -54,6 +54,7 @@ class Controls(NamedTuple):
     step: float  # the fastest point's motion per increment [m]
     max_increments: int
     solver: str
+    record_spacing: float  # the largest change of the parameter between two records (0: no limit)
     tolerance: float
     flow: str  # "nonassociative": joints slide without opening; "associative": la's dilatant joints
 
@@ -250,7 +251,7 @@ def run(ref: Reference, controls: Controls, record, progress) -> Outcome:
                 current, failing = landed, None
                 record(current)
                 continue
-            dt = min(scale * controls.step / speed, controls.target - current.t)
+            dt = min(scale * controls.step / speed, controls.target - current.t, controls.record_spacing or np.inf)
             if failing is not None:
                 dt = min(dt, 0.5 * (failing[0] - current.t))
             pose = pose_at(ref, current.pose, current.state.motion, dt, current.t + dt)

@@ -39,7 +39,7 @@ def _progress(total: int, enabled: bool):
 @click.option("--zip", "zipped", is_flag=True,
               help="Pair the values of all --param (same count) instead of taking every combination.")
 @click.option("--option", "options", multiple=True, metavar="KEY=VALUE", help="A solver option for every point (repeatable).")
-@click.option("--scheduler", metavar="ADDRESS", help="Use the running dask cluster at ADDRESS (tcp://host:port); left running.")
+@click.option("--scheduler", type=mfp.ADDRESS, help="Use the running dask cluster at ADDRESS (tcp://host:port); left running.")
 @click.option("--workers", type=click.IntRange(min=1),
               help="Worker processes of the local cluster [default: one per core].")
 @click.option("-o", "--output", type=click.Path(dir_okay=False), help="[default: <spec>.<plugin>.sweep.nc]")

@@ -116,23 +116,81 @@ def test_openings_have_lintels_and_floors_load_their_course(house):
     assert -house.dead_load.values[masonry, 2].sum() == pytest.approx(weight + floors, rel=1e-12)
 
 
-def test_a_straight_building_wall_is_the_planar_wall():
+DOOR = {"x": 0.96, "y": 0.0, "width": 0.48, "height": 0.72, "lintel_bearing": 0.12}
+
+
+@pytest.mark.parametrize("openings", [[], [DOOR]], ids=["plain", "with a door"])
+def test_a_straight_building_wall_is_the_planar_wall(openings):
     """The same wall over the same trough from a 2D spec (2D builder, 2D programme) and as a building of one wall
-    (3D builder, 3D programme): the same support motions, alpha and settlement reaction."""
+    (3D builder, 3D programme): the same support motions, alpha and settlement reaction. With a door on the
+    ground the segments under it touch no masonry and carry nothing in both (3D support loads by contact area
+    as 2D's by contact length; they went by the footprint)."""
     planar = mf.build({"title": "wall", "wall": {"width": 2.4, "height": 1.2, "thickness": 0.12}, "unit": UNIT,
                        "bond": {"pattern": "running", "first_course": "full"}, "material": MATERIAL,
+                       "openings": openings,
                        "settlement": {"profile": "gaussian", "width": 0.8, "center": 1.9, "segment": 0.06},
                        "loading": {"type": "settlement"}})
     building = mf.build({"title": "wall", "building": {"unit": UNIT, "segment": 0.06,
-                                                       "walls": [wall("w", (0, 0), (2.4, 0))]},
+                                                       "walls": [wall("w", (0, 0), (2.4, 0), openings)]},
                          "material": MATERIAL, "settlement": {"profile": "gaussian", "width": 0.8, "center_x": 1.9}})
-    assert building.sizes["block"] == planar.sizes["block"]
-    moving = planar.block_role.values == ROLE["moving_support"]
-    np.testing.assert_allclose(building.settlement_direction.values[moving][:, [0, 2, 4]],
-                               planar.settlement_direction.values[moving] * [1, 1, -1], atol=1e-12)
+    if not openings:  # the 2D wall lays no ground under a door, the building does (unloaded): the same blocks else
+        assert building.sizes["block"] == planar.sizes["block"]
+        moving = planar.block_role.values == ROLE["moving_support"]
+        np.testing.assert_allclose(building.settlement_direction.values[moving][:, [0, 2, 4]],
+                                   planar.settlement_direction.values[moving] * [1, 1, -1], atol=1e-12)
     a, b = mf.solve(planar, "la"), mf.solve(building, "la")
     assert float(b.collapse_multiplier) == pytest.approx(float(a.collapse_multiplier), rel=1e-7)
     assert float(b.moving_support_reaction) == pytest.approx(float(a.moving_support_reaction), rel=1e-7)
+
+
+def test_a_door_on_the_ground_leaves_its_segments_unloaded_and_the_rest_share_the_weight_by_contact():
+    """By hand: a wall 2.4 x 1.2 x 0.12 m of 20 kN/m3 with a door 0.48 x 0.72 m at x 0.96 (its lintel masonry too)
+    weighs W = 20000 (2.4 x 1.2 - 0.48 x 0.72) 0.12 = 6082.56 N. On ten segments of 0.24 m, all settling under
+    a trough over the wall, the two under the door touch no masonry: each of the other eight carries W / 8 up as
+    dead load and down as live load, the two nothing."""
+    model = mf.build({"title": "door", "building": {"unit": UNIT, "segment": 0.24,
+                                                    "walls": [wall("w", (0, 0), (2.4, 0), [DOOR])]},
+                      "material": MATERIAL, "settlement": {"profile": "gaussian", "width": 3.0, "center_x": 1.2}})
+    ground = ~mfp.masonry_blocks(model.block_role.values)
+    assert (model.block_role.values[ground] == ROLE["moving_support"]).all()
+    low, high = box_bounds(model)
+    middle = 0.5 * (low[ground, 0] + high[ground, 0])
+    under_door = (middle > 0.96) & (middle < 1.44)
+    weight = 20000.0 * (2.4 * 1.2 - 0.48 * 0.72) * 0.12
+    assert -model.dead_load.values[~ground, 2].sum() == pytest.approx(weight, rel=1e-12)
+    assert under_door.sum() == 2
+    np.testing.assert_allclose(model.dead_load.values[ground, 2], np.where(under_door, 0.0, weight / 8), rtol=1e-12,
+                               atol=1e-9)
+    np.testing.assert_allclose(model.live_load.values[ground, 2], -model.dead_load.values[ground, 2], atol=1e-12)
+
+
+def test_the_corner_buildings_ground_carries_the_weight_by_its_contact_with_the_masonry_in_plan():
+    """An independent construction of the 3D rule on the corner building (two toothed walls, a door on the
+    ground): each ground block's share is the area, by shapely in plan, of its top face under the first course's
+    bottom faces, over that of all the ground; the builder's loads come from the contacts it finds in 3D."""
+    import shapely
+
+    from masonryfw.testing import corner_building
+
+    model = corner_building()
+    poly = mfp.polyhedra_of(model)
+    index = poly.face_vertex_index()
+    starts = np.r_[0, np.cumsum(poly.face_node_count)[:-1]]
+    block = poly.face_block()
+    normal, _, centre = mfp.face_normals_areas(poly)
+    faces = [poly.vertices[index[a:a + n], :2] for a, n in zip(starts, poly.face_node_count)]
+    ground = ~mfp.masonry_blocks(model.block_role.values)
+    level = poly.vertices[:, 2][np.repeat(~ground, poly.block_node_count)].min()
+    bottoms = [f for f, b, nz, c in zip(faces, block, normal[:, 2], centre) if not ground[b] and nz < -0.99
+               and abs(c[2] - level) < 1e-9]
+    under = shapely.union_all([shapely.Polygon(f) for f in bottoms])
+    tops = {b: shapely.Polygon(f) for f, b, nz in zip(faces, block, normal[:, 2]) if ground[b] and nz > 0.99}
+    area = np.array([tops[b].intersection(under).area if b in tops else 0.0 for b in range(block.max() + 1)])
+    weight = -model.dead_load.values[~ground, 2].sum()
+    moving = model.block_role.values == ROLE["moving_support"]
+    assert (area[moving] == 0).any(), "the door's ground carries nothing"
+    np.testing.assert_allclose(model.dead_load.values[moving, 2], weight * area[moving] / area.sum(), rtol=1e-9,
+                               atol=1e-9 * weight)
 
 
 def test_a_wall_along_y_is_the_wall_along_x_turned():

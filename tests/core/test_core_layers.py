@@ -57,16 +57,18 @@ def cycles(graph: dict[str, set[str]]) -> list[list[str]]:
     return found
 
 
-#: The one deferred import, by design: the command's entry installs the signal handlers before the command line's
-#: imports (about a second), so that a Ctrl-C during them is answered (docs/faults.md).
+#: The deferred imports, by design: the command's entry installs the signal handlers before the command line's
+#: imports (about a second), so that a Ctrl-C during them is answered (docs/faults.md); the test models import
+#: the conformance suite (which needs pytest) only when it is named, so that the docs' models need no pytest.
 ENTRY_IMPORT = "__main__"
+KIT_IMPORT = "testing"
 
 
 def test_core_modules_import_each_other_at_the_top_and_without_a_cycle():
     graph, deferred = core_imports()
     assert {"api", "registry", "provenance", "options", "sources", "model", "semantics"} <= set(graph)
-    assert [where for where in deferred if where.split(":")[0] != ENTRY_IMPORT] == []
-    assert len(deferred) == 1 and graph[ENTRY_IMPORT] == {"signals"}
+    assert [where for where in deferred if where.split(":")[0] not in (ENTRY_IMPORT, KIT_IMPORT)] == []
+    assert len(deferred) == 2 and graph[ENTRY_IMPORT] == {"signals"}
     assert cycles(graph) == []
     # the layers the architecture names: the lowest know nothing of the plugins or of the builder
     for low in ("model", "semantics", "options", "geometry", "schema", "errors"):
@@ -133,3 +135,19 @@ def test_packages_import_only_each_others_public_namespaces():
                     elif top.startswith("masonryfw_") and top != own and name != top:
                         found.append(f"{path.relative_to(ROOT)}: {name}")
     assert found == []
+
+
+def test_the_models_of_the_docs_are_read_without_pytest(tmp_path):
+    """``masonryfw.testing`` (the arch and the corner building the docs use) imports without pytest; only the
+    conformance suite needs it, and is imported when it is named."""
+    import subprocess
+    import sys
+
+    script = ("import sys\nsys.modules['pytest'] = None  # no pytest: importing it fails\n"
+              "import masonryfw.testing as mt\n"
+              "print(mt.corner_building().sizes['block'], mt.arch_model(0.15).sizes['block'])\n"
+              "try:\n    mt.SolverConformance\nexcept ImportError:\n    print('the kit needs pytest')\n")
+    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120, cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    sizes, kit = done.stdout.splitlines()
+    assert all(int(n) > 10 for n in sizes.split()) and kit == "the kit needs pytest"

@@ -54,13 +54,17 @@ def test_compare_prints_both_headlines_and_each_score_with_what_it_measures(test
     assert "1 = the same mechanism, 0 = unrelated, -1 = opposite" in run.stdout
 
 
+def _not_json(name):
+    raise AssertionError(f"{name} written as a JSON number")
+
+
 def test_compare_of_three_results_scores_every_pair(test_12c_files, opened):
     paths = [test_12c_files[s] for s in ("la", "fdem", "jmm")]
     run = invoke("compare", *paths)
     assert run.exit_code == 0, run.output
     header = next(line for line in run.stdout.splitlines() if line.startswith("crack score"))
     assert header.split()[2:] == ["A-B", "A-C", "B-C"]
-    scores = json.loads(invoke("compare", *paths, "--json").stdout)
+    scores = json.loads(invoke("compare", *paths, "--json").stdout, parse_constant=_not_json)  # NaN is not JSON
     assert [(p["a"], p["b"]) for p in scores["pairs"]] == [(str(paths[0]), str(paths[1])), (str(paths[0]), str(paths[2])),
                                                          (str(paths[1]), str(paths[2]))]
     expected = mf.compare(opened["fdem"], opened["jmm"], "crack")

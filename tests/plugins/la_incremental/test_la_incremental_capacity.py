@@ -39,13 +39,13 @@ type = "settlement"
 """
 
 
-def test_first_exceeding_is_linear_between_records():
-    settlement = np.array([0.0, 1.0, 2.0, 3.0])
+def test_first_exceeding_is_linear_between_records_and_known_to_their_spacing():
+    settlement = np.array([0.0, 1.0, 2.0, 3.5])
     width = np.array([0.0, 0.5, 1.5, 1.0])
-    assert first_exceeding(settlement, width, 1.0) == pytest.approx(1.5)
-    assert first_exceeding(settlement, width, 0.2) == pytest.approx(0.4)
-    assert np.isnan(first_exceeding(settlement, width, 2.0))
-    assert first_exceeding(settlement, width + 3.0, 1.0) == 0.0  # over from the first record
+    assert first_exceeding(settlement, width, 1.0) == pytest.approx((1.5, 1.0))
+    assert first_exceeding(settlement, width, 0.2) == pytest.approx((0.4, 1.0))
+    assert np.isnan(first_exceeding(settlement, width, 2.0)).all()
+    assert first_exceeding(settlement, width + 3.0, 1.0) == (0.0, 0.0)  # over from the first record, exactly
 
 
 #: A run to its target: fdem would stop at its reaction plateau (masonryfw capacity sets this too).
