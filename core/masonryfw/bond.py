@@ -87,7 +87,7 @@ def lay(outline: Polygon, openings: list[Polygon], bond: Bond, heads: list[Head]
         ) -> Laid:
     """The units and heads of ``outline`` less ``openings`` (each bridged by its ``heads`` entry; ``names`` say
     which opening a note speaks of); see the module docstring."""
-    names = names or [f"opening {k}" for k in range(len(openings))]
+    names = names or [f"openings[{k}]" for k in range(len(openings))]
     laid = Laid()
     size = math.hypot(outline.bounds[2] - outline.bounds[0], outline.bounds[3] - outline.bounds[1])
     tol = 1e-9 * size

@@ -175,7 +175,6 @@ class Wall:
 _TOP_KEYS = ("title", "description", "space", "length_unit", "wall", "unit", "bond", "material",
              "openings", "supports", "settlement", "loading")
 _OPENING_KEYS = ("x", "y", "width", "height", "lintel_bearing")
-_SUPPORT_KEYS = ("kind", "start", "end", "motion", "pivot", "rate")
 
 
 def parse_spec(spec: dict) -> Wall:

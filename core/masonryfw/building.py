@@ -417,10 +417,10 @@ def lay_masonry(walls: list[Wall], joins: Junctions, unit_length: float, unit_he
         for number, (x, y, width, height, bearing) in enumerate(wall.openings):
             k0, k1 = round(y / unit_height), round((y + height) / unit_height)
             if abs(k0 * unit_height - y) > 1e-9 or abs(k1 * unit_height - y - height) > 1e-9:
-                notes.append(f"wall {wall.name!r} opening {number}: sill and head moved onto bed joints "
+                notes.append(f"wall {wall.name!r} openings[{number}]: sill and head moved onto bed joints "
                              f"(y {k0 * unit_height:.4g} m, height {(k1 - k0) * unit_height:.4g} m)")
             if k1 <= k0 or x + width > wall.length or k1 > courses[w]:
-                raise SpecError(f"wall {wall.name!r} opening {number}: x {x:g}, y {y:g}, width {width:g}, height "
+                raise SpecError(f"wall {wall.name!r} openings[{number}]: x {x:g}, y {y:g}, width {width:g}, height "
                                 f"{height:g} m does not fit in the wall ({wall.length:.6g} m long, {wall.height:.6g} "
                                 "m high, at least a course high)")
             for k in range(k0, k1):

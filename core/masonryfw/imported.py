@@ -46,7 +46,7 @@ from .material import Material
 from .model import checked_model
 from .profiles import SETTLEMENT_KEYS, profile_segments, read_profile, with_profile
 from .roles import ROLE
-from .spec import LENGTH_UNITS, SpecTable, check_pivot, read_loading, read_material, read_motion
+from .spec import LENGTH_UNITS, MOTION_KEYS, SpecTable, check_pivot, read_loading, read_material, read_motion
 
 if TYPE_CHECKING:  # annotations only
     import xarray as xr
@@ -59,7 +59,7 @@ _TOP_KEYS = ("title", "description", "space", "length_unit", "geometry", "wall",
 #: The keys a drawn wall's ``[settlement]`` takes beside a profile's: which drawn blocks are the ground.
 GROUND_KEYS = ("ground_layer", "ground_select")
 _GEOMETRY_KEYS = ("dxf", "polygons", "drawing_unit", "chord_tolerance", "snap_tolerance", "layers")
-_SUPPORT_KEYS = ("kind", "select", "layer", "at", "motion", "pivot", "rate")
+_SUPPORT_KEYS = ("kind", "select", "layer", "at", *MOTION_KEYS)
 _PARAMETRIC = {
     "unit": "the drawing gives the blocks; to lay a bond in an outline, name its layer: geometry.outline_layer",
     "bond": "the drawing gives the blocks; to lay a bond in an outline, name its layer: geometry.outline_layer",

@@ -184,7 +184,7 @@ def _drawn(top: SpecTable, base_dir: Path | None, bond: Bond) -> Elevation:
     drawn = read_elevation(path, unit, geometry.text("outline_layer"), geometry.text("openings_layer", "") or None,
                            geometry.number("chord_tolerance", None, positive=True))
     heads = _heads(top, len(drawn.openings), bond, _extent(drawn.outline))
-    names = [f"opening {k} ({source} in {path.name!r})" for k, source in enumerate(drawn.opening_sources)]
+    names = [f"openings[{k}] ({source} in {path.name!r})" for k, source in enumerate(drawn.opening_sources)]
     return Elevation(_valid(Polygon(drawn.outline), f"the outline ({drawn.outline_source} in {path.name!r})"),
                      [_valid(Polygon(o), name) for o, name in zip(drawn.openings, names)],
                      [_arched_default(h, o) for h, o in zip(heads, drawn.openings)], names, path, drawn.notes)

@@ -196,6 +196,8 @@ def read_loading(top: SpecTable, any_moving: bool) -> tuple[str, int]:
 
 #: A translating support's direction unless its table gives one: straight down.
 DOWN = (0.0, -1.0)
+#: The keys of a support's motion (:func:`read_motion`), the same in every spec kind that has supports.
+MOTION_KEYS = ("motion", "pivot", "rate", "direction")
 
 
 def read_motion(entry: SpecTable, kind: str) -> tuple[str, tuple[float, float] | None, float, tuple[float, float]]:

@@ -474,7 +474,7 @@ def result_label(result: xr.Dataset) -> str:
     name = str(result.attrs.get("solver", result.attrs.get("plugin", "?")))
     options = result_options(result)
     detail = ([str(result.attrs["method"])] if "method" in result.attrs
-              else [str(options[k]) for k in ("solver", "backend") if k in options])
+              else [str(options[k]) for k in ("solver", "backend") if options.get(k) is not None])
     return f"{name} ({', '.join(detail)})" if detail else name
 
 

@@ -11,11 +11,11 @@ from . import blocks
 from .blocks import GroundEdge
 from .errors import SpecError
 from .profiles import Profile, profile_segments
-from .spec import SpecTable, check_pivot, read_motion
+from .spec import MOTION_KEYS, SpecTable, check_pivot, read_motion
 
 #: Position tolerance, relative to the wall size.
 POSITION_TOLERANCE = 1.0e-9
-_SUPPORT_KEYS = ("kind", "start", "end", "motion", "pivot", "rate", "direction")
+_SUPPORT_KEYS = ("kind", "start", "end", *MOTION_KEYS)
 
 
 @dataclass(frozen=True)

@@ -61,6 +61,7 @@ import masonryfw as mf
 import masonryfw.plugin_api as mfp
 
 from . import assembly, backends, postprocess
+from .options import DEFAULT_BACKEND
 
 LOG = logging.getLogger("masonryfw.la")
 #: The relaxation is halved, down to this, whenever alpha's change changes sign.
@@ -234,7 +235,7 @@ def admissible(selection: Selection, lp: assembly.KinematicLP, solution: backend
 def solve(wall: assembly.Wall, scales: assembly.Scales, kin: assembly.Kinematics, options,
           progress=mfp.no_progress) -> FlowIteration:
     """The sequence of LPs of the module docstring."""
-    backend, lp_tolerance = options["solver"], options["tolerance"]
+    backend, lp_tolerance = options["solver"] or DEFAULT_BACKEND, options["tolerance"]
     tolerance, cap, relaxation = options["flow_tolerance"], options["flow_iterations"], options["flow_relaxation"]
     try:
         lp = assembly.assemble(wall, scales, kin)

@@ -11,8 +11,10 @@ OPTIONS = (
     mfp.Option(
         "solver",
         str,
-        DEFAULT_BACKEND,
-        "LP backend: ipm (our interior point on the normal equations with CHOLMOD; fastest from "
+        None,
+        "backend of the programme; auto: ipm for an LP (2D, a 3D pyramid), clarabel for Coulomb's cone in 3D (a "
+        "second-order cone programme; no other backend solves it). LP backends: ipm (our interior point on the "
+        "normal equations with CHOLMOD; fastest from "
         "~300 blocks, 2.2x Clarabel at 1,000 units, 3.5x at 10,000; tied mechanisms come out as their mean; "
         "infeasible problems go to clarabel), clarabel (conic interior point, fastest below ~300 "
         "blocks), highs (dual simplex, exact vertex; slow beyond a few hundred blocks), osqp "

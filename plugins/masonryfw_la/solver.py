@@ -17,6 +17,7 @@ import xarray as xr
 import masonryfw.plugin_api as mfp
 
 from . import assembly, backends, limit, nonassociative, topology
+from .options import DEFAULT_BACKEND
 
 
 def solve(model: xr.Dataset, options: Mapping[str, Any], progress=mfp.no_progress) -> xr.Dataset:
@@ -25,6 +26,7 @@ def solve(model: xr.Dataset, options: Mapping[str, Any], progress=mfp.no_progres
         from . import space3
 
         return space3.solve(model, options, progress)
+    backend = options["solver"] or DEFAULT_BACKEND
     clock = time.perf_counter()
     progress(0.0, "la: assembling the kinematic programme")
     wall = assembly.Wall.from_model(model)
@@ -36,14 +38,14 @@ def solve(model: xr.Dataset, options: Mapping[str, Any], progress=mfp.no_progres
     t_assembly = time.perf_counter() - clock
 
     rows, cols = lp.constraints.shape
-    progress(0.2, f"la: solving the LP with {options['solver']} ({rows} rows, {cols} columns)")
+    progress(0.2, f"la: solving the LP with {backend} ({rows} rows, {cols} columns)")
     clock = time.perf_counter()
     flow = None
     if options["flow"] == "nonassociative":
         flow = nonassociative.solve(wall, scales, kin, options, progress)
         lp, sol = flow.lp, flow.solution
     else:
-        sol = backends.solve_lp(options["solver"], lp.cost, lp.constraints, lp.live, options["tolerance"])
+        sol = backends.solve_lp(backend, lp.cost, lp.constraints, lp.live, options["tolerance"])
     t_lp = time.perf_counter() - clock
 
     progress(0.9, "la: post-processing")
@@ -59,13 +61,14 @@ def solve(model: xr.Dataset, options: Mapping[str, Any], progress=mfp.no_progres
                               "normal forces; each LP's contact forces with the least squared normal forces, "
                               + (f"by the LP regularised with weight {flow.selection_weight:g} (ipm), then the "
                                  f"exact finish by LP + QP{'' if flow.finish == 'exact' else ': ' + flow.finish}"
-                                 if options["solver"] == "ipm" else f"by a QP after the {options['solver']} LP")
+                                 if backend == "ipm" else f"by a QP after the {backend} LP")
                               + " (docs/la.md)",
         )
         if not flow.converged:
             result.attrs["stop_reason"] = flow.stop_reason
     result.attrs.update(
-        la_backend=options["solver"],
+        method=backend,
+        la_backend=backend,
         la_time_assembly_s=t_assembly,
         la_time_lp_s=t_lp,
         la_time_postprocess_s=time.perf_counter() - clock,

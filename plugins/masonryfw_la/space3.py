@@ -33,6 +33,7 @@ import masonryfw as mf
 import masonryfw.plugin_api as mfp
 
 from . import backends
+from .options import DEFAULT_BACKEND
 
 #: Coulomb's cone itself unless a caller asks for a pyramid: on the bundled house the 8-sided pyramid is 4.2 %
 #: below the cone and takes 7.2 s against the cone's 4.9 s (docs/la.md, "In 3D").
@@ -246,8 +247,12 @@ def solve(model: xr.Dataset, options: Mapping[str, Any], progress=mfp.no_progres
     progress(0.0, "la: assembling the 3D programme")
     blocks = blocks_of(model)
     sides = int(options["pyramid_sides"])
+    if sides == 0 and options["solver"] not in (None, "clarabel"):
+        raise mf.SolveError(f"la in 3D: Coulomb's cone is a second-order cone programme, which clarabel solves "
+                            f"(solver = {options['solver']} solves LPs: a pyramid, pyramid_sides = 8 or more)")
+    backend = "clarabel" if sides == 0 else options["solver"] or DEFAULT_BACKEND
     progress(0.2, f"la: solving in 3D ({'the cone' if sides == 0 else f'a pyramid of {sides} sides'})")
-    state = limit_state_3d(blocks, sides, options["solver"], options["tolerance"])
+    state = limit_state_3d(blocks, sides, backend, options["tolerance"])
     axis = ("block", "axis")
     data = {
         "collapse_multiplier": ((), state.alpha, mfp.variable_attrs("collapse_multiplier", "result3d")),
@@ -270,8 +275,8 @@ def solve(model: xr.Dataset, options: Mapping[str, Any], progress=mfp.no_progres
         data["moving_support_reaction"] = ((), settlement_reaction(wrench, blocks),
                                            mfp.variable_attrs("moving_support_reaction", "result3d"))
     progress(1.0, f"la: alpha = {state.alpha:.6g}")
-    method = "cone, clarabel" if sides == 0 else f"pyramid of {sides} sides, {options['solver']}"
+    method = f"cone, {backend}" if sides == 0 else f"pyramid of {sides} sides, {backend}"
     return xr.Dataset(data, attrs={"rotations": "small", "flow_rule": "associative", "method": method,
-                                   "la_backend": "clarabel" if sides == 0 else options["solver"],
+                                   "la_backend": backend,
                                    "la_pyramid_sides": sides, "la_time_s": time.perf_counter() - clock,
                                    "la_alpha_dual": float(state.solution.alpha_dual)})

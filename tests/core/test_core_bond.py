@@ -92,7 +92,7 @@ def test_the_gable_house_comes_in_from_an_architects_drawing_and_its_bond_covers
     outline = Polygon(elevation.outline)
     notes = gable_house.attrs["laying_notes"]
     moved = [Polygon(o) for o in elevation.openings]
-    moves = [line for line in notes.splitlines() if line.startswith("opening ")]
+    moves = [line for line in notes.splitlines() if line.startswith("openings[")]
     shifts = [float(s) for s in __import__("re").findall(r"by ([-+][0-9.]+) mm", notes)]
     # the architect's sills at 850, 3,800 and 6,500 mm and heads at 2,200, 2,350 and 5,450 mm: 25 mm to a joint
     assert len(moves) == 6 and sorted(shifts) == [-25.0] * 5 + [25.0] * 5
@@ -242,7 +242,7 @@ def test_a_height_that_is_not_whole_courses_cuts_or_stretches_the_top_course():
 
 def test_openings_are_moved_onto_bed_joints_and_the_moves_are_said():
     laid = lay(box(0, 0, 3.0, 1.5), [box(1.0, 0.31, 2.0, 0.92)], Bond(0.2, 0.075), [Head("none")])
-    assert laid.notes[0] == "opening 0 (x 1..2 m): its sill by -10 mm and its head by -20 mm, onto bed joints"
+    assert laid.notes[0] == "openings[0] (x 1..2 m): its sill by -10 mm and its head by -20 mm, onto bed joints"
     union = __import__("shapely").union_all([Polygon(p) for p in laid.polygons])
     assert union.area == pytest.approx(3.0 * 1.5 - 1.0 * 0.6, rel=1e-9)
 

@@ -227,7 +227,7 @@ def test_an_opening_off_the_bed_joints_is_moved_onto_them_and_said():
     spec = house_spec()
     spec["building"]["walls"][2]["openings"] = [{"x": 0.72, "y": 0.5, "width": 0.48, "height": 0.3}]
     notes = mf.build(spec).attrs["laying_notes"]
-    assert "wall 'north' opening 0: sill and head moved onto bed joints (y 0.48 m, height 0.36 m)" in notes
+    assert "wall 'north' openings[0]: sill and head moved onto bed joints (y 0.48 m, height 0.36 m)" in notes
 
 
 def test_the_engineers_stages_of_a_straight_building_wall_are_the_planar_walls():

@@ -188,3 +188,22 @@ def test_joints_with_cohesion_and_too_few_sides_are_refused(walls):
         twin_blocks(cohesive)
     with pytest.raises(mf.SolveError, match="at least 3 sides"):
         space3.limit_state_3d(single_box(1.0, 1.0, 0.5, 0.5, live_force=(1.0, 0.0, 0.0)), sides=2)
+
+
+def test_the_backend_a_3d_result_names_is_the_one_that_ran():
+    """The report's provenance named one backend while its title named another (``"solver": "ipm"`` under "la
+    (cone, clarabel)"): the option is automatic, the cone's backend clarabel, and asking the cone of another is
+    refused; a pyramid runs on the backend asked."""
+    import json
+
+    from masonryfw.testing import corner_building
+
+    model = corner_building()
+    cone = mf.solve(model, "la")
+    assert json.loads(cone.attrs["solver_options"])["solver"] is None
+    assert cone.attrs["method"] == "cone, clarabel" and cone.attrs["la_backend"] == "clarabel"
+    assert mf.result_label(cone) == "la (cone, clarabel)"
+    with pytest.raises(mf.SolveError, match="cone is a second-order cone programme, which clarabel solves"):
+        mf.solve(model, "la", {"solver": "highs"})
+    pyramid = mf.solve(model, "la", {"pyramid_sides": 8, "solver": "highs"})
+    assert pyramid.attrs["la_backend"] == "highs" and mf.result_label(pyramid) == "la (pyramid of 8 sides, highs)"
