@@ -30,7 +30,16 @@ from .semantics import CRACK_THRESHOLD, at_threshold, cracked_joints, dead_react
 from .signals import WriteInterrupted
 from .sources import open_checked, open_model
 from .spec import dump_toml
-from .summary import KeyNumber, capacity_text, headline_text, key_numbers, result_label, stages_text
+from .summary import (
+    KeyNumber,
+    capacity_text,
+    damage_text,
+    headline_text,
+    key_numbers,
+    load_word,
+    result_label,
+    stages_text,
+)
 from .version import __version__ as __version__
 
 __all__ = [
@@ -45,7 +54,8 @@ __all__ = [
     "get_comparator", "get_plotter", "get_solver", "installed_solvers", "__version__",
     # What results mean
     "CRACK_THRESHOLD", "at_threshold", "cracked_joints", "dead_reaction", "settlement_reaction",
-    "KeyNumber", "key_numbers", "headline_text", "result_label", "stages_text", "capacity_text",
+    "KeyNumber", "key_numbers", "headline_text", "load_word", "damage_text", "result_label", "stages_text",
+    "capacity_text",
     "DAMAGE_LIMITS", "Cracks", "damage_category", "widest_crack",
     # Files
     "open_dataset", "save", "save_figure",

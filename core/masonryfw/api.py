@@ -364,8 +364,21 @@ def _fit_text(figure) -> None:
         scale *= factor
         for text in figure.findobj(Text):
             text.set_fontsize(text.get_fontsize() * factor)
+        for axes in figure.axes:  # tick labels made at the next draw take the size too (one size an axis)
+            axes.tick_params(which="both", labelsize=_tick_size(axes) * factor)
     warnings.warn(f"a figure of {width:.3g} x {height:.3g} in is too small for what it shows, even with its text at "
                   f"{SMALLEST_TEXT:.0%} of its size: ask for a larger --size", UserWarning, stacklevel=3)
+
+
+def _tick_size(axes) -> float:
+    """The size [pt] of the tick labels ``axes`` draws now."""
+    labels = axes.xaxis.get_ticklabels()
+    if labels:
+        return labels[0].get_fontsize()
+    from matplotlib import rcParams
+    from matplotlib.font_manager import FontProperties
+
+    return FontProperties(size=rcParams["xtick.labelsize"]).get_size_in_points()
 
 
 def plot_table(

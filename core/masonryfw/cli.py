@@ -354,7 +354,8 @@ def compare(
     if output:
         mfp.check_output_path(output, list(results))
     datasets = [mf.open_dataset(r) for r in results]
-    pairs = list(itertools.combinations(range(len(results)), 2))
+    standing = [mfp.standing_text(ds) is None for ds in datasets]  # a run whose masonry fell has no damage to score
+    pairs = [(i, j) for i, j in itertools.combinations(range(len(results)), 2) if standing[i] and standing[j]]
     comparisons = [mf.compare(datasets[i], datasets[j], comparator, options) for i, j in pairs]
     if output:
         mf.save(comparisons[0], output, command=command_line(), protect=list(results))
@@ -366,10 +367,14 @@ def compare(
         click.echo(f"{letter}: {path} ({mf.result_label(ds)})")
     click.echo("")
     click.echo(mfp.text_table(["", *letters], mfp.headline_rows(datasets)))
-    r0 = mfp.r0_text(datasets, letters)
-    if r0:
-        click.echo(textwrap.fill(r0, 100))
+    for said in (mfp.r0_text(datasets, letters), mf.damage_text(datasets, letters)):
+        if said:
+            click.echo(textwrap.fill(said, 100))
     click.echo("")
+    if not comparisons:
+        click.echo("no pair to score: " + "; ".join(f"{letter} did not stand under its own weight" for letter, ok
+                                                     in zip(letters, standing) if not ok))
+        return
     rows = mfp.score_rows(comparisons)
     header = [f"{comparisons[0].attrs['comparator']} score", *(f"{letters[i]}-{letters[j]}" for i, j in pairs)]
     click.echo(mfp.text_table(header, rows) if rows else "(no scalar scores)")

@@ -78,9 +78,12 @@ def load_word(result: xr.Dataset) -> str:
 
 
 def collapse_record(result: xr.Dataset) -> int | None:
-    """The first record of a history at which the masonry has collapsed: its widest crack wider than the ground has
-    moved by more than a unit (the square root of the median block area): a block fallen away from the rest. None
-    when it did not, and for a history that says its own collapse (la-incremental's ``settlement_capacity``)."""
+    """The record of a history at which its masonry began to collapse, or None when it did not (and for a
+    history that says its own collapse: la-incremental's ``settlement_capacity``). It collapsed when its widest
+    crack came to be wider than the ground has moved by more than a unit (the square root of the median block
+    area): a block fallen away from the rest; it began to where that crack started to open faster than the
+    ground moves, for good (a mechanism the ground drives opens no faster than it: an arch on spreading
+    supports, 0.33 mm a mm until 108 mm, then 1.1, 3, 10, 31 mm a mm; la-incremental: collapse at 108.3 mm)."""
     if "settlement_capacity" in result or not {"step_crack_width_max", "step_settlement"} <= set(result.variables) \
             or int(result.attrs.get("masonryfw_space", 2)) == 3:
         return None
@@ -88,21 +91,24 @@ def collapse_record(result: xr.Dataset) -> int | None:
     direction = np.asarray(result.settlement_direction.values, dtype=float)[moving]
     rate = float(np.hypot(direction[:, 0], direction[:, 1]).max(initial=0.0))
     ground = np.asarray(result.step_settlement.values, dtype=float) * rate
-    over = np.flatnonzero(np.asarray(result.step_crack_width_max.values, dtype=float) - ground
-                          > model_scales(result).block)
-    return int(over[0]) if over.size else None
+    width = np.asarray(result.step_crack_width_max.values, dtype=float)
+    over = np.flatnonzero(width - ground > model_scales(result).block)
+    if not over.size:
+        return None
+    fell = int(over[0])
+    keeping_up = np.flatnonzero(np.diff(width[:fell + 1]) <= np.diff(ground[:fell + 1]))  # intervals
+    return int(keeping_up[-1]) + 1 if keeping_up.size else 0
 
 
 def _collapse_numbers(result: xr.Dataset, fell: int) -> list[KeyNumber]:
-    """The settlement at collapse from a history (:func:`collapse_record`): the last record that still carries
-    itself, its reaction, and where the masonry broke away (the widest crack at the record it had)."""
-    last = max(fell - 1, 0)
-    numbers = [KeyNumber("settlement_capacity", float(result.step_settlement.values[last]), "m",
-                         f"settlement at collapse: the last record before a block fell away (the next at "
-                         f"{float(result.step_settlement.values[fell]) * 1e3:.4g} mm)")]
+    """The settlement at collapse from a history (:func:`collapse_record`): the record where the masonry began to
+    fall away, its reaction, and where it broke away (the widest crack of that record)."""
+    numbers = [KeyNumber("settlement_capacity", float(result.step_settlement.values[fell]), "m",
+                         "settlement at collapse: where the widest crack began to open faster than the ground "
+                         "moves, for good, until a block fell away")]
     if "step_reaction" in result:
-        numbers.append(KeyNumber("capacity_reaction", float(result.step_reaction.values[last]), "N",
-                                 "settlement reaction of the last record before the collapse"))
+        numbers.append(KeyNumber("capacity_reaction", float(result.step_reaction.values[fell]), "N",
+                                 "settlement reaction where the collapse began"))
     interface = int(result.step_crack_interface.values[fell]) if "step_crack_interface" in result else -1
     if interface >= 0:
         numbers += [KeyNumber("collapse_x", float(result.interface_x.values[interface].mean()), "m",
@@ -225,7 +231,7 @@ def key_numbers(result: xr.Dataset) -> list[KeyNumber]:
             numbers.append(KeyNumber("collapse_reaction", (1.0 - alpha) * r0, "N",
                                      "settlement reaction at collapse, (1 - alpha) R0"))
     fell = collapse_record(result)
-    history = result if fell is None else result.isel(step=slice(0, max(fell, 1)))  # the records before a collapse
+    history = result if fell is None else result.isel(step=slice(0, fell + 1))  # the records to the collapse
     if "step_reaction" in result and "step_settlement" in result:
         numbers += _history_numbers(history)
     if fell is not None:
@@ -288,8 +294,8 @@ def _crack_text(numbers: dict) -> str:
     """``0.272 mm (joint 41 at x 3.1 m, y 0.125 m; S = 15 mm)``: the widest crack, where and when."""
     where = []
     if "crack_interface" in numbers:
-        where.append(f"joint {int(numbers['crack_interface'])} at x {numbers['crack_x']:.3g} m, "
-                     f"y {numbers['crack_y']:.3g} m")
+        where.append(f"joint {int(numbers['crack_interface'])} at x {_place(numbers['crack_x'])} m, "
+                     f"y {_place(numbers['crack_y'])} m")
     if "crack_settlement" in numbers:
         where.append(f"settlement {_mm(numbers['crack_settlement'])}")
     return _mm(numbers["crack_width"]) + (f" ({'; '.join(where)})" if where else "")
@@ -428,8 +434,9 @@ _HEADLINES = (
      f"{_mm(n['plateau_settlement'])}", "the reaction once it stops changing (within 1 % of R0)"),
     ("final_settlement", "final settlement", lambda n: _mm(n["final_settlement"]), "settlement of the last record"),
     ("settlement_capacity", "settlement at collapse", lambda n: f"{_mm(n['settlement_capacity'])}, reaction "
-     f"{force_text(n['capacity_reaction'])}", "the last moved configuration that carries its dead load "
-     "(la-incremental), and its settlement reaction"),
+     f"{force_text(n['capacity_reaction'])}", "la-incremental: the last moved configuration that carries its dead "
+     "load; fdem: where its widest crack began to open faster than the ground moves, until a block fell away; "
+     "and the reaction there"),
     ("crack_width", "widest crack", lambda n: _crack_text(n),
      "widest opening of a joint in the masonry over the run: the joint, its midpoint, the settlement"),
     ("damage_category", "damage category", lambda n: _damage_name(n["damage_category"]),
@@ -549,6 +556,50 @@ def r0_text(results: Sequence[xr.Dataset], labels: Sequence[str]) -> str:
             "the parts; the stiffness of the contacts and the openings over each part do (a pier over a part "
             "carries more than its length's share). A computed R0 is that split at rest, the convention is the "
             "same for every wall; compare collapse or minimum reactions in kN, or each as a share of its own R0.")
+
+
+def _flow(result: xr.Dataset) -> str:
+    """How a result's joints slide: ``dilatant`` (la's associative flow, la-incremental's associative option),
+    ``non-dilatant`` (Coulomb's friction without opening: fdem, la-incremental's default, la's non-associative
+    flow), or the solver's continuum."""
+    solver, flow = str(result.attrs.get("solver", "")), str(result.attrs.get("flow_rule", ""))
+    if solver in ("jmm", "jmm-limit"):
+        return "a continuum (the joints smeared in elastic-plastic elements)"
+    if flow == "associative" or solver == "la" and flow != "nonassociative":
+        return "dilatant rigid joints (associative flow: a sliding joint opens by mu |slip|)"
+    return ("elastic joints, non-dilatant (Coulomb friction, no opening on sliding)" if solver == "fdem" else
+            "rigid joints, non-dilatant (sliding without opening)")
+
+
+def damage_text(results: Sequence[xr.Dataset], labels: Sequence[str]) -> str:
+    """Why results of one model give different damage answers (empty when they do not differ): which did not
+    stand under its own weight, which collapsed and where, the largest category each reached and at what
+    settlement, and how each one's joints slide, with the numbers that show it."""
+    said, categories, flows = [], {}, {}
+    for label, result in zip(labels, results):
+        fallen = standing_text(result)
+        if fallen:
+            said.append(f"{label} {fallen.removeprefix('the masonry ')}")
+            continue
+        numbers = {n.name: n.value for n in key_numbers(result)}
+        flows[label] = _flow(result)
+        if "settlement_capacity" in numbers and "alpha" not in numbers:
+            said.append(f"{label} collapses at a {load_word(result)} of {_mm(numbers['settlement_capacity'])}")
+        if "damage_category" in numbers:
+            categories[label] = int(numbers["damage_category"])
+            said.append(f"{label} reaches category {_damage_name(numbers['damage_category'])} (widest crack "
+                        f"{_mm(numbers['crack_width'])} at {_mm(numbers.get('crack_settlement', float('nan')))})")
+        elif "alpha" in numbers:
+            said.append(f"{label} gives the collapse multiplier alone (alpha {numbers['alpha']:.4f}): a mechanism's "
+                        "shape, no crack width")
+    differ = len(set(categories.values())) > 1 or any("did not stand" in t or "collapses" in t for t in said)
+    if len(set(flows.values())) > 1:
+        said.append("their joints differ: " + "; ".join(f"{label} {flow}" for label, flow in flows.items())
+                    + ". Dilatant joints carry by the opening sliding forces on them (an upper bound on what the "
+                    "wall sheds); elastic non-dilatant ones open and slide at once, so their cracks come earlier "
+                    "and wider")
+        differ = differ or len(set(flows.values())) > 1 and bool(categories)
+    return ("The damage answers differ: " + "; ".join(said) + ".") if differ and len(results) > 1 else ""
 
 
 def headline_rows(results: Sequence[xr.Dataset]) -> list[Row]:

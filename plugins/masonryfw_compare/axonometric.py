@@ -3,6 +3,7 @@ with its macro-blocks coloured and its cracked interfaces outlined. What the ``m
 draw for a 3D dataset."""
 from __future__ import annotations
 
+import json
 from collections.abc import Mapping
 from typing import Any
 
@@ -10,11 +11,12 @@ import numpy as np
 import xarray as xr
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
+from matplotlib.ticker import MaxNLocator
 
 import masonryfw as mf
 import masonryfw.plugin_api as mfp
 
-from .figure_parts import SUPPORT_COLOUR, title_of
+from .figure_parts import SUPPORT_COLOUR, legend_beside, title_text
 
 #: The view: elevation and azimuth [degrees] (the front, y = 0, seen from the south-west, from above).
 VIEW = (22.0, -58.0)
@@ -53,19 +55,40 @@ def default_amplification(geo: xr.Dataset, u: np.ndarray) -> float:
     return DRAWN_MOTION_SHARE * size / largest if largest > 0 else 1.0
 
 
+#: The 3D box drawn this much larger than matplotlib's default (which leaves a wide margin round it).
+ZOOM = 1.05
+#: The share of the axes' width the z axis' labels stand out of a 3D box: a legend beside it keeps clear of them.
+TICKS_3D = 0.1
+
+
 def finish_3d(ax, ds: xr.Dataset, points: np.ndarray) -> None:
-    """Equal scales on the three axes fitted to ``points``, the view, labels and the title."""
+    """Equal scales on the three axes fitted to ``points`` (the box as long, deep and high as what is drawn, so
+    that a building fills its page rather than a cube round it), the view, labels, the walls named and the
+    title wrapped to the page."""
     low, high = points.min(axis=0), points.max(axis=0)
-    centre, half = 0.5 * (low + high), 0.5 * float((high - low).max())
-    for setter, c in zip((ax.set_xlim, ax.set_ylim, ax.set_zlim), centre):
-        setter(c - half, c + half)
-    ax.set_box_aspect((1, 1, 1))
+    span = np.maximum(high - low, 1e-3 * float((high - low).max()))
+    for setter, a, b in zip((ax.set_xlim, ax.set_ylim, ax.set_zlim), low, low + span):
+        setter(a, b)
+    ax.set_box_aspect(tuple(span / span.max()), zoom=ZOOM)
+    for axis, length in zip((ax.xaxis, ax.yaxis, ax.zaxis), span / span.max()):
+        axis.set_major_locator(MaxNLocator(max(2, round(6 * length)), steps=[1, 2, 5, 10]))  # a short axis, few ticks
     ax.view_init(*VIEW)
     ax.set_xlabel("x [m]")
     ax.set_ylabel("y [m]")
     ax.set_zlabel("z [m]")
-    headline = mf.headline_text(ds) if "solver" in ds.attrs else ""
-    ax.set_title(title_of(ds) + (f"\n{headline}" if headline else ""), fontsize="medium")
+    name_walls(ax, ds)
+    ax.set_title(title_text(ax, ds), fontsize="medium")
+
+
+def name_walls(ax, ds: xr.Dataset) -> None:
+    """Each wall of a building (``building_walls``) named over the middle of its top."""
+    if "building_walls" not in ds.attrs:
+        return
+    for wall in json.loads(ds.attrs["building_walls"]):
+        (x0, y0), (x1, y1) = wall["start"], wall["end"]
+        ax.text(0.5 * (x0 + x1), 0.5 * (y0 + y1), 1.04 * wall["height"], wall["name"], ha="center", va="bottom",
+                fontsize="small", fontweight="bold", zorder=5,
+                bbox={"boxstyle": "round,pad=0.15", "facecolor": "white", "edgecolor": "none", "alpha": 0.8})
 
 
 def draw_model_3d(ds: xr.Dataset, ax, colours: Mapping[str, str]) -> None:
@@ -81,8 +104,8 @@ def draw_model_3d(ds: xr.Dataset, ax, colours: Mapping[str, str]) -> None:
     ax.add_collection3d(Poly3DCollection(polygons, facecolors=[colours[role[b]] for b in block], edgecolors="0.35",
                                          linewidths=0.2))
     present = sorted(set(role), key=list(colours).index)
-    ax.legend(handles=[Patch(facecolor=colours[r], edgecolor="0.35", label=r.replace("_", " ")) for r in present],
-              loc="upper left", bbox_to_anchor=(1.02, 1.0), fontsize="small", frameon=False)
+    legend_beside(ax, TICKS_3D, handles=[Patch(facecolor=colours[r], edgecolor="0.35", label=r.replace("_", " "))
+                                         for r in present], fontsize="small", frameon=False)
     finish_3d(ax, ds, points)
 
 
@@ -113,8 +136,8 @@ def draw_mechanism_3d(ds: xr.Dataset, ax, options: Mapping[str, Any], pieces, pi
         handles.append(Line2D([], [], color=CRACK_COLOUR, lw=1.5, label=f"cracked interfaces ({int(cracked.sum())}), "
                                                                        "seen through the masonry"))
     reference = "macro-block (1)" if pieces.dominant else "the ground"
-    ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.02, 1.0), fontsize="small", frameon=False,
-              title=f"motion relative to {reference}, x {amplification:.3g}", title_fontsize="small")
+    legend_beside(ax, TICKS_3D, handles=handles, fontsize="small", frameon=False,
+                  title=f"motion relative to {reference}, x {amplification:.3g}", title_fontsize="small")
     finish_3d(ax, ds, points)
 
 

@@ -28,6 +28,7 @@ from .figure_parts import (
     draw_blocks,
     draw_outline,
     finish_axes,
+    legend_beside,
     line_scale,
     require_variables,
     segment_array,
@@ -210,7 +211,7 @@ def draw_model(datasets: Sequence[xr.Dataset], ax, options: Mapping[str, Any]) -
             ax.text(geo.block_centroid_x.values[block], geo.block_centroid_y.values[block], str(block),
                     ha="center", va="center", fontsize=options["font_size"], zorder=4)
     if handles:
-        ax.legend(handles=handles, title="interfaces", fontsize="small", loc="upper left", bbox_to_anchor=(1.01, 1.0))
+        legend_beside(ax, handles=handles, title="interfaces", fontsize="small")
     finish_axes(ax, ds)
 
 
@@ -268,8 +269,8 @@ def draw_mechanism(datasets: Sequence[xr.Dataset], ax, options: Mapping[str, Any
                                  np.array([int(geo.interface_blocks.values[k, 0])]))
         point = (float(px[0]), float(py[0]))
     _mark_widest(ax, ds, widest, point, handles)
-    ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize="small", frameon=False,
-              title=f"displacements x {amplification:.3g}", title_fontsize="small")
+    legend_beside(ax, handles=handles, fontsize="small", frameon=False, title=f"displacements x {amplification:.3g}",
+                  title_fontsize="small")
     finish_axes(ax, ds)
 
 
@@ -288,7 +289,7 @@ def draw_cracks(datasets: Sequence[xr.Dataset], ax, options: Mapping[str, Any]) 
     segments = segment_array(geo.interface_x.values, geo.interface_y.values)
     flag = mfp.flags("interface_state")
     handles = []
-    opening = np.maximum(ds.interface_opening.values, 0.0).mean(axis=1)
+    opening = np.maximum(ds.interface_opening.values, 0.0).max(axis=1)  # at its wider end, as a crack is measured
     in_masonry = ~mfp.support_blocks(geo.block_role.values)[geo.interface_blocks.values.astype(np.int64)].any(axis=1)
     widest_opening = float(opening[(state > 0) & in_masonry].max(initial=0.0))  # a base gap is no crack
     drawn_widths = options["widths"] and widest_opening > 0
@@ -299,14 +300,24 @@ def draw_cracks(datasets: Sequence[xr.Dataset], ax, options: Mapping[str, Any]) 
         ax.add_collection(LineCollection(segments[chosen], colors=colour, linewidths=widths[chosen], zorder=3))
         handles.append(Line2D([], [], color=colour, lw=2.2, label=f"{meaning.replace('_', ' + ')} ({chosen.sum()})"))
     if drawn_widths:
-        handles.append(Line2D([], [], color="0.3", lw=WIDEST_LINE, label=f"line width: the opening,\nup to "
-                                                                       f"{widest_opening * 1000:.3g} mm in the masonry"))
+        handles.append(Line2D([], [], color="0.3", lw=WIDEST_LINE,
+                              label=f"line width: the joint's opening at the last record,\nup to "
+                                    f"{widest_opening * 1000:.3g} mm in the masonry" + _over_the_run(ds, widest_opening)))
     widest = widest_crack(ds)
     point = None if widest is None else (float(geo.interface_x.values[widest.interface].mean()),
                                          float(geo.interface_y.values[widest.interface].mean()))
     _mark_widest(ax, ds, widest, point, handles)
-    ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize="small", frameon=False)
+    legend_beside(ax, handles=handles, fontsize="small", frameon=False)
     finish_axes(ax, ds)
+
+
+def _over_the_run(ds: xr.Dataset, at_the_end: float) -> str:
+    """``(the widest of the run, 1.24 mm, was earlier)`` when the run's widest crack is wider than the last
+    record's: the legend and the marker then say why they differ."""
+    if "step_crack_width_max" not in ds or not ds.step_crack_width_max.size:
+        return ""
+    widest = float(np.max(ds.step_crack_width_max.values))
+    return f"\n(the run's widest, {widest * 1000:.3g} mm, was earlier)" if widest > at_the_end * (1 + 1e-6) else ""
 
 
 def loaded_joints(normal: np.ndarray) -> np.ndarray:
@@ -408,7 +419,7 @@ def draw_plastic(datasets: Sequence[xr.Dataset], ax, options: Mapping[str, Any])
         chosen = failure == flag[meaning]
         ax.scatter(ds.qp_x.values[chosen], ds.qp_y.values[chosen], s=options["marker_size"], c=colour,
                    label=f"{meaning.replace('_', ' + ')} ({chosen.sum()})", zorder=3, linewidths=0)
-    ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize="small", frameon=False, markerscale=2)
+    legend_beside(ax, fontsize="small", frameon=False, markerscale=2)
     finish_axes(ax, ds)
 
 

@@ -20,7 +20,10 @@ import masonryfw.plugin_api as mfp
 from .shapes import padded_block_nodes
 
 SUPPORT_COLOUR = "0.45"
-TITLE_WIDTH = 75  # characters of a title line (a 7 in figure's width at the medium size)
+TITLE_WIDTH = 75  # characters of a title line on a 7 in wide figure at the medium size (more or fewer as it is)
+#: A page this much taller than wide is portrait: legends go below the drawing, not beside it (on a narrow
+#: portrait page the legend column left a band of white as wide as the drawing).
+PORTRAIT = 1.1
 # damage categories 0..5: green to dark red
 DAMAGE_COLOURS = ("#1a9850", "#91cf60", "#fee08b", "#fc8d59", "#d73027", "#7f0000")
 
@@ -44,14 +47,35 @@ def title_of(ds: xr.Dataset) -> str:
     return f"{ds.attrs.get('title', 'untitled')} - {label}"
 
 
+def portrait(ax) -> bool:
+    """Whether the figure ``ax`` is on is a portrait page (:data:`PORTRAIT`)."""
+    width, height = ax.figure.get_size_inches()
+    return height > PORTRAIT * width
+
+
+def legend_beside(ax, gap: float = 0.01, below: bool = False, **kwargs):
+    """The legend beside the drawing: to its right on a landscape page (``gap`` of the axes' width clear of them),
+    under it (two columns) on a portrait one, or ``below`` always (a building in axonometry wants the width)."""
+    if below or portrait(ax):
+        return ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.06 if below else -0.1), ncol=2, **kwargs)
+    return ax.legend(loc="upper left", bbox_to_anchor=(1.0 + gap, 1.0), **kwargs)
+
+
+def title_text(ax, ds: xr.Dataset) -> str:
+    """The model, the solver and the headline, wrapped to the width of the figure (a title wider than a small
+    page was cut at its left edge)."""
+    width = max(30, int(TITLE_WIDTH * ax.figure.get_size_inches()[0] / 7.0))
+    lines = [title_of(ds), mf.headline_text(ds)]
+    return "\n".join(textwrap.fill(line, width) for line in lines if line)
+
+
 def finish_axes(ax, ds: xr.Dataset) -> None:
     """Equal axes in metres fitted to the drawing, titled with the model, the solver and the headline."""
     ax.set_aspect("equal", adjustable="box")
     ax.autoscale_view()
     ax.set_xlabel("x [m]")
     ax.set_ylabel("y [m]")
-    headline = textwrap.fill(mf.headline_text(ds), TITLE_WIDTH)
-    ax.set_title(title_of(ds) + (f"\n{headline}" if headline else ""), fontsize="medium")
+    ax.set_title(title_text(ax, ds), fontsize="medium")
 
 
 def line_scale(geo: xr.Dataset) -> float:

@@ -164,7 +164,8 @@ def draw_history(datasets: Sequence[xr.Dataset], ax, options: Mapping[str, Any])
     labels = distinct_labels(incremental)
     colours = [f"C{i % 10}" for i in range(len(incremental))]
     ax.grid(True, lw=0.3)
-    ax.set_xlabel("settlement [mm]")
+    word = mf.load_word(datasets[0]) if datasets else "settlement"
+    ax.set_xlabel(f"{'spread of the supports' if word == 'spread' else word} [mm]")
     log = options["xscale"] == "log"
     ax.set_xscale("log" if log else "linear")
     if options["quantity"] == "damage":
@@ -178,6 +179,7 @@ def draw_history(datasets: Sequence[xr.Dataset], ax, options: Mapping[str, Any])
             first = max(gravity_records(s) - 1, 0)
             shown = slice(first + 1 if log else first, None)
             handles += ax.plot(s[shown], r[shown], color=colour, lw=1.2, label=label)
+            handles += _mark_collapse(ax, ds, label, colour, word)
             if first > 0 and not log:  # the reactions of the gravity stage, at zero settlement
                 low, high = float(r[:first + 1].min()), float(r[:first + 1].max())
                 handles.append(ax.vlines(0.0, low, high, color=colour, lw=4, alpha=0.35,
@@ -194,7 +196,8 @@ def draw_history(datasets: Sequence[xr.Dataset], ax, options: Mapping[str, Any])
                                       label=f"{mf.result_label(ds)}: (1 - alpha) R0 = {mfp.force_text(collapse)}"))
         strips, rows = _damage_strips(ax, incremental)
         unit = _force_axis(ax, r0)
-        ax.set_ylabel(f"settlement reaction [{unit}]" if _profiled(references) else
+        ax.set_ylabel(f"thrust on the moving support [{unit}]" if word == "spread" else
+                      f"settlement reaction [{unit}]" if _profiled(references) else
                       f"reaction on the moving support [{unit}]")
         ax.set_ylim(bottom=min(0.0, ax.get_ylim()[0]))
         ax.legend(handles=handles + strips, loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=2,
@@ -222,6 +225,17 @@ def _volume_loss_axis(ax, results: Sequence[xr.Dataset]) -> None:
     top = ax.secondary_xaxis("top", functions=(lambda mm: mm * per_mm, lambda loss: loss / per_mm))
     top.set_xlabel("tunnel volume loss V_L [%]", fontsize="small")
     top.tick_params(labelsize="small")
+
+
+def _mark_collapse(ax, ds: xr.Dataset, label: str, colour: str, word: str) -> list:
+    """The collapse of a run that collapsed (:func:`masonryfw.key_numbers`' ``settlement_capacity``: la-incremental's
+    own, or where fdem's masonry broke away) as a cross on its curve, said in the legend."""
+    numbers = {n.name: n.value for n in mf.key_numbers(ds)}
+    if "settlement_capacity" not in numbers:
+        return []
+    at, reaction = 1e3 * numbers["settlement_capacity"], numbers.get("capacity_reaction", float("nan"))
+    return ax.plot([at], [reaction], ls="none", marker="X", ms=9, color=colour, markeredgecolor="k", zorder=5,
+                   label=f"{label}: collapses at a {word} of {at:.3g} mm")
 
 
 def _force_axis(ax, reference: float) -> str:

@@ -276,6 +276,8 @@ def report_html(paths: Sequence[str], command: str, progress: Callable[[float, s
         parts += ["<h2>Key numbers</h2>", _table(["", *letters], mfp.headline_rows(datasets), "key-numbers", letters)]
         r0 = mfp.r0_text(datasets, labels)
         parts += [f'<p class="note" id="r0-note">{html.escape(r0)}</p>'] if r0 else []
+        damage = mf.damage_text(datasets, labels)
+        parts += [f'<p class="note" id="damage-note">{html.escape(damage)}</p>'] if damage else []
     step(0.2, "figures")
     parts += _history_section(datasets)
     for i, (label, ds) in enumerate(zip(labels, datasets)):
