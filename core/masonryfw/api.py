@@ -326,11 +326,18 @@ def render(
         width = max(FIGURE_SIZE[0], PANEL_WIDTH * len(datasets)) if record.side_by_side else FIGURE_SIZE[0]
         ax = Figure(figsize=size or (width, FIGURE_SIZE[1]), layout="constrained").add_subplot()
     figure = ax.figure  # kept: a kind may put other axes in the place of ``ax`` (a 3D model's axonometry)
+    figure.masonryfw_size_asked = size is not None  # a kind chooses its own size only when none was asked
     _call_plugin("plotter", record.name, record.plot, datasets, ax, resolved)
     if size is not None:  # asked for: it wins over a size the kind chose for itself
         figure.set_size_inches(*size)
         _fit_text(figure)
     return figure
+
+
+def size_asked(figure) -> bool:
+    """Whether the figure :func:`render` made for a plot kind has a size the user asked for (``--size``): a kind
+    that lays out panels of its own sizes the figure only when none was (it wraps its text to the size it has)."""
+    return bool(getattr(figure, "masonryfw_size_asked", False))
 
 
 #: The smallest share of its size a figure's text is scaled to, to fit a page asked for.

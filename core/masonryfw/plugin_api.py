@@ -10,6 +10,7 @@ here, documented in docs/api.md ("For plugin authors"), and like ``mf`` every na
 import lazy_loader
 
 __getattr__, __dir__, __all__ = lazy_loader.attach("masonryfw", submod_attrs={
+    "api": ["size_asked"],
     "assessment": ["LTSM_LIMITS", "POISSON", "Part", "assess", "deep_beam_strains", "ltsm_category", "volume_loss_per_settlement", "wall_extent"],
     "command_kit": ["ADDRESS", "LENGTH", "Number", "OPTIONS", "PROGRESS", "command_line"],
     "cores": ["core_share", "cores", "free_cores", "machine_load"],

@@ -56,7 +56,7 @@ def default_amplification(geo: xr.Dataset, u: np.ndarray) -> float:
 
 
 #: The 3D box drawn this much larger than matplotlib's default (which leaves a wide margin round it).
-ZOOM = 1.05
+ZOOM = 0.85
 #: The share of the axes' width the z axis' labels stand out of a 3D box: a legend beside it keeps clear of them.
 TICKS_3D = 0.1
 

@@ -393,8 +393,7 @@ def draw_forces(datasets: Sequence[xr.Dataset], ax, options: Mapping[str, Any]) 
             Line2D([], [], ls="none", marker=".", color="0.35", label="centre of pressure"),
             Line2D([], [], ls="none", label=f"largest {magnitude.max():.3g} N, {magnitude.size} loaded joints"),
         ]
-    ax.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, -0.14), ncol=2, fontsize="small",
-              frameon=False)
+    legend_beside(ax, below=True, handles=handles, fontsize="small", frameon=False)
     finish_axes(ax, ds)
 
 

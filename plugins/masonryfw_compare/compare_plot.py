@@ -2,6 +2,7 @@
 scores against the first (the ``crack`` comparator at the plot's ``threshold``)."""
 from __future__ import annotations
 
+import textwrap
 from collections.abc import Mapping, Sequence
 from typing import Any
 
@@ -13,7 +14,7 @@ import masonryfw as mf
 import masonryfw.plugin_api as mfp
 
 from .block_plots import draw_mechanism, draw_plastic, mechanism_amplification
-from .figure_parts import draw_blocks, finish_axes, segment_array
+from .figure_parts import TITLE_WIDTH, draw_blocks, finish_axes, segment_array
 
 
 def panel_kind(ds: xr.Dataset) -> str:
@@ -87,5 +88,7 @@ def draw_compare(datasets: Sequence[xr.Dataset], ax, options: Mapping[str, Any])
             panel.get_legend().remove()
         alpha = f", alpha = {ds.collapse_multiplier.item():.4g}" if "collapse_multiplier" in ds else ""
         heading = f"{wall}\n" if k == 0 and wall else ""
-        panel.set_title(f"{heading}{mf.result_label(ds)}{alpha}\n{caption}", fontsize="medium")
+        width = max(20, int(TITLE_WIDTH * ax.figure.get_size_inches()[0] / 7.0 / len(datasets)))  # a panel's share
+        lines = [f"{mf.result_label(ds)}{alpha}", caption]
+        panel.set_title(heading + "\n".join(textwrap.fill(line, width) for line in lines), fontsize="medium")
 

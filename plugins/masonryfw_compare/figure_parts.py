@@ -56,8 +56,9 @@ def portrait(ax) -> bool:
 def legend_beside(ax, gap: float = 0.01, below: bool = False, **kwargs):
     """The legend beside the drawing: to its right on a landscape page (``gap`` of the axes' width clear of them),
     under it (two columns) on a portrait one, or ``below`` always (a building in axonometry wants the width)."""
-    if below or portrait(ax):
-        return ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.06 if below else -0.1), ncol=2, **kwargs)
+    if below or portrait(ax):  # the figure's own legend: the constrained layout keeps it clear of the axis labels
+        handles = kwargs.pop("handles", None) or ax.get_legend_handles_labels()[0]
+        return ax.figure.legend(handles=handles, loc="outside lower center", ncol=1 if portrait(ax) else 2, **kwargs)
     return ax.legend(loc="upper left", bbox_to_anchor=(1.0 + gap, 1.0), **kwargs)
 
 

@@ -164,7 +164,8 @@ def draw_history(datasets: Sequence[xr.Dataset], ax, options: Mapping[str, Any])
     labels = distinct_labels(incremental)
     colours = [f"C{i % 10}" for i in range(len(incremental))]
     ax.grid(True, lw=0.3)
-    word = mf.load_word(datasets[0]) if datasets else "settlement"
+    models = [ds for ds in datasets if "block_role" in ds]  # a sweep has no blocks to say what moves them
+    word = mf.load_word(models[0]) if models else "settlement"
     ax.set_xlabel(f"{'spread of the supports' if word == 'spread' else word} [mm]")
     log = options["xscale"] == "log"
     ax.set_xscale("log" if log else "linear")

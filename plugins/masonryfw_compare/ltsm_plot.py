@@ -10,6 +10,7 @@ against the horizontal strain, the zones of the LTSM categories for that part's 
 from __future__ import annotations
 
 import json
+import textwrap
 from collections.abc import Mapping, Sequence
 from dataclasses import replace
 from typing import Any
@@ -21,7 +22,7 @@ from matplotlib.patches import Rectangle
 import masonryfw as mf
 import masonryfw.plugin_api as mfp
 
-from .figure_parts import DAMAGE_COLOURS, single_result, title_of
+from .figure_parts import DAMAGE_COLOURS, TITLE_WIDTH, single_result, title_of
 
 ZONE_NAMES = ("0 negligible", "1 very slight", "2 slight", "3 moderate", "4-5 severe to very severe")
 
@@ -65,7 +66,8 @@ def draw_ltsm(datasets: Sequence[xr.Dataset], ax, options: Mapping[str, Any]) ->
     rows = spec.subgridspec(2, 1, height_ratios=(1.3, 2) if "building_walls" in ds.attrs else (1, 2), hspace=0.12)
     top = figure.add_subplot(rows[0])
     if "building_walls" in ds.attrs:
-        figure.set_size_inches(8.5, 8.5)  # a plan above the charts
+        if not mfp.size_asked(figure):
+            figure.set_size_inches(8.5, 8.5)  # a plan above the charts
         walls = json.loads(ds.attrs["building_walls"])
         worst = _draw_plan(top, ds, walls, stages, settlement)
         _draw_charts(figure, rows[1], replace(stages, parts=tuple(p for p in stages.parts if p.wall == worst["name"])),
@@ -76,10 +78,12 @@ def draw_ltsm(datasets: Sequence[xr.Dataset], ax, options: Mapping[str, Any]) ->
         _draw_trough(top, mf.model_profile(ds), stages, settlement, x_a, x_b, height)
         _draw_charts(figure, rows[1], stages, settlement, height)
         where = ""
-    top.set_title(f"{title_of(ds)}: stage 2 (LTSM) at S_max = {1e3 * settlement:.3g} mm\n"
-                  f"LTSM strain {100 * stages.strain:.3g} %, category {ZONE_NAMES[stages.category]}{where}; stage 1: "
-                  f"slope 1/{1 / max(stages.slope, 1e-12):.0f}, settlement {1e3 * stages.greenfield_settlement:.3g} mm"
-                  f"{' (screened out)' if stages.screened_out else ''}", fontsize="medium")
+    width = max(30, int(TITLE_WIDTH * figure.get_size_inches()[0] / 7.0))  # the title wrapped to the page
+    lines = [f"{title_of(ds)}: stage 2 (LTSM) at S_max = {1e3 * settlement:.3g} mm",
+             f"LTSM strain {100 * stages.strain:.3g} %, category {ZONE_NAMES[stages.category]}{where}; stage 1: "
+             f"slope 1/{1 / max(stages.slope, 1e-12):.0f}, settlement {1e3 * stages.greenfield_settlement:.3g} mm"
+             f"{' (screened out)' if stages.screened_out else ''}"]
+    figure.suptitle("\n".join(textwrap.fill(line, width) for line in lines), fontsize="medium")  # over every panel
 
 
 def _draw_plan(ax, ds: xr.Dataset, walls: list[dict], stages, settlement: float) -> dict:

@@ -177,7 +177,8 @@ def draw_diagnosis(datasets, ax, options) -> None:
     width = float(np.ptp(ds.node_x.values))
     height = float(np.ptp(ds.node_y.values))
     panel = 3.6
-    figure.set_size_inches(panel * columns, panel * height / width + 3.4)
+    if not mfp.size_asked(figure):
+        figure.set_size_inches(panel * columns, panel * height / width + 3.4)
     grid = figure.add_gridspec(2, columns, height_ratios=[max(height / width, 0.25), 0.9])
     _survey_panel(figure.add_subplot(grid[0, 0]), ds)
     for k in range(kept):
