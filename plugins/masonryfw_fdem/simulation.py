@@ -113,6 +113,7 @@ class State:
     stop_reason: str = ""
     interrupted: bool = False
     gravity_motion: np.ndarray | None = None  # (block,) how far each block moved in the gravity phase (scaled)
+    fell: bool = False  # a block moved more than STAND_SHARE of a unit in the gravity phase
     collapse_bracket: tuple = ()  # (largest stable, smallest unstable load factor) of the search
     last_stable: State | None = None  # the search's state at rest under the largest stable load factor
     trials: list = field(default_factory=list)  # (load factor, stable, motion) of the load-factor search
@@ -231,7 +232,11 @@ def chunk(scene: Scene, controls: Controls, state: State, n_steps: int, rate: fl
 
 def gravity_phase(scene, controls, state, history, progress) -> None:
     """Apply the loads with the supports still until the unbalanced-force ratio drops below
-    the rest tolerance (or for exactly ``gravity_time``)."""
+    the rest tolerance (or for exactly ``gravity_time``).
+
+    Masonry that does not stand (a block moves more than ``STAND_SHARE`` of a unit) stops the wait for rest at
+    once: its damage is not the settlement's. A fixed ``gravity_time`` is a study of the fall itself (a block
+    sliding down an incline), so it runs its whole time; either way no settlement follows."""
     if controls.gravity_time > 0:
         total = int(np.ceil(controls.gravity_time / controls.dt))
     else:  # a wall settles in a few sqrt(length / g); one that has not after 20 never will
@@ -246,13 +251,15 @@ def gravity_phase(scene, controls, state, history, progress) -> None:
         history.add(GRAVITY_PHASE, state, out)
         state.gravity_motion = block_motions(scene, state.pos, scene.pos0)
         if state.gravity_motion.max(initial=0.0) > STAND_SHARE * scene.unit_height:
+            state.fell = True
             state.stop_reason = "did not stand under its own weight"
-            return
+            if controls.gravity_time <= 0:
+                return
         ramped = state.acc[kernels.TIME] >= controls.load_ramp
         if controls.gravity_time <= 0 and ramped and out.report.unbalanced < controls.rest_tolerance:
             state.stop_reason = "at rest"
             break
-        if not warned and state.gravity_steps > OVERRUN * expected:
+        if controls.gravity_time <= 0 and not warned and state.gravity_steps > OVERRUN * expected:
             warned = True
             LOG.warning("fdem: the gravity phase has run %d steps, %.0f times its estimate, and the masonry is not at "
                         "rest yet (unbalanced force ratio %.2e, rest at %g); it stops at %d steps, or sooner if a "
@@ -270,7 +277,8 @@ def gravity_phase(scene, controls, state, history, progress) -> None:
                 f"(lower dt_safety); set gravity_time to run a fixed time instead. Moving fastest: "
                 f"{fastest_blocks(scene, state)}"
             )
-        state.stop_reason = "gravity time reached"
+        if not state.fell:
+            state.stop_reason = "gravity time reached"
 
 
 def plateau_reached(history: History, controls: Controls, reference: float) -> bool:
@@ -418,7 +426,7 @@ def run(scene: Scene, controls: Controls, state: State, load: np.ndarray, progre
     state.set_loads(scene, load)
     try:
         gravity_phase(scene, controls, state, history, progress)
-        if state.stop_reason == "did not stand under its own weight":
+        if state.fell:
             pass  # its damage is not the settlement's: nothing more to run (the result says so)
         elif controls.search:
             search_phase(scene, controls, state, history, progress)

@@ -114,7 +114,7 @@ def standing(scene: Scene, state) -> dict:
         return {"stood": 1}
     worst = int(np.argmax(motion))
     length = scene.scales.length
-    return {"stood": int(state.stop_reason != "did not stand under its own weight"),
+    return {"stood": int(not state.fell),
             "gravity_motion": float(motion[worst] * length), "gravity_motion_block": worst,
             "gravity_motion_x": float(scene.pos0[worst, 0] * length),
             "gravity_motion_y": float(scene.pos0[worst, 1] * length)}

@@ -105,11 +105,15 @@ def test_capacity_and_compare_read_no_damage_from_a_wall_that_fell(fallen):
     assert "did not stand under its own weight" in done.output and "Traceback" not in done.output
 
 
-def test_a_gravity_phase_that_does_not_come_to_rest_names_the_blocks_still_moving(monkeypatch):
+def test_a_gravity_phase_that_does_not_come_to_rest_names_the_blocks_still_moving(monkeypatch, caplog):
     """A wall that neither comes to rest nor falls within the gravity phase's limit is refused with the blocks
-    moving fastest (the limit shortened here to a few steps)."""
+    moving fastest (the limit shortened here to a few steps); on its way it said, once, that it ran past its
+    estimate (the overrun shortened to a few steps too)."""
     from masonryfw_fdem import simulation
 
     monkeypatch.setattr(simulation, "GRAVITY_TIME_LIMIT", 1e-3)
+    monkeypatch.setattr(simulation, "OVERRUN", 1e-9)
     with pytest.raises(mf.SolveError, match=r"did not come to rest .* Moving fastest: block \d+ at \("):
         mf.solve(wall(ARCHED), "fdem", {"settlement": 0.0, "rest_tolerance": 1e-12})
+    said = [r.getMessage() for r in caplog.records if "times its estimate" in r.getMessage()]
+    assert len(said) == 1 and "not at rest yet" in said[0] and "Moving fastest: block" in said[0], said
