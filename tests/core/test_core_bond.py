@@ -136,7 +136,7 @@ def test_every_unit_of_the_gable_house_is_within_the_size_limits_and_every_openi
 
 @pytest.mark.parametrize("solver, options", [
     ("la", []),
-    ("fdem", ["--option", "settlement=0.002"]),
+    pytest.param("fdem", ["--option", "settlement=0.002"], marks=pytest.mark.slow),  # 35 s
     pytest.param("jmm", ["--option", "max_steps=2", "--option", "mesh_size=0.3"], marks=pytest.mark.slow),  # 70 s
 ])
 def test_every_solver_runs_on_a_gable_house_laid_in_its_outline(tmp_path, solver, options):

@@ -143,6 +143,7 @@ def mirrored(model, width):
                         node_y=model.node_y.copy(data=model.node_y.values[order]))
 
 
+@pytest.mark.slow  # 13 s: a second search
 def test_a_mirrored_wall_with_mirrored_cracks_gives_the_mirrored_candidates(diagnosis_12c, cracks_12c):
     mirror_model = mirrored(mf.open_model("test-12c"), WIDTH_12C)
     lines = [np.c_[WIDTH_12C - line[:, 0], line[:, 1]] for line in cracks_12c]

@@ -159,6 +159,7 @@ def test_the_free_profile_keeps_a_step_a_step():
     assert 5e-3 < free.settlement[free.x > 1.3].min() <= free.settlement.max() < 7e-3
 
 
+@pytest.mark.slow  # 46 s: two full searches of a study case
 def test_cracks_alone_name_what_they_cannot_tell_apart(tmp_path):
     """case-06 (held-out, the tuning half): fdem's cracks of the left 1.34 m settling 5.8 mm. From the cracks
     alone the plausible set holds more than one family and the verdict names them and the levelling that would
@@ -198,6 +199,7 @@ def test_the_levelling_sigma_option_is_used(tmp_path):
     assert data["levelling"]["sigma"] == pytest.approx(3e-4) and data["levelling"]["sigma_given"]
 
 
+@pytest.mark.slow  # 17 s: two fdem runs forward
 def test_a_re_ranking_by_fdem_says_so(tmp_path):
     """--rerank 2: the best two run forward by fdem and scored on its cracks lead the ranking in that order."""
     case = STUDY / "case-06"
@@ -214,6 +216,7 @@ def ranking(data: dict) -> list[tuple]:
     return [(json.dumps(c["settlement"], sort_keys=True), round(c["score"], 9)) for c in data["candidates"]]
 
 
+@pytest.mark.slow  # 40 s: three searches and a dask cluster
 def test_the_search_on_processes_and_on_a_dask_cluster_ranks_alike(tmp_path):
     """The same survey searched here, on two local processes and on a dask cluster (two workers): the same
     candidates with the same scores in the same order (chunks come back in any order; the ranking is made at

@@ -87,6 +87,7 @@ def compare_once(seed) -> dict:
             "dashpot": acc[kernels.DISSIPATED_DAMPING] != 0}
 
 
+@pytest.mark.slow  # 24 s: both modes on one wall
 def test_the_rigid_and_the_nodal_contact_law_agree_to_round_off():
     seen = [compare_once(seed) for seed in range(200)]
     for branch in seen[0]:

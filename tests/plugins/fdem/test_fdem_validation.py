@@ -29,6 +29,7 @@ def test_block_slides_down_incline_with_g_sin_minus_mu_cos(walls):
     expected = G * (np.sin(theta) - mu * np.cos(theta))
     assert settled_acceleration(result, after=0.05) == pytest.approx(expected, rel=2e-3)
     assert mfp.block_motion(result)[0, 0] > 0.08  # 0.5 a t^2 = 0.089 m, down the slope (+x)
+    assert int(result.attrs["stood"]) == 0  # a fixed gravity time runs the fall to its end, and says it fell
 
 
 def test_block_rests_on_incline_flatter_than_friction_angle(walls):
