@@ -59,6 +59,7 @@ def written(tmp_path_factory):
 
 @pytest.mark.parametrize("kind", ["model", "la", "fdem", "jmm", "jmm-limit", "statics", "comparison", "sweep",
                                   "drawn model", pytest.param("fdem tilt", marks=pytest.mark.slow),
-                                  pytest.param("jmm tilt", marks=pytest.mark.slow), "jmm-limit tilt", "3D model", "3D la"])
+                                  pytest.param("jmm tilt", marks=pytest.mark.slow),
+                                  pytest.param("jmm-limit tilt", marks=pytest.mark.slow), "3D model", "3D la"])
 def test_cf_checker_finds_no_error(written, tmp_path, kind):
     assert cf_errors(written[kind], tmp_path) == []

@@ -176,7 +176,7 @@ def test_a_drawing_too_big_for_the_memory_is_refused_before_it_is_read(tmp_path)
 
 #: Panel 5 by fdem is interrupted where its stderr says each phase begins: the imports (``-X importtime`` prints a
 #: line as each module is loaded; click is the command line's first), numba's compilation (a cache of its own,
-#: empty), the gravity phase and the settlement phase (a cache warmed once). Marks, not delays, and after each mark
+#: empty), the gravity phase and the settlement phase (the installation's own cache, warm). Marks, not delays, and after each mark
 #: far more work than the test needs to answer: the compilation alone takes 20 s on a fresh install, and the
 #: settlement is loaded ten times slower than by default (:data:`SLOW`: 40 s of steps instead of 4 s), so
 #: the signal lands in the phase named however busy the machine is (it slows the command as much as the test).
@@ -193,12 +193,13 @@ SLOW = ("--option", "loading_rate=2e-4")
 
 @pytest.fixture(scope="module")
 def warm_numba_cache(tmp_path_factory):
-    """A numba cache holding fdem's kernels (one short run compiles them)."""
-    folder = tmp_path_factory.mktemp("numba-cache")
+    """The environment of a run whose numba cache holds fdem's kernels: the installation's own cache, warmed by
+    one short run (at once when a test before compiled them; a cache of the module's own cost 38 s to fill)."""
+    folder = tmp_path_factory.mktemp("warm")
     done = cli(["solve", "panel-5", "--plugin", "fdem", "--option", "settlement=0.0002", "-o", "warm.nc"], folder,
-               env={"NUMBA_CACHE_DIR": str(folder)}, timeout=600)
+               timeout=600)
     assert done.returncode == 0, done.stderr
-    return folder
+    return {}
 
 
 @pytest.mark.parametrize("phase, signum", [("start-up", signal.SIGINT), ("compiling", signal.SIGINT),
@@ -211,9 +212,9 @@ def test_a_signal_in_any_phase_of_an_fdem_run_ends_it_with_one_line_and_keeps_wh
     or turned by CPython into a death by SIGINT after the command had said 130. Now every phase ends with
     128 + the signal and one line; from the gravity phase on, a readable partial result is kept."""
     mark, cache = PHASES[phase]
-    folder = tmp_path / "cold-cache" if cache == "cold" else warm_numba_cache
-    running = command(["solve", "panel-5", "--plugin", "fdem", *SLOW, "-o", "r.nc"], tmp_path,
-                      env={"NUMBA_CACHE_DIR": str(folder)}, python=("-X", "importtime") if phase == "start-up" else ())
+    env = {"NUMBA_CACHE_DIR": str(tmp_path / "cold-cache")} if cache == "cold" else warm_numba_cache
+    running = command(["solve", "panel-5", "--plugin", "fdem", *SLOW, "-o", "r.nc"], tmp_path, env=env,
+                      python=("-X", "importtime") if phase == "start-up" else ())
     running.wait_for(mark)
     status, stderr, answered = running.signal(signum)
     assert status == 128 + signum and "Traceback" not in stderr, stderr[-3000:]
@@ -238,7 +239,7 @@ def test_a_signal_inherited_ignored_stays_ignored_and_sigterm_still_ends_the_run
     process = subprocess.Popen(
         [sys.executable, "-m", "masonryfw", "solve", "panel-5", "--plugin", "fdem", *SLOW, "-o", "r.nc"],
         cwd=tmp_path, text=True, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
-        env={**os.environ, "NUMBA_CACHE_DIR": str(warm_numba_cache)},
+        env={**os.environ, **warm_numba_cache},
         preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_IGN))
     seen = ""
     while "fdem: settlement" not in seen:
