@@ -192,7 +192,7 @@ SLOW = ("--option", "loading_rate=2e-4")
 
 
 @pytest.fixture(scope="module")
-def warm_numba_cache(tmp_path_factory):
+def warm_cache_env(tmp_path_factory):
     """The environment of a run whose numba cache holds fdem's kernels: the installation's own cache, warmed by
     one short run (at once when a test before compiled them; a cache of the module's own cost 38 s to fill)."""
     folder = tmp_path_factory.mktemp("warm")
@@ -206,13 +206,13 @@ def warm_numba_cache(tmp_path_factory):
                                            ("compiling", signal.SIGTERM), ("gravity", signal.SIGINT),
                                            ("settlement", signal.SIGTERM), ("settlement", signal.SIGINT)])
 def test_a_signal_in_any_phase_of_an_fdem_run_ends_it_with_one_line_and_keeps_what_it_can(
-        tmp_path, warm_numba_cache, command, phase, signum):
+        tmp_path, warm_cache_env, command, phase, signum):
     """A fresh-clone CI run ended with status -2 and no word: a Ctrl-C in the imports or the compilation of a
     first fdem run was outside the command's handling, dropped by LLVM's callbacks (the run went on to exit 0),
     or turned by CPython into a death by SIGINT after the command had said 130. Now every phase ends with
     128 + the signal and one line; from the gravity phase on, a readable partial result is kept."""
     mark, cache = PHASES[phase]
-    env = {"NUMBA_CACHE_DIR": str(tmp_path / "cold-cache")} if cache == "cold" else warm_numba_cache
+    env = {"NUMBA_CACHE_DIR": str(tmp_path / "cold-cache")} if cache == "cold" else warm_cache_env
     running = command(["solve", "panel-5", "--plugin", "fdem", *SLOW, "-o", "r.nc"], tmp_path, env=env,
                       python=("-X", "importtime") if phase == "start-up" else ())
     running.wait_for(mark)
@@ -231,7 +231,7 @@ def test_a_signal_in_any_phase_of_an_fdem_run_ends_it_with_one_line_and_keeps_wh
     assert hidden(tmp_path) == []
 
 
-def test_a_signal_inherited_ignored_stays_ignored_and_sigterm_still_ends_the_run(tmp_path, warm_numba_cache):
+def test_a_signal_inherited_ignored_stays_ignored_and_sigterm_still_ends_the_run(tmp_path, warm_cache_env):
     """A shell script's background job inherits SIGINT ignored, so that a Ctrl-C meant for the foreground leaves
     it running; it stays so, and SIGTERM still ends the run at once with a partial result. SIGINT and SIGTERM are
     sent together: were SIGINT taken, the status would say 130 (the first signal taken, and Linux delivers the
@@ -239,7 +239,7 @@ def test_a_signal_inherited_ignored_stays_ignored_and_sigterm_still_ends_the_run
     process = subprocess.Popen(
         [sys.executable, "-m", "masonryfw", "solve", "panel-5", "--plugin", "fdem", *SLOW, "-o", "r.nc"],
         cwd=tmp_path, text=True, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
-        env={**os.environ, **warm_numba_cache},
+        env={**os.environ, **warm_cache_env},
         preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_IGN))
     seen = ""
     while "fdem: settlement" not in seen:
