@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from importlib import resources
 
-from masonryfw.builder import load_spec
+from masonryfw.kinds import load_spec
 from masonryfw.errors import ModelError
 
 #: Bundled case names, in the paper's order.

@@ -2,7 +2,6 @@
 (lazy_loader.attach_stub reads them from here; Scientific Python SPEC 1)."""
 
 from .api import SolvePlan, compare, estimate, plot_table, render, solve, solve_plan
-from .builder import STAND_IN_GROUND, build, load_spec, load_wall
 from .checks import Problem, check
 from .damage import DAMAGE_LIMITS, Cracks, damage_category, widest_crack
 from .datasets import (
@@ -21,6 +20,7 @@ from .ground import ground_model, over_profile
 from .inputs import InputError
 from .interfaces import detect_interfaces
 from .io import open_dataset, save, save_figure
+from .kinds import STAND_IN_GROUND, build, load_spec, load_wall
 from .locks import BusyError
 from .model import checked_model
 from .plausibility import PlausibilityWarning, plausibility

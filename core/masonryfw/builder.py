@@ -36,30 +36,24 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, replace
-from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
 
 from . import blocks
-from .building import build_building, is_building
-from .drawing3d import build_drawn_3d, is_drawn_3d, mesh_path
 from .errors import SpecError
-from .imported import build_drawn, is_drawn, parse_drawn_spec, resolved_drawing
 from .inputs import fits_in_memory
 from .material import Material
 from .model import checked_model
-from .model3d import twin
-from .outlined import build_outlined, is_outlined
-from .plausibility import warn_implausible
 from .profiles import SETTLEMENT_KEYS, Profile, read_profile, with_profile
 from .roles import ROLE
 from .spec import (
-    LENGTH_UNITS,
     SpecTable,
+    model_attributes,
+    open_spec,
     read_loading,
     read_material,
-    read_spec,
+    refuse_ground_twice,
 )
 from .supports import Support, profile_supports, read_supports, support_blocks
 
@@ -70,63 +64,6 @@ if TYPE_CHECKING:  # annotations only
 COURSE_TOLERANCE = 1.0e-6
 #: Position tolerance, relative to the wall size.
 POSITION_TOLERANCE = 1.0e-9
-
-# --------------------------------------------------------------------------- reading
-
-
-def load_spec(path_or_text) -> dict:
-    """Read and validate a spec: a path (str or PathLike or Traversable) or the TOML text itself.
-
-    Returns the spec as a plain dict (as written, except that a drawn wall's
-    drawing path is made absolute), ready to be modified (e.g. by a parameter
-    sweep) and passed to :func:`build`.
-    """
-    spec, _, base_dir = read_spec(path_or_text)
-    return _validated(spec, base_dir)
-
-
-#: What a wall read by :func:`load_wall` stands on when its spec gives no supports and no profile: every
-#: support block moving (a tilt so gentle and wide that nothing is still), for a command that makes its own
-#: ground from the wall's (``masonryfw diagnose``).
-STAND_IN_GROUND = {"settlement": {"profile": "linear", "start": -1.0e6, "end": 1.0e6},
-                   "loading": {"type": "settlement"}}
-
-
-def load_wall(path_or_text) -> dict:
-    """Read and validate a spec for its wall alone: its ``[supports.*]``, ``[settlement]`` and ``[loading]`` may
-    be left out (:data:`STAND_IN_GROUND` stands in for them; a command that reads walls this way sets their
-    supports aside and makes its own ground)."""
-    spec, _, base_dir = read_spec(path_or_text)
-    if is_building(spec) or is_drawn_3d(spec):
-        what = "a [building] table" if is_building(spec) else "a 3D drawing (geometry.mesh)"
-        raise SpecError(f"the spec is 3D ({what}); a wall alone is read in 2D: masonryfw diagnose handles 2D walls "
-                        "(a building's walls: masonryfw solve and capacity)")
-    if "supports" not in spec and "settlement" not in spec:
-        spec = {**spec, **STAND_IN_GROUND}
-    return _validated({**spec, "loading": spec.get("loading", STAND_IN_GROUND["loading"])}, base_dir)
-
-
-def _validated(spec: dict, base_dir) -> dict:
-    if is_building(spec):  # checked as it is laid (masonryfw.building)
-        build_building(spec, "")
-        return spec
-    if is_drawn_3d(spec):  # checked as it is read; its mesh found from the spec's folder
-        spec = {**spec, "geometry": {**spec["geometry"], "mesh": str(mesh_path(spec, base_dir).resolve())}}
-        build_drawn_3d(spec, "", None)
-        return spec
-    if is_outlined(spec):  # checked as it is laid (masonryfw.outlined); its drawing found from the spec's folder
-        geometry = spec.get("geometry", {})
-        drawings = {k: str(Path(base_dir or ".", Path(geometry[k]).expanduser()).resolve())
-                    for k in ("dxf", "polygons") if isinstance(geometry.get(k), str)}
-        return {**spec, "geometry": {**geometry, **drawings}} if drawings else spec
-    if is_drawn(spec):
-        drawn = parse_drawn_spec(spec)
-        key = drawn.drawing_key.split(".")[1]
-        spec = {**spec, "geometry": {**spec["geometry"], key: str(resolved_drawing(drawn, base_dir).resolve())}}
-    else:
-        parse_spec(spec)
-    return spec
-
 
 # --------------------------------------------------------------------------- validation
 
@@ -179,9 +116,8 @@ _OPENING_KEYS = ("x", "y", "width", "height", "lintel_bearing")
 
 def parse_spec(spec: dict) -> Wall:
     """Validate a spec dict and return it in SI; a :class:`SpecError` names the offending key."""
-    top = SpecTable(spec, "", _TOP_KEYS)
-    unit_name = top.choice("length_unit", tuple(LENGTH_UNITS), "m")
-    top.scale = LENGTH_UNITS[unit_name]
+    top = open_spec(spec, _TOP_KEYS)
+    unit_name = top.raw("length_unit", "m")
 
     wall = top.sub("wall", ("width", "height", "thickness"))
     width = wall.number("width", length=True, positive=True)
@@ -200,8 +136,7 @@ def parse_spec(spec: dict) -> Wall:
     bond = top.sub("bond", ("pattern", "first_course"), {})
 
     material = read_material(top)
-    if top.has("settlement") and top.has("supports"):
-        raise SpecError("spec tables 'settlement' and 'supports': give one of them (the profile makes the supports)")
+    refuse_ground_twice(top)
     supports = () if top.has("settlement") else read_supports(top, 0.0, width)
     kind, direction = read_loading(top, top.has("settlement") or any(s.kind == "moving" for s in supports))
 
@@ -406,53 +341,15 @@ def masonry_blocks(wall: Wall):
 # --------------------------------------------------------------------------- the dataset
 
 
-def build(spec, *, validate: bool = True) -> xr.Dataset:
-    """Build the model dataset of a wall spec (a dict, a path, a Traversable or TOML text).
-
-    A spec with a ``[geometry]`` table is a drawn wall (:mod:`masonryfw.imported`;
-    its drawing's path is relative to the spec file, else to the working folder); a wall given by its outline
-    (a drawing's ``outline_layer``, a gable, shaped openings, an English or Flemish bond, a height that is not
-    whole courses) gets its bond laid (:mod:`masonryfw.outlined`).
-
-    Blocks come course by course, left to right (units and lintels), then the
-    supports in spec order; interfaces, kinds and loads as every model gets them
-    (:mod:`masonryfw.blocks`). Raises :class:`SpecError` naming the key at fault.
-    ``space = 3`` builds the wall one block thick in 3D (:func:`masonryfw.model3d.twin`).
-    The model is returned checked (:func:`masonryfw.checked_model`), unless
-    ``validate`` is False. Values outside the range of real masonry give a
-    :class:`masonryfw.PlausibilityWarning` each (:mod:`masonryfw.plausibility`).
-    """
-    spec_dict, text, base_dir = read_spec(spec)
-    space = spec_dict.get("space", 2)
-    if space not in (2, 3) or isinstance(space, bool):
-        raise SpecError(f"space: must be 2 (the wall in its plane) or 3 (the wall one block thick in 3D), not {space!r}")
-    if is_building(spec_dict) or is_drawn_3d(spec_dict):
-        model = build_building(spec_dict, text) if is_building(spec_dict) else build_drawn_3d(spec_dict, text, base_dir)
-        warn_implausible(model)
-        return checked_model(model, repr(model.attrs["title"])) if validate else model
-    if is_outlined(spec_dict):
-        model = build_outlined(spec_dict, text, base_dir, validate)
-    elif is_drawn(spec_dict):
-        model = build_drawn(spec_dict, text, base_dir, validate)
-    else:
-        model = _build_parametric(spec_dict, text, validate)
-    warn_implausible(model)
-    if space == 3:
-        model = twin(model)
-        return checked_model(model, repr(model.attrs["title"])) if validate else model
-    return model
-
-
-def _build_parametric(spec_dict: dict, text: str, validate: bool) -> xr.Dataset:
+def build_parametric(spec_dict: dict, text: str, validate: bool = True) -> xr.Dataset:
+    """The model of a wall of rectangular units (module docstring); checked unless ``validate`` is False."""
     wall = parse_spec(spec_dict)
     mx0, mx1, my0, my1, m_role = masonry_blocks(wall)
     s_x0, s_x1, s_y0, s_y1, supports = support_blocks(wall.supports, 0.0, wall.unit_height)
     x0, x1 = np.concatenate((mx0, s_x0)), np.concatenate((mx1, s_x1))
     y0, y1 = np.concatenate((my0, s_y0)), np.concatenate((my1, s_y1))
     role = np.concatenate((m_role, np.full(s_x0.size, ROLE["fixed_support"], dtype=np.int8)))
-    attrs = {"title": wall.title, "source_spec": text}
-    if wall.description:
-        attrs["comment"] = wall.description
+    attrs = model_attributes(wall.title, wall.description, text)
     ds = blocks.model_from_blocks(*blocks.rectangle_nodes(x0, x1, y0, y1), role, wall.thickness, wall.material,
                                   supports, wall.loading, wall.tilt_direction, attrs)
     ds = with_profile(ds, wall.profile)

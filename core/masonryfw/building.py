@@ -39,11 +39,12 @@ from .bond import pattern_cells
 from .errors import SpecError
 from .ground_plan import SETTLEMENT_3D_KEYS, GroundInPlan, profile_in_plan
 from .inputs import fits_in_memory
+from .material import Material
 from .on_ground import model_on_ground
 from .profiles import refuse_fine_segments, with_profile
 from .resources import count_text
 from .roles import ROLE
-from .spec import LENGTH_UNITS, SpecTable, read_material
+from .spec import SpecTable, model_attributes, open_spec, read_material
 
 BUILDING_KEYS = ("unit", "walls", "floors", "support_depth", "segment", "bond", "header_every")
 WALL_KEYS = ("name", "start", "end", "height", "thickness", "openings", "bond", "header_every")
@@ -519,12 +520,26 @@ def segment_motion(ground: GroundInPlan, ends: np.ndarray, along: np.ndarray, ac
     return motion + 0.0
 
 
-def build_building(spec: dict, text: str) -> xr.Dataset:
-    """The 3D model of a spec with a ``[building]`` table (module docstring); a :class:`SpecError` names the key."""
-    top = SpecTable(spec, "", TOP_KEYS)
-    top.scale = LENGTH_UNITS[top.choice("length_unit", tuple(LENGTH_UNITS), "m")]
-    if top.raw("space", 3) != 3:
-        raise SpecError(f"spec key 'space' = {top.raw('space')!r}: a [building] is 3D (space = 3, or leave it out)")
+class BuildingPlan(NamedTuple):
+    """A ``[building]`` spec read and checked, before anything is laid (what ``load_spec`` validates)."""
+
+    top: SpecTable
+    walls: list[Wall]
+    joins: Junctions
+    floors: list[Floor]
+    material: Material
+    ground_plan: GroundInPlan
+    unit_length: float
+    unit_height: float
+    support_depth: float
+    segment: float
+    notes: list[str]
+
+
+def read_building(spec: dict) -> BuildingPlan:
+    """A ``[building]`` spec's keys read and checked, its walls' junctions found and its size weighed against the
+    memory available, without laying a block; a :class:`SpecError` names the key."""
+    top = open_spec(spec, TOP_KEYS, three_d="a [building]")
     building = top.sub("building", BUILDING_KEYS)
     unit = building.sub("unit", ("length", "height", "depth"))
     unit_length = unit.number("length", length=True, positive=True)
@@ -548,10 +563,19 @@ def build_building(spec: dict, text: str) -> xr.Dataset:
     if building.has("segment"):
         refuse_fine_segments(max(w.length for w in walls), segment, unit_length, f"spec key {building.key('segment')!r}")
     refuse_too_big(walls, unit_length, unit_height, segment, building, top)
+    joins = junctions(walls, 1e-6 * max(w.length for w in walls))
+    return BuildingPlan(top, walls, joins, read_floors(building, walls, unit_height), material, ground_plan,
+                        unit_length, unit_height, depth, segment, notes)
+
+
+def build_building(spec: dict, text: str) -> xr.Dataset:
+    """The 3D model of a spec with a ``[building]`` table (module docstring); a :class:`SpecError` names the key."""
+    (top, walls, joins, floors, material, ground_plan, unit_length, unit_height, depth, segment,
+     notes) = read_building(spec)
+    profile = ground_plan.profile
     tol = 1e-6 * max(w.length for w in walls)
-    joins = junctions(walls, tol)
     laid = lay_masonry(walls, joins, unit_length, unit_height, notes)
-    add_floors(building, walls, laid, unit_height)
+    add_floors(floors, walls, laid, unit_height)
     courses = [round(w.height / unit_height) for w in walls]
     n_masonry = len(laid.wall)
     for w, wall in enumerate(walls):  # the ground under the first course, less where a crossing wall's ground is
@@ -567,14 +591,10 @@ def build_building(spec: dict, text: str) -> xr.Dataset:
                 laid.add(w, (s0, s1), (-half, half), (-depth, 0.0), ROLE["fixed_support"])
     refuse_overlaps(walls, laid, unit_length)
     poly = oriented_boxes(walls, laid)
-    attrs = {"title": top.text("title"), "source_spec": text,
-             "building_walls": json.dumps([{"name": w.name, "start": w.start.tolist(), "end": w.end.tolist(),
-                                            "height": w.height, "thickness": w.thickness,
-                                            "ground": [c.at for c in course_extent(walls, joins, courses, k, 0)]}
-                                           for k, w in enumerate(walls)]),
-             "settlement_axis": ground_plan.axis_attr(),
-             **({"laying_notes": "\n".join(notes)} if notes else {}),
-             **({"comment": top.text("description")} if top.has("description") else {})}
+    attrs = model_attributes(top.text("title"), top.text("description", ""), text, notes=notes, settlement_axis=ground_plan.axis_attr(), building_walls=json.dumps(
+        [{"name": w.name, "start": w.start.tolist(), "end": w.end.tolist(), "height": w.height,
+          "thickness": w.thickness, "ground": [c.at for c in course_extent(walls, joins, courses, k, 0)]}
+         for k, w in enumerate(walls)]))
     model = _dataset(walls, laid, n_masonry, poly, material, ground_plan, depth, attrs, tol)
     return with_profile(model, profile)
 
@@ -606,27 +626,42 @@ def refuse_too_big(walls: list[Wall], unit_length: float, unit_height: float, se
                    "are the unit, the walls and length_unit what was meant?")
 
 
-def add_floors(building: SpecTable, walls: list[Wall], laid: Laid, unit_height: float) -> None:
-    """Each ``[[building.floors]]`` line load [N/m] on the named walls' course whose top is nearest its height,
-    a block taking the load on its length and on its share of the wall's thickness."""
-    names = {wall.name: w for w, wall in enumerate(walls)}
+class Floor(NamedTuple):
+    """A ``[[building.floors]]`` line load: ``load`` [N/m] on the course ``course`` (from 0) of the walls ``on``."""
+
+    on: tuple[str, ...]
+    course: int
+    load: float
+
+
+def read_floors(building: SpecTable, walls: list[Wall], unit_height: float) -> list[Floor]:
+    """Each ``[[building.floors]]`` on the named walls' course whose top is nearest its height; a
+    :class:`SpecError` names a wall that is not there or a height where none of its walls has a course."""
+    names = [wall.name for wall in walls]
+    courses = {wall.name: round(wall.height / unit_height) for wall in walls}
+    floors = []
     for i, table in enumerate(building.raw("floors", [])):
         floor = SpecTable(table, f"{building.key('floors')}[{i}]", FLOOR_KEYS, building.scale)
         on = floor.raw("walls")
         if not isinstance(on, list) or not on or any(name not in names for name in on):
             raise SpecError(f"spec key {floor.key('walls')!r} = {on!r}: must list walls by name ({', '.join(names)})")
-        top_course = round(floor.number("height", length=True, positive=True) / unit_height) - 1
-        load = floor.number("load", minimum=0.0)
-        hit = False
-        for b, (w, z0) in enumerate(zip(laid.wall, laid.z0)):
-            if walls[w].name in on and round(z0 / unit_height) == top_course:
-                share = (laid.q1[b] - laid.q0[b]) / walls[w].thickness
-                middle = 0.5 * (laid.q0[b] + laid.q1[b])
-                laid.load[b] += load * (laid.s1[b].at_face(middle) - laid.s0[b].at_face(middle)) * share
-                hit = True
-        if not hit:
+        course = round(floor.number("height", length=True, positive=True) / unit_height) - 1
+        if not any(0 <= course < courses[name] for name in on):
             raise SpecError(f"spec key {floor.key('height')!r} = {floor.raw('height')!r}: no course of the walls "
                             f"{', '.join(on)} ends there")
+        floors.append(Floor(tuple(on), course, floor.number("load", minimum=0.0)))
+    return floors
+
+
+def add_floors(floors: list[Floor], walls: list[Wall], laid: Laid, unit_height: float) -> None:
+    """Each floor's line load on its walls' course, a block taking the load on its length and on its share of the
+    wall's thickness."""
+    for floor in floors:
+        for b, (w, z0) in enumerate(zip(laid.wall, laid.z0)):
+            if walls[w].name in floor.on and round(z0 / unit_height) == floor.course:
+                share = (laid.q1[b] - laid.q0[b]) / walls[w].thickness
+                middle = 0.5 * (laid.q0[b] + laid.q1[b])
+                laid.load[b] += floor.load * (laid.s1[b].at_face(middle) - laid.s0[b].at_face(middle)) * share
 
 
 def _dataset(walls, laid, n_masonry, poly, material, ground_plan, depth, attrs, tol) -> xr.Dataset:

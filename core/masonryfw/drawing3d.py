@@ -39,7 +39,7 @@ from .mesh_drawing import MeshDrawing, read_obj
 from .on_ground import model_on_ground, plane_motion
 from .profiles import with_profile
 from .roles import ROLE
-from .spec import LENGTH_UNITS, SpecTable, read_material
+from .spec import SpecTable, model_attributes, open_spec, read_material, spec_relative
 
 GEOMETRY_KEYS = ("mesh", "drawing_unit", "snap_tolerance", "ground_depth", "layers")
 TOP_KEYS = ("title", "description", "space", "length_unit", "geometry", "material", "settlement")
@@ -54,17 +54,13 @@ def is_drawn_3d(spec: dict) -> bool:
 
 def mesh_path(spec: dict, base_dir: Path | None) -> Path:
     """The mesh's path: as written if absolute, else relative to ``base_dir`` (the spec file's folder)."""
-    path = Path(spec["geometry"]["mesh"]).expanduser()
-    return path if path.is_absolute() or base_dir is None else base_dir / path
+    return spec_relative(spec["geometry"]["mesh"], base_dir)
 
 
 def build_drawn_3d(spec: dict, text: str, base_dir: Path | None) -> xr.Dataset:
     """The 3D model of a spec whose ``[geometry]`` has a ``mesh`` (module docstring); a :class:`SpecError` names
     the key, the block or the line at fault."""
-    top = SpecTable(spec, "", TOP_KEYS)
-    top.scale = LENGTH_UNITS[top.choice("length_unit", tuple(LENGTH_UNITS), "m")]
-    if top.raw("space", 3) != 3:
-        raise SpecError(f"spec key 'space' = {top.raw('space')!r}: a mesh is 3D (space = 3, or leave it out)")
+    top = open_spec(spec, TOP_KEYS, three_d="a mesh")
     geometry = top.sub("geometry", GEOMETRY_KEYS)
     unit = DRAWING_UNITS[geometry.choice("drawing_unit", tuple(DRAWING_UNITS), "m")]
     if not isinstance(geometry.raw("mesh"), str):
@@ -97,10 +93,7 @@ def build_drawn_3d(spec: dict, text: str, base_dir: Path | None) -> xr.Dataset:
     ground = polyhedra.vertical_prisms(*_rings(pieces), np.full(len(pieces), level - depth), np.full(len(pieces), level))
     motion = np.array([_piece_motion(ground_plan, piece, depth) for piece in pieces])
     volume, _ = polyhedra.volumes_centroids(masonry)
-    attrs = {"title": top.text("title"), "source_spec": text, "source_drawing": path.name,
-             "settlement_axis": ground_plan.axis_attr(),
-             **({"laying_notes": "\n".join(drawing.notes)} if drawing.notes else {}),
-             **({"comment": top.text("description")} if top.has("description") else {})}
+    attrs = model_attributes(top.text("title"), top.text("description", ""), text, drawing=path, notes=drawing.notes, settlement_axis=ground_plan.axis_attr())
     model = model_on_ground(polyhedra.joined(masonry, ground), roles[roles >= 0], material.unit_weight * volume,
                             motion, material, attrs, tol, "piece of the ground",
                             lambda b: f"drawing {path.name!r}: {label(b)}")

@@ -28,8 +28,6 @@ order; loads, interfaces and kinds as for every model (:mod:`masonryfw.blocks`).
 """
 from __future__ import annotations
 
-import hashlib
-import os
 import re
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -46,7 +44,18 @@ from .material import Material
 from .model import checked_model
 from .profiles import SETTLEMENT_KEYS, profile_segments, read_profile, with_profile
 from .roles import ROLE
-from .spec import LENGTH_UNITS, MOTION_KEYS, SpecTable, check_pivot, read_loading, read_material, read_motion
+from .spec import (
+    MOTION_KEYS,
+    SpecTable,
+    check_pivot,
+    model_attributes,
+    open_spec,
+    read_loading,
+    read_material,
+    read_motion,
+    refuse_ground_twice,
+    spec_relative,
+)
 
 if TYPE_CHECKING:  # annotations only
     import xarray as xr
@@ -113,9 +122,7 @@ def parse_drawn_spec(spec: dict) -> DrawnSpec:
     for key, why in _PARAMETRIC.items():
         if key in spec:
             raise SpecError(f"spec key {key!r} does not apply to a wall drawn in [geometry] ({why})")
-    top = SpecTable(spec, "", _TOP_KEYS)
-    unit_name = top.choice("length_unit", tuple(LENGTH_UNITS), "m")
-    top.scale = LENGTH_UNITS[unit_name]
+    top = open_spec(spec, _TOP_KEYS)
     geometry = top.sub("geometry", _GEOMETRY_KEYS)
     sources = [k for k in ("dxf", "polygons") if geometry.has(k)]
     if len(sources) != 1:
@@ -141,10 +148,9 @@ def parse_drawn_spec(spec: dict) -> DrawnSpec:
                             "(the drawing gives its size)")
     wall = top.sub("wall", ("thickness",))
     material = read_material(top)
+    refuse_ground_twice(top, "the profile makes the supports; drawn ground blocks are chosen by "
+                             "settlement.ground_layer or settlement.ground_select")
     settlement = top.sub("settlement", SETTLEMENT_KEYS + GROUND_KEYS) if top.has("settlement") else None
-    if settlement is not None and top.has("supports"):
-        raise SpecError("spec tables 'settlement' and 'supports': give one of them (the profile makes the supports; "
-                        "drawn ground blocks are chosen by settlement.ground_layer or settlement.ground_select)")
     supports = () if settlement is not None else _drawn_supports(top, layers)
     loading, direction = read_loading(top, settlement is not None or any(s.kind == "moving" for s in supports))
     return DrawnSpec(
@@ -199,8 +205,7 @@ def _drawn_supports(top: SpecTable, layers: dict[str, str]) -> tuple[DrawnSuppor
 
 def resolved_drawing(spec: DrawnSpec, base_dir: Path | None) -> Path:
     """The drawing's path: as written if absolute, else relative to ``base_dir`` (the spec file's folder)."""
-    path = Path(os.path.expanduser(spec.drawing))
-    return path if path.is_absolute() or base_dir is None else base_dir / path
+    return spec_relative(spec.drawing, base_dir)
 
 
 def build_drawn(spec_dict: dict, text: str, base_dir: Path | None, validate: bool = True) -> xr.Dataset:
@@ -212,14 +217,7 @@ def build_drawn(spec_dict: dict, text: str, base_dir: Path | None, validate: boo
     drawing = read_drawing(path, spec.drawing_unit, spec.chord_tolerance, spec.snap_tolerance)
     kept = np.array([spec.layers.get(layer, "unit") != "ignore" for layer in drawing.layers])
     _refuse_an_elevation(drawing, kept, path)
-    attrs = {
-        "title": spec.title,
-        "source_spec": text,
-        "source_drawing": path.name,
-        "source_drawing_sha256": hashlib.sha256(path.read_bytes()).hexdigest(),
-    }
-    if spec.description:
-        attrs["comment"] = spec.description
+    attrs = model_attributes(spec.title, spec.description, text, drawing=path)
     if spec.settlement is None:
         ds, labels = _drawn_supports_model(spec, drawing, kept, path, attrs)
     else:

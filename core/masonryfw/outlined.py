@@ -22,7 +22,6 @@ course, slivers merged) is the model's ``laying_notes``.
 """
 from __future__ import annotations
 
-import hashlib
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -39,7 +38,17 @@ from .model import checked_model
 from .profiles import SETTLEMENT_KEYS, read_profile, with_profile
 from .resources import count_text
 from .roles import ROLE
-from .spec import LENGTH_UNITS, SpecTable, is_finite_number, read_loading, read_material, shown
+from .spec import (
+    SpecTable,
+    is_finite_number,
+    model_attributes,
+    open_spec,
+    read_loading,
+    read_material,
+    refuse_ground_twice,
+    shown,
+    spec_relative,
+)
 from .supports import profile_supports, read_supports, support_blocks
 
 if TYPE_CHECKING:  # annotations only
@@ -96,8 +105,7 @@ class Elevation:
 
 def build_outlined(spec_dict: dict, text: str, base_dir: Path | None, validate: bool = True) -> xr.Dataset:
     """The model of a wall laid in its outline (module docstring); checked unless ``validate`` is False."""
-    top = SpecTable(spec_dict, "", _TOP_KEYS)
-    top.scale = LENGTH_UNITS[top.choice("length_unit", tuple(LENGTH_UNITS), "m")]
+    top = open_spec(spec_dict, _TOP_KEYS)
     unit = top.sub("unit", ("length", "height"))
     bond_table = top.sub("bond", ("pattern", "first_course", "min_piece"), {})
     bond = Bond(unit.number("length", length=True, positive=True), unit.number("height", length=True, positive=True),
@@ -110,8 +118,7 @@ def build_outlined(spec_dict: dict, text: str, base_dir: Path | None, validate: 
     _refuse_one_block(laid, elevation)
     x0, y0, x1, _ = elevation.outline.bounds
     base = np.array([(p[:, 0].min(), p[:, 0].max()) for p in laid.polygons if p[:, 1].min() <= y0 + 1e-9 * (x1 - x0)])
-    if top.has("settlement") and top.has("supports"):
-        raise SpecError("spec tables 'settlement' and 'supports': give one of them (the profile makes the supports)")
+    refuse_ground_twice(top)
     profile = None
     if top.has("settlement"):
         profile = read_profile(top.sub("settlement", SETTLEMENT_KEYS), x0, x1, bond.unit_length)
@@ -123,12 +130,7 @@ def build_outlined(spec_dict: dict, text: str, base_dir: Path | None, validate: 
     rectangles = [np.array([[a, c], [b, c], [b, d], [a, d]]) for a, b, c, d in zip(s_x0, s_x1, s_y0, s_y1)]
     rings = laid.polygons + rectangles
     roles = np.array(laid.roles + [ROLE["fixed_support"]] * len(rectangles), dtype=np.int8)
-    attrs = {"title": top.text("title"), "source_spec": text, "laying_notes": "\n".join([*elevation.notes, *laid.notes])}
-    if top.text("description", ""):
-        attrs["comment"] = top.text("description")
-    if elevation.source is not None:
-        attrs["source_drawing"] = elevation.source.name
-        attrs["source_drawing_sha256"] = hashlib.sha256(elevation.source.read_bytes()).hexdigest()
+    attrs = model_attributes(top.text("title"), top.text("description", ""), text, drawing=elevation.source, notes=[*elevation.notes, *laid.notes])
     wall = top.sub("wall", _WALL_KEYS)
     ds = blocks.model_from_blocks(np.concatenate([r[:, 0] for r in rings]), np.concatenate([r[:, 1] for r in rings]),
                                   np.array([len(r) for r in rings], dtype=np.int32), roles,
@@ -162,6 +164,13 @@ def _refuse_one_block(laid: Laid, elevation: Elevation) -> None:
 
 # ---------------------------------------------------------------- a drawing's outline
 
+def drawing_paths(spec: dict, base_dir: Path | None) -> dict[str, Path]:
+    """The drawing an outline spec names, by its key (``dxf`` or ``polygons``): none for a parametric outline."""
+    geometry = spec.get("geometry")
+    geometry = geometry if isinstance(geometry, dict) else {}
+    return {k: spec_relative(geometry[k], base_dir) for k in ("dxf", "polygons") if isinstance(geometry.get(k), str)}
+
+
 def _drawn(top: SpecTable, base_dir: Path | None, bond: Bond) -> Elevation:
     from shapely.geometry import Polygon
 
@@ -170,8 +179,7 @@ def _drawn(top: SpecTable, base_dir: Path | None, bond: Bond) -> Elevation:
     if len(sources) != 1:
         raise SpecError("spec table 'geometry': give exactly one of 'geometry.dxf' and 'geometry.polygons'")
     written = geometry.text(sources[0])
-    path = Path(written).expanduser()
-    path = path if path.is_absolute() or base_dir is None else base_dir / path
+    path = spec_relative(written, base_dir)
     if not path.exists():
         raise SpecError(f"spec key 'geometry.{sources[0]}' = {written!r}: no such file ({path})")
     unit = geometry.raw("drawing_unit", None)

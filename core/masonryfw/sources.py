@@ -8,13 +8,12 @@ import os
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from .builder import build
 from .checks import check
 from .datasets import BUNDLED_NAMES, bundled_spec_path
 from .derived import DERIVED_VARIABLES, derive_geometry
 from .errors import MasonryError, ModelError
-from .imported import is_drawn, parse_drawn_spec, resolved_drawing
 from .io import open_dataset
+from .kinds import build, files_read
 from .model import checked_model, model_part
 from .spec import read_spec
 
@@ -66,9 +65,9 @@ def input_files(*names: str | os.PathLike | None) -> list[Path]:
 def _drawing_of(spec_path: Path) -> list[Path]:
     try:
         spec, _, base_dir = read_spec(spec_path)
-        return [resolved_drawing(parse_drawn_spec(spec), base_dir)] if is_drawn(spec) else []
     except MasonryError:  # a spec that cannot be read is refused, with its message, by the build
         return []
+    return files_read(spec, base_dir)
 
 
 def open_checked(path: str | os.PathLike) -> xr.Dataset:

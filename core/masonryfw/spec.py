@@ -7,6 +7,7 @@ Shared by the parametric builder (:mod:`masonryfw.builder`) and drawn walls
 from __future__ import annotations
 
 import difflib
+import hashlib
 import json
 import math
 import os
@@ -155,6 +156,46 @@ class SpecTable:
 
 _MATERIAL_KEYS = ("unit_weight", "friction_angle", "friction", "cohesion", "tensile_strength",
                   "young_modulus", "poisson_ratio")
+
+
+def spec_relative(written: str, base_dir: Path | None) -> Path:
+    """A file a spec names (its drawing): as written if absolute, else relative to ``base_dir`` (the spec file's
+    folder; the working folder for a spec given as text or a dict)."""
+    path = Path(written).expanduser()
+    return path if path.is_absolute() or base_dir is None else base_dir / path
+
+
+def open_spec(spec: dict, keys: tuple[str, ...], *, three_d: str | None = None) -> SpecTable:
+    """The spec's top table (its ``keys`` the only ones allowed) with its length unit set, every builder's first
+    step; ``three_d`` names what a kind that exists only in 3D is (e.g. ``"a [building]"``): its ``space`` must
+    be 3 or left out."""
+    top = SpecTable(spec, "", keys)
+    top.scale = LENGTH_UNITS[top.choice("length_unit", tuple(LENGTH_UNITS), "m")]
+    if three_d is not None and top.raw("space", 3) != 3:
+        raise SpecError(f"spec key 'space' = {top.raw('space')!r}: {three_d} is 3D (space = 3, or leave it out)")
+    return top
+
+
+def refuse_ground_twice(top: SpecTable, how: str = "the profile makes the supports") -> None:
+    """A wall stands on ``[supports.*]`` or on a ``[settlement]`` profile, not both (``how``: what the profile does)."""
+    if top.has("settlement") and top.has("supports"):
+        raise SpecError(f"spec tables 'settlement' and 'supports': give one of them ({how})")
+
+
+def model_attributes(title: str, description: str, text: str, *, drawing: Path | None = None, notes=(),
+                     **more: str) -> dict:
+    """A built model's global attributes from its spec, every builder's last step: ``title``, ``source_spec`` (the
+    spec's ``text``), ``comment`` (its ``description``, when it has one), ``source_drawing`` and its SHA-256 when
+    it was drawn, ``laying_notes`` when laying it said something, and ``more``."""
+    attrs = {"title": title, "source_spec": text, **more}
+    if description:
+        attrs["comment"] = description
+    if drawing is not None:
+        attrs["source_drawing"] = drawing.name
+        attrs["source_drawing_sha256"] = hashlib.sha256(drawing.read_bytes()).hexdigest()
+    if notes:
+        attrs["laying_notes"] = "\n".join(notes)
+    return attrs
 
 
 def read_material(top: SpecTable) -> Material:

@@ -36,7 +36,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from . import blocks
-from .builder import build
+from .kinds import build
 from .material import Material
 from .model import checked_model
 from .roles import ROLE, support_blocks

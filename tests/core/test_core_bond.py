@@ -18,7 +18,8 @@ from support import cli, refused
 import masonryfw as mf
 import masonryfw.plugin_api as mfp
 from masonryfw.bond import Bond, Head, lay
-from masonryfw.builder import load_spec, masonry_blocks, parse_spec
+from masonryfw.builder import masonry_blocks, parse_spec
+from masonryfw.kinds import load_spec
 
 DRAWINGS = Path(mf.bundled_spec_path("gable-house")).parent
 GABLE = """title = "gable"

@@ -280,6 +280,23 @@ def test_a_building_spec_is_read_validated_and_built_again(tmp_path):
     path.write_text(mf.dump_toml(broken))
     with pytest.raises(mf.SpecError, match="must list walls by name"):
         mf.load_spec(path)
+    high = {**house_spec(), "building": {**house_spec()["building"], "floors": [{"walls": ["south"], "height": 60.0,
+                                                                                "load": 1.0}]}}
+    with pytest.raises(mf.SpecError, match="no course of the walls south ends there"):
+        mf.load_spec(high)
+
+
+def test_load_spec_reads_a_building_without_laying_it(monkeypatch):
+    """Validating a building's spec reads and checks every key, but lays no block (it laid the whole building)."""
+    import masonryfw.building as building
+
+    def refuse(*args, **kwargs):
+        raise AssertionError("load_spec laid the building")
+
+    monkeypatch.setattr(building, "lay_masonry", refuse)
+    assert mf.load_spec(house_spec()) == house_spec()
+    with pytest.raises(AssertionError, match="laid the building"):
+        mf.build(house_spec())
 
 
 def test_the_house_in_millimetres_is_the_house_in_metres():

@@ -21,6 +21,7 @@ import pytest
 from support import Command, cli, hidden, peak_memory, refused, tilted_drawing_spec
 
 import masonryfw as mf
+import masonryfw.plugin_api as mfp
 
 DATASETS = Path(mf.bundled_spec_path("panel-1")).parent  # the installed package's bundled cases and drawings
 SURVEYS = Path(__file__).resolve().parents[2] / "datasets" / "surveys"  # the clone's: surveys are not installed
@@ -133,6 +134,8 @@ def _drawn_folder(folder):
     (folder / "l.csv").write_text(LEVELLING)
     (folder / "s.toml").write_text((DATASETS / "drawings" / "stepped-units.toml").read_text())
     (folder / "stepped-units.geojson").write_text((DATASETS / "drawings" / "stepped-units.geojson").read_text())
+    for name in ("gable-house.toml", "gable-house.dxf", "drawn-corner.toml", "drawn-corner.obj"):
+        (folder / name).write_bytes((DATASETS / "drawings" / name).read_bytes())
     os.symlink("wall.dxf", folder / "alias.nc")
     os.link(folder / "c.geojson", folder / "twin.nc")
 
@@ -145,8 +148,15 @@ def _drawn_folder(folder):
     (["diagnose", "facade-1", "--cracks", "c.geojson", "-o", "twin.nc"], "c.geojson"),
     (["diagnose", "facade-1", "--cracks", "c.geojson", "--levelling", "l.csv", "-o", "l.csv"], "l.csv"),
     (["diagnose", "s.toml", "--cracks", "c.geojson", "-o", "stepped-units.geojson"], "stepped-units.geojson"),
+    (["build", "s.toml", "-o", "stepped-units.geojson"], "stepped-units.geojson"),
+    (["build", "gable-house.toml", "-o", "gable-house.dxf"], "gable-house.dxf"),
+    (["solve", "gable-house.toml", "--plugin", "la", "-o", "gable-house.dxf"], "gable-house.dxf"),
+    (["build", "drawn-corner.toml", "-o", "drawn-corner.obj"], "drawn-corner.obj"),
+    (["solve", "drawn-corner.toml", "--plugin", "la", "-o", "drawn-corner.obj"], "drawn-corner.obj"),
 ], ids=["build onto its drawing", "solve onto its drawing", "through a link", "onto the crack map",
-        "through a hard link", "onto the levelling", "onto a drawn spec's GeoJSON"])
+        "through a hard link", "onto the levelling", "onto a drawn spec's GeoJSON", "build onto its GeoJSON",
+        "build onto an outline's DXF", "solve onto an outline's DXF", "build onto a 3D drawing's OBJ",
+        "solve onto a 3D drawing's OBJ"])
 def test_no_output_is_written_onto_a_file_the_command_reads(tmp_path, args, shown):
     """``-o wall.dxf`` of a drawn spec replaced the drawing with a netCDF file, exit 0. Every file a command
     reads (the spec, its drawing, the crack map, the levelling) is refused as an output, through links too."""
@@ -154,6 +164,21 @@ def test_no_output_is_written_onto_a_file_the_command_reads(tmp_path, args, show
     before = digests(tmp_path)
     refused(cli(args, tmp_path), "refusing to overwrite", shown)
     assert digests(tmp_path) == before
+
+
+@pytest.mark.parametrize("spec, drawing", [
+    ("w.toml", "wall.dxf"), ("s.toml", "stepped-units.geojson"), ("gable-house.toml", "gable-house.dxf"),
+    ("drawn-corner.toml", "drawn-corner.obj")], ids=["drawn DXF", "drawn GeoJSON", "outline DXF", "3D OBJ"])
+def test_every_kind_of_spec_names_its_drawing_before_it_is_built(tmp_path, monkeypatch, spec, drawing):
+    """The files a command checks its output against come from the kinds' one table, without building: an outline
+    spec's DXF and a 3D drawing's OBJ were missed, and ``-o`` onto them was refused only after the build."""
+    import dataclasses
+
+    import masonryfw.kinds as kinds
+
+    _drawn_folder(tmp_path)  # nothing may be built to name the files
+    monkeypatch.setattr(kinds, "SPEC_KINDS", tuple(dataclasses.replace(k, builds=None) for k in kinds.SPEC_KINDS))
+    assert mfp.input_files(tmp_path / spec) == [tmp_path / spec, tmp_path / drawing]
 
 
 # ---------------------------------------------------------------- memory and time, estimated first
