@@ -228,7 +228,7 @@ def _checked_estimate(solver: Solver, model: xr.Dataset, resolved: Mapping[str, 
         return expected
 
     expected = made_once(model, f"estimate {solver.name} {options_json(resolved)}", make)
-    require_memory(solver.name, expected)
+    require_memory(solver.name, expected.memory, expected.basis, expected.advice)
     return expected
 
 

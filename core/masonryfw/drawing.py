@@ -37,9 +37,9 @@ import numpy as np
 
 from .errors import SpecError
 from .geometry import block_offsets, polygon_area_centroid
+from .graph import connected_components
 from .inputs import DRAWING_BYTES_FACTOR, fits_in_memory, read_text, regular_file
 from .resources import size_text
-from .semantics import connected_components
 
 #: Metres per drawing unit.
 DRAWING_UNITS = {"m": 1.0, "cm": 0.01, "mm": 0.001}

@@ -38,7 +38,8 @@ __getattr__, __dir__, __all__ = lazy_loader.attach("masonryfw", submod_attrs={
     "resources": ["count_text", "duration_text", "size_text"],
     "roles": ["ROLE", "jointed_blocks", "masonry_blocks", "masonry_joints", "support_blocks"],
     "schema": ["FORMAT_VERSION", "flags", "load_schema", "variable_attrs"],
-    "semantics": ["ModelScales", "connected_components", "crack_indicator", "indicator_at", "interface_states", "joint_motion", "macro_blocks", "model_scales", "nearest_interface", "plastic_crack_indicator", "point_motion", "polar_moment", "refuse_rigid_settlement", "relative_motion", "rigid_fit", "settlement_weights"],
+    "graph": ["connected_components"],
+    "semantics": ["ModelScales", "crack_indicator", "indicator_at", "interface_states", "joint_motion", "macro_blocks", "model_scales", "nearest_interface", "plastic_crack_indicator", "point_motion", "polar_moment", "refuse_rigid_settlement", "relative_motion", "rigid_fit", "settlement_weights"],
     "sources": ["SPEC_SUFFIXES", "input_files", "is_spec", "source_path"],
     "summary": ["DIAGNOSIS_COLUMNS", "QUASI_STATIC_RATIO", "Row", "quasi_static_text", "candidate_text", "csv_text", "R0_SPREAD", "diagnosis_rows", "force_text", "headline_rows", "r0_text", "result_options", "score_rows", "text_table"],
 })

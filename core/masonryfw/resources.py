@@ -13,7 +13,6 @@ import re
 from pathlib import Path
 
 from .errors import SolveError
-from .records import Estimate
 
 MEMORY_LIMIT_VARIABLE = "MASONRYFW_MEMORY_LIMIT"
 _UNITS = {"": 1, "b": 1, "kb": 1e3, "mb": 1e6, "gb": 1e9, "kib": 2**10, "mib": 2**20, "gib": 2**30}
@@ -86,13 +85,14 @@ def duration_text(seconds: float) -> str:
     return f"{seconds / 3600:.1f} h" if seconds < 3.6e7 else f"{seconds / 3600:.3g} h"
 
 
-def require_memory(solver: str, estimate: Estimate) -> None:
-    """Raise :class:`SolveError` when ``estimate.memory`` exceeds :func:`available_memory`."""
+def require_memory(solver: str, memory: float, basis: str, advice: str = "") -> None:
+    """Raise :class:`SolveError` when a run's estimated ``memory`` [bytes] (worked out so: ``basis``) exceeds
+    :func:`available_memory`, with the ``advice`` that makes it smaller."""
     available = available_memory()
-    if estimate.memory <= available:
+    if memory <= available:
         return
-    hint = f"; to make it smaller: {estimate.advice}" if estimate.advice else ""
+    hint = f"; to make it smaller: {advice}" if advice else ""
     raise SolveError(
-        f"solver {solver}: this run needs about {size_text(estimate.memory)} of memory ({estimate.basis}) "
+        f"solver {solver}: this run needs about {size_text(memory)} of memory ({basis}) "
         f"and {size_text(available)} is available ({MEMORY_LIMIT_VARIABLE} sets the limit){hint}"
     )

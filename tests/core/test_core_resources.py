@@ -32,10 +32,10 @@ def test_the_variable_overrides_the_system(monkeypatch):
 
 def test_a_run_over_the_limit_is_refused_with_the_advice(monkeypatch):
     monkeypatch.setenv("MASONRYFW_MEMORY_LIMIT", "1GiB")
-    require_memory("x", mfp.Estimate(seconds=1.0, memory=2**30, basis="b"))  # exactly fits
+    require_memory("x", 2**30, "b")  # exactly fits
     with pytest.raises(mf.SolveError, match=r"solver x: this run needs about 2.0 GiB .* 1.0 GiB is available "
                                             r".*; to make it smaller: use less"):
-        require_memory("x", mfp.Estimate(seconds=1.0, memory=2**31, basis="b", advice="use less"))
+        require_memory("x", 2**31, "b", "use less")
 
 
 def test_an_interruptible_call_returns_its_value_and_raises_its_error():
