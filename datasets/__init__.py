@@ -9,8 +9,8 @@ from __future__ import annotations
 
 from importlib import resources
 
-from masonryfw.errors import ModelError
-from masonryfw.kinds import load_spec
+from masonryfw.builders.kinds import load_spec
+from masonryfw.runtime.errors import ModelError
 
 #: Bundled case names, in the paper's order.
 CASE_NAMES = (

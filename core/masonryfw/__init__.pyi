@@ -2,8 +2,11 @@
 (lazy_loader.attach_stub reads them from here; Scientific Python SPEC 1)."""
 
 from .api import SolvePlan, compare, estimate, plot_table, render, solve, solve_plan
-from .checks import Problem, check
-from .damage import DAMAGE_LIMITS, Cracks, damage_category, widest_crack
+from .builders.ground import ground_model, over_profile
+from .builders.kinds import STAND_IN_GROUND, build, load_spec, load_wall
+from .builders.plausibility import PlausibilityWarning, plausibility
+from .builders.sources import open_checked, open_model
+from .contract.registry import get_comparator, get_plotter, get_solver, installed_solvers
 from .datasets import (
     BUILDING_NAMES,
     BUNDLED_NAMES,
@@ -14,23 +17,16 @@ from .datasets import (
     bundled_cases,
     bundled_spec_path,
 )
-from .describe import describe_model
-from .errors import Interrupted, MasonryError, ModelError, PluginError, SolveError, SpecError
-from .ground import ground_model, over_profile
-from .inputs import InputError
-from .interfaces import detect_interfaces
-from .io import open_dataset, save, save_figure
-from .kinds import STAND_IN_GROUND, build, load_spec, load_wall
-from .locks import BusyError
-from .model import checked_model
-from .plausibility import PlausibilityWarning, plausibility
-from .profiles import Profile, model_profile, settlement_profile
-from .registry import get_comparator, get_plotter, get_solver, installed_solvers
-from .semantics import CRACK_THRESHOLD, at_threshold, cracked_joints, dead_reaction, settlement_reaction
-from .signals import WriteInterrupted
-from .sources import open_checked, open_model
-from .spec import dump_toml
-from .summary import (
+from .format.checks import Problem, check
+from .format.io import open_dataset, save, save_figure
+from .format.model import checked_model
+from .geometry.interfaces import detect_interfaces
+from .ground.profiles import Profile, model_profile, settlement_profile
+from .readers.spec import dump_toml
+from .results.damage import DAMAGE_LIMITS, Cracks, damage_category, widest_crack
+from .results.describe import describe_model
+from .results.semantics import CRACK_THRESHOLD, at_threshold, cracked_joints, dead_reaction, settlement_reaction
+from .results.summary import (
     KeyNumber,
     capacity_text,
     damage_text,
@@ -40,7 +36,11 @@ from .summary import (
     result_label,
     stages_text,
 )
-from .version import __version__ as __version__
+from .runtime.errors import Interrupted, MasonryError, ModelError, PluginError, SolveError, SpecError
+from .runtime.inputs import InputError
+from .runtime.locks import BusyError
+from .runtime.signals import WriteInterrupted
+from .runtime.version import __version__ as __version__
 
 __all__ = [
     # Models: from a spec, a drawing, a file or a bundled case

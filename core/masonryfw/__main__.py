@@ -1,12 +1,12 @@
 """The ``masonryfw`` command (and ``python -m masonryfw``): Ctrl-C and SIGTERM answered from its first line.
 
 The click layer's imports take about a second, numba's first compilation tens: the signal handlers are
-installed before them (:func:`masonryfw.signals.install`), so a signal at any moment ends the command with
+installed before them (:func:`masonryfw.runtime.signals.install`), so a signal at any moment ends the command with
 ``128 + signal`` and one line. Only the interpreter's own start (some 20 ms) comes before.
 """
 import sys
 
-from masonryfw import signals
+from masonryfw.runtime import signals
 
 
 def main(argv: list[str] | None = None) -> None:

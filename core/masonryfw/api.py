@@ -12,22 +12,19 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
-from .checks import check
-from .damage import DERIVED_STEP_VARIABLES, damage_variables, refuse_not_standing
-from .dofs import block_motion
-from .errors import MasonryError, ModelError, PluginError, SolveError
-from .io import CONVENTIONS, add_history, content_sha256
-from .lazy import resolved as resolved_function
-from .model import checked_model, contents_digest, made_once
-from .model3d import require_space, space
-from .options import resolve_options
-from .progress import ProgressCallback, no_progress
-from .provenance import core_version, input_hash, options_json, plugin_version, record_version
-from .records import Comparator, Estimate, Plotter, Solver
-from .registry import by_name, lookup
-from .resources import require_memory
-from .schema import FORMAT_VERSION, variable_attrs
-from .semantics import (
+from .contract.lazy import resolved as resolved_function
+from .contract.options import resolve_options
+from .contract.provenance import core_version, input_hash, options_json, plugin_version, record_version
+from .contract.records import Comparator, Estimate, Plotter, Solver
+from .contract.registry import by_name, lookup
+from .format.checks import check
+from .format.dofs import block_motion
+from .format.io import CONVENTIONS, add_history, content_sha256
+from .format.model import checked_model, contents_digest, made_once
+from .format.model3d import require_space, space
+from .format.schema import FORMAT_VERSION, variable_attrs
+from .results.damage import DERIVED_STEP_VARIABLES, damage_variables, refuse_not_standing
+from .results.semantics import (
     CRACK_THRESHOLD,
     DERIVED_RESULT_VARIABLES,
     FLOW_RULES,
@@ -36,7 +33,10 @@ from .semantics import (
     indicator_attrs,
     plastic_crack_indicator,
 )
-from .semantics3d import derived_variables_3d
+from .results.semantics3d import derived_variables_3d
+from .runtime.errors import MasonryError, ModelError, PluginError, SolveError
+from .runtime.progress import ProgressCallback, no_progress
+from .runtime.resources import require_memory
 
 _VALID = "masonryfw_valid"  # encoding key: (kind, contents digest) of an input found valid
 
@@ -191,7 +191,7 @@ def solve_plan(model: xr.Dataset, plugin: str, options: Mapping[str, Any] | None
     """The solve of ``model`` by the solver called ``plugin``, ready to start: the model checked unless it already
     is (:func:`masonryfw.checked_model`; every problem raises one :class:`ModelError`), the solver looked up, the
     options resolved and checked against its declared rules, and its estimate made, once each; a run whose
-    estimated memory exceeds what is available is refused (:func:`masonryfw.resources.require_memory`).
+    estimated memory exceeds what is available is refused (:func:`masonryfw.runtime.resources.require_memory`).
     The command line prints the estimate, then runs the plan."""
     model = checked_model(model)
     item = lookup("solver", plugin)
@@ -208,7 +208,7 @@ def solve_plan(model: xr.Dataset, plugin: str, options: Mapping[str, Any] | None
 def estimate(model: xr.Dataset, plugin: str, options: Mapping[str, Any] | None = None) -> Estimate | None:
     """The time and peak memory the solver called ``plugin`` expects on ``model`` (None if it gives none).
 
-    Raises :class:`SolveError` when the memory would not fit (:func:`masonryfw.resources.require_memory`):
+    Raises :class:`SolveError` when the memory would not fit (:func:`masonryfw.runtime.resources.require_memory`):
     the check :func:`solve` makes before it starts.
     """
     return solve_plan(model, plugin, options).estimate
@@ -241,7 +241,7 @@ def solve(
     """Run the solver called ``plugin`` on ``model`` and return the result dataset: :func:`solve_plan`, run.
 
     The result holds the model's variables, the solver's primary variables, the comparable fields the core
-    derives from ``block_displacement`` (:mod:`masonryfw.semantics`) and the provenance attributes of
+    derives from ``block_displacement`` (:mod:`masonryfw.results.semantics`) and the provenance attributes of
     docs/format.md. A result may be given: its model is solved. ``wall_time_s`` leaves out the
     ``compile_time_s`` a solver reports. A ``KeyboardInterrupt`` the solver lets through propagates (nothing
     computed).
@@ -259,7 +259,7 @@ def compare(
 
     Returns a ``comparison`` dataset: the comparator's variables plus the
     attributes ``schemas/comparison-2.json`` requires. A result whose masonry did not stand under its own weight
-    is refused (:func:`masonryfw.damage.standing_text`): its cracks are no settlement's damage. ``input_a_sha256`` /
+    is refused (:func:`masonryfw.results.damage.standing_text`): its cracks are no settlement's damage. ``input_a_sha256`` /
     ``input_b_sha256`` are the files' hashes when the results were read from
     files, otherwise their content hashes.
     """

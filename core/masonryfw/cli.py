@@ -21,10 +21,10 @@ import numpy as np
 
 import masonryfw as mf
 import masonryfw.plugin_api as mfp
-from masonryfw import inputs, signals
 from masonryfw.command_kit import FIGURE, OPTIONS, PROGRESS, command_line
-from masonryfw.locks import release_all
-from masonryfw.registry import command_plugin, installed_plugins, installed_solvers, plugin_commands
+from masonryfw.contract.registry import command_plugin, installed_plugins, installed_solvers, plugin_commands
+from masonryfw.runtime import inputs, signals
+from masonryfw.runtime.locks import release_all
 
 LONG_RUN = 60.0  # seconds: the solve command prints the estimate of a run longer than this
 #: Seconds: a run estimated longer starts only with --force or its end set (--option settlement=): a volume loss typed

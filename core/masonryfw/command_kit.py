@@ -12,8 +12,8 @@ import sys
 
 import click
 
-from .errors import PluginError
-from .options import parse_option_pairs
+from .contract.options import parse_option_pairs
+from .runtime.errors import PluginError
 
 
 def command_line() -> str:

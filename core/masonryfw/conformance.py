@@ -20,12 +20,12 @@ import numpy as np
 import pytest
 
 from .api import estimate, solve
-from .checks import check
-from .errors import PluginError, SolveError
-from .model3d import twin
-from .registry import get_solver
-from .schema import load_schema
-from .summary import headline_text, key_numbers
+from .contract.registry import get_solver
+from .format.checks import check
+from .format.model3d import twin
+from .format.schema import load_schema
+from .results.summary import headline_text, key_numbers
+from .runtime.errors import PluginError, SolveError
 from .testing import permuted, scaled, small_settlement_wall
 
 if TYPE_CHECKING:  # annotations only
@@ -119,7 +119,7 @@ class SolverConformance:
 
     def test_the_dimensions_it_declares_are_the_ones_it_solves(self, solved):
         """2D, 3D or both (``Solver.spaces``): the conformance model stood one block thick in 3D
-        (:func:`masonryfw.model3d.twin`) is solved and checked when 3D is declared (or, for options the solver
+        (:func:`masonryfw.format.model3d.twin`) is solved and checked when 3D is declared (or, for options the solver
         does not support in 3D, refused with a SolveError that says 3D), refused before the run (a SolveError
         naming the solver) when it is not."""
         spaces = get_solver(self.solver).spaces

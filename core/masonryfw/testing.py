@@ -10,7 +10,7 @@ Small models from rectangles (and a semicircular arch, :func:`arch_model`)::
     )
 
 The conformance suite checks a solver against the contract every masonryfw
-solver keeps (docs/format.md, ``masonryfw.hookspecs``). In the plugin's tests::
+solver keeps (docs/format.md, ``masonryfw.contract.hookspecs``). In the plugin's tests::
 
     from masonryfw.testing import SolverConformance
 
@@ -35,11 +35,11 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from . import blocks
-from .kinds import build
-from .material import Material
-from .model import checked_model
-from .roles import ROLE, support_blocks
+from .builders import blocks
+from .builders.kinds import build
+from .format.model import checked_model
+from .format.roles import ROLE, fixed_blocks, support_blocks
+from .readers.material import Material
 
 if TYPE_CHECKING:  # annotations only
     import xarray as xr
@@ -80,7 +80,7 @@ def rectangles_model(
     motions = dict(motions or {})
     supports = []
     for b in np.flatnonzero(support_blocks(role)):
-        if role[b] == ROLE["fixed_support"]:
+        if fixed_blocks(role[b]):
             supports.append(blocks.Support(f"support block {b}"))
         else:
             motion, point = motions.get(int(b), ("translation", None))
@@ -139,7 +139,7 @@ def arch_model(thickness_ratio: float, voussoirs: int = 40, radius: float = 1.0,
 
 
 def corner_building(bond: str = "running", angle: float = 90.0) -> xr.Dataset:
-    """A small building in 3D (:mod:`masonryfw.building`): two walls toothed at a corner (``angle`` degrees between
+    """A small building in 3D (:mod:`masonryfw.builders.building`): two walls toothed at a corner (``angle`` degrees between
     them), 1.44 and 1.2 m long and 0.96 m high in 0.24 x 0.12 m units, a door in the first, over a trough whose
     axis runs at 30 degrees to x; one leaf (0.12 m) thick in running ``bond``, two leaves (0.24 m) in English or
     Flemish."""

@@ -88,9 +88,9 @@ def user_modules() -> dict[str, str]:
 
 def plugin_groups() -> list[tuple[str, str, list[str]]]:
     """``(module, its docstring's first sentence, names)`` of every module ``plugin_api`` takes names from."""
-    tree = ast.parse((ROOT / "core" / "masonryfw" / "plugin_api.py").read_text())
-    call = next(node.value for node in tree.body if isinstance(node, ast.Assign))
-    mapping = ast.literal_eval(call.keywords[0].value)
+    tree = ast.parse((ROOT / "core" / "masonryfw" / "plugin_api.pyi").read_text())
+    mapping = {node.module: [alias.name for alias in node.names] for node in tree.body
+               if isinstance(node, ast.ImportFrom)}
     out = []
     for module, names in mapping.items():
         doc = inspect.getdoc(importlib.import_module(f"masonryfw.{module}")) or ""

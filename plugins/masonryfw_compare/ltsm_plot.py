@@ -5,7 +5,7 @@ greenfield settlement, each wall coloured by its LTSM category); below, the clas
 1995; Boscardin & Cording 1989) for every part of the wall (a building's worst wall): the deflection ratio
 against the horizontal strain, the zones of the LTSM categories for that part's length over height and kind
 (sagging, hogging), and the part as a point at the assessed settlement. The numbers are
-:mod:`masonryfw.assessment`'s.
+:mod:`masonryfw.ground.assessment`'s.
 """
 from __future__ import annotations
 

@@ -1,7 +1,7 @@
 """The records this plugin registers: names, summaries and options only.
 
 Importing this module is cheap (no matplotlib, scipy or meshio): the work is
-imported on first use through :func:`masonryfw.lazy`.
+imported on first use through :func:`masonryfw.contract.lazy`.
 """
 from __future__ import annotations
 

@@ -1,7 +1,7 @@
 """Geometry the comparison and the pictures need, vectorised over all blocks/interfaces.
 
 What block results mean (relative motion, states, macro-blocks, polar moments)
-is the core's (:mod:`masonryfw.semantics`); here are only drawing and distance helpers.
+is the core's (:mod:`masonryfw.results.semantics`); here are only drawing and distance helpers.
 """
 from __future__ import annotations
 

@@ -4,7 +4,7 @@ Panel 5's 24.9 s on a cold cache, 2-core machine, 2026-11-27), on later runs it 
 :class:`Compilations` listens to numba's compile events (fired on a compilation, not on a load from the cache)
 for the length of a solve: it says when the first starts and about how long it takes (a progress message),
 measures their time (``compile_time_s``) and holds Ctrl-C and SIGTERM while they run
-(:func:`masonryfw.signals.held`), taking them at the next event: raised anywhere inside, a
+(:func:`masonryfw.plugin_api.signals_held`), taking them at the next event: raised anywhere inside, a
 ``KeyboardInterrupt`` lands in LLVM's callbacks into llvmlite, where it is dropped and loses the compiled code
 ("no compiled object yet"), or the run goes on as if nothing had happened. Panel 5's compilation fired 104
 events, at most 4.6 s apart: a Ctrl-C is answered within that.
@@ -17,7 +17,7 @@ from typing import Any
 
 from numba.core import event
 
-from masonryfw import signals
+import masonryfw.plugin_api as mfp
 
 #: Seconds to compile the kernels of a mode once (the rigid kernels: 19.3 s on the 2-core machine; the CST mode
 #: compiles its own kernels beside the rigid detection).
@@ -38,7 +38,7 @@ class Compilations(event.Listener):
 
     def on_start(self, event) -> None:
         if self.depth == 0:
-            self.hold = signals.held()
+            self.hold = mfp.signals_held()
             self.checkpoint = self.hold.__enter__()
             self.started = time.perf_counter()
         self.depth += 1  # before anything can raise: numba sends the end event of a start that raised

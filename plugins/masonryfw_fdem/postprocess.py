@@ -2,7 +2,7 @@
 
 The comparable fields (opening and slip at the model's interface ends with
 finite rotations, joint states, crack indicator, macro-blocks) are derived by the
-core (:mod:`masonryfw.semantics`), as for every solver: the same quantities the
+core (:mod:`masonryfw.results.semantics`), as for every solver: the same quantities the
 limit analysis reports, so the two compare directly.
 """
 from __future__ import annotations

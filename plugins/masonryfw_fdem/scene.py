@@ -66,7 +66,7 @@ def build_scene(model: xr.Dataset) -> Scene:
     role = model.block_role.values.astype(np.int64)
     n_block = role.size
     driven = mfp.support_blocks(role)
-    moving = role == ROLE["moving_support"]
+    moving = mfp.moving_blocks(role)
     offs = mfp.block_offsets(model.block_node_count.values)
     area = model.block_area.values
     thickness = model.block_thickness.values

@@ -261,14 +261,14 @@ def support_edges(domain: Domain, field: StaticField, model: xr.Dataset) -> tupl
     on = support_facets(field.points, ends, domain.mesh.supports / H, 1e-6 * domain.mesh_size / H)
     block = np.where(on >= 0, domain.mesh.support_block[np.maximum(on, 0)], -1)
     role = np.where(block >= 0, model.block_role.values[np.maximum(block, 0)], -1)
-    fixed, moving = role == ROLE["fixed_support"], role == ROLE["moving_support"]
+    fixed, moving = mfp.fixed_blocks(role), mfp.moving_blocks(role)
     return occ[fixed], occ[moving]
 
 
 def check_vertical_settlement(model: xr.Dataset) -> None:
     """The LP's objective is the vertical reaction: every moving support must translate straight down, all
     at one rate (a trough's segments at their own rates need the incremental solver)."""
-    moving = np.nonzero(model.block_role.values == ROLE["moving_support"])[0]
+    moving = np.nonzero(mfp.moving_blocks(model.block_role.values))[0]
     direction = model.settlement_direction.values[moving]
     bad = moving[~(np.isclose(direction[:, 0], 0) & np.isclose(direction[:, 2], 0) & (direction[:, 1] < 0))]
     if bad.size:

@@ -207,7 +207,7 @@ def _support_dofs(mesh: WallMesh, disc: Discretisation, model: xr.Dataset, lengt
     fixed, moving, direction, vertical = [], [], [], []
     for support in np.unique(block[block >= 0]):  # a handful of supports
         dofs = disc.facet_dofs(boundary[block == support])
-        is_fixed = model.block_role.values[support] == ROLE["fixed_support"]
+        is_fixed = mfp.fixed_blocks(model.block_role.values[support])
         vertical.append((not is_fixed, 2 * dofs + 1, np.full(dofs.size, support)))
         if is_fixed:
             fixed.append(np.concatenate([2 * dofs, 2 * dofs + 1]))

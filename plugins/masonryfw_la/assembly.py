@@ -106,7 +106,7 @@ class Wall:
 
     @property
     def moving(self) -> np.ndarray:
-        return self.role == ROLE["moving_support"]
+        return mfp.moving_blocks(self.role)
 
     @property
     def between_supports(self) -> np.ndarray:

@@ -2,7 +2,7 @@
 
 The comparable fields (opening and slip at the interface ends, joint states,
 crack indicator, macro-blocks) are derived from the mechanism by the core
-(:mod:`masonryfw.semantics`), as for every solver.
+(:mod:`masonryfw.results.semantics`), as for every solver.
 """
 from __future__ import annotations
 

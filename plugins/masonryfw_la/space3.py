@@ -110,7 +110,7 @@ def scales_of(blocks: Blocks3D) -> Scales3D:
 def column_map(blocks: Blocks3D, scales: Scales3D) -> tuple[sp.csr_matrix, int | None]:
     """The programme's columns to all block dofs: the free dofs, then one settlement parameter ``t`` moving every
     moving support by ``t * direction`` (as in 2D)."""
-    moving = blocks.role == mfp.ROLE["moving_support"]
+    moving = mfp.moving_blocks(blocks.role)
     free = np.flatnonzero((~blocks.fixed & ~moving[:, None] & ~mfp.support_blocks(blocks.role)[:, None]).ravel())
     rows, cols, vals = [free], [np.arange(free.size)], [np.ones(free.size)]
     settlement = None
@@ -235,7 +235,7 @@ def support_wrenches(blocks: Blocks3D, state: LimitState3D) -> np.ndarray:
 def settlement_reaction(wrench: np.ndarray, blocks: Blocks3D) -> float:
     """The settlement reaction at collapse [N]: the masonry's wrench on every moving support, weighted by the
     support's motion per unit t (as in 2D, :func:`masonryfw.plugin_api.settlement_reaction`)."""
-    moving = blocks.role == mfp.ROLE["moving_support"]
+    moving = mfp.moving_blocks(blocks.role)
     return float((wrench[moving] * blocks.direction[moving]).sum())
 
 
@@ -271,7 +271,7 @@ def solve(model: xr.Dataset, options: Mapping[str, Any], progress=mfp.no_progres
                                               mfp.variable_attrs(f"interface_point_force_{c}", "result3d"))
     wrench = support_wrenches(blocks, state)
     data["support_reaction"] = (axis, -wrench[:, :3] + 0.0, mfp.variable_attrs("support_reaction", "result3d"))
-    if (blocks.role == mfp.ROLE["moving_support"]).any():
+    if mfp.moving_blocks(blocks.role).any():
         data["moving_support_reaction"] = ((), settlement_reaction(wrench, blocks),
                                            mfp.variable_attrs("moving_support_reaction", "result3d"))
     progress(1.0, f"la: alpha = {state.alpha:.6g}")

@@ -131,7 +131,7 @@ class _SolverPlugin:
 @pytest.fixture
 def registered():
     """``register(solve, name, **record)``: a hand-made solver registered as a plugin for one test."""
-    from masonryfw import registry
+    from masonryfw.contract import registry
 
     registry.reset()
     manager = mfp.plugin_manager()

@@ -1,4 +1,4 @@
-"""A bond laid in an outline (masonryfw.bond, masonryfw.outlined): the gable house from an architect's drawing,
+"""A bond laid in an outline (masonryfw.builders.bond, masonryfw.builders.outlined): the gable house from an architect's drawing,
 the patterns against their definitions, openings on bed joints, heads over them, and the rectangle walls the
 builder lays, laid the same way by the engine.
 
@@ -17,9 +17,9 @@ from support import cli, refused
 
 import masonryfw as mf
 import masonryfw.plugin_api as mfp
-from masonryfw.bond import Bond, Head, lay
-from masonryfw.builder import masonry_blocks, parse_spec
-from masonryfw.kinds import load_spec
+from masonryfw.builders.bond import Bond, Head, lay
+from masonryfw.builders.builder import masonry_blocks, parse_spec
+from masonryfw.builders.kinds import load_spec
 
 DRAWINGS = Path(mf.bundled_spec_path("gable-house")).parent
 GABLE = """title = "gable"

@@ -12,7 +12,7 @@ import masonryfw
 import masonryfw.plugin_api
 from masonryfw import SpecError, build, load_spec
 from masonryfw.plugin_api import flags
-from masonryfw.spec import dump_toml
+from masonryfw.readers.spec import dump_toml
 
 GAMMA = 12000.0
 THICKNESS = 0.1
@@ -314,7 +314,7 @@ SECOND_OPENING = {"x": 0.3, "y": 0.1, "width": 0.1, "height": 0.05, "lintel_bear
         (_set("wall.thickness", 0.0), "wall.thickness"),
         (_set("wall.height", -0.3), "wall.height"),  # 0.23 (not whole courses) is laid, a cut course on top
         (_set("length_unit", "km"), "length_unit"),
-        (_set("bond", {"pattern": "herringbone"}), "bond.pattern"),  # flemish is laid (masonryfw.bond)
+        (_set("bond", {"pattern": "herringbone"}), "bond.pattern"),  # flemish is laid (masonryfw.builders.bond)
         (_set("material.friction", 0.4), "material.friction"),
         (_set("material.friction_angle", DELETE), "material.friction_angle"),
         (_set("material.poisson_ratio", 0.5), "material.poisson_ratio"),

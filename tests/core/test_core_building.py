@@ -249,8 +249,8 @@ def test_the_engineers_stages_of_a_straight_building_wall_are_the_planar_walls()
 def test_a_walls_cut_of_the_greenfield_surface_is_the_surface_along_it(degrees):
     """The trough along a wall at an angle to the axis (``wall_profile``): its settlement and its horizontal
     movement along the wall are the plan profile's at the wall's points, projected."""
-    from masonryfw.assessment import wall_profile
-    from masonryfw.profiles import Profile
+    from masonryfw.ground.assessment import wall_profile
+    from masonryfw.ground.profiles import Profile
 
     profile = Profile("tunnel", 0.1, 0.01, center=0.3, width=3.0, depth=6.0)
     angle = np.radians(degrees)
@@ -263,8 +263,8 @@ def test_a_walls_cut_of_the_greenfield_surface_is_the_surface_along_it(degrees):
 
 
 def test_a_wall_along_the_trough_axis_settles_uniformly_and_is_not_strained():
-    from masonryfw.assessment import wall_profile
-    from masonryfw.profiles import Profile
+    from masonryfw.ground.assessment import wall_profile
+    from masonryfw.ground.profiles import Profile
 
     assert wall_profile(Profile("tunnel", 0.1, 0.01, center=0.3, width=3.0, depth=6.0), -1.2, 0.0) is None
 
@@ -288,7 +288,7 @@ def test_a_building_spec_is_read_validated_and_built_again(tmp_path):
 
 def test_load_spec_reads_a_building_without_laying_it(monkeypatch):
     """Validating a building's spec reads and checks every key, but lays no block (it laid the whole building)."""
-    import masonryfw.building as building
+    import masonryfw.builders.building as building
 
     def refuse(*args, **kwargs):
         raise AssertionError("load_spec laid the building")

@@ -15,8 +15,8 @@ import numpy as np
 import pytest
 import xarray as xr
 
-from masonryfw.checks import Problem, check
-from masonryfw.interfaces import detect_interfaces
+from masonryfw.format.checks import Problem, check
+from masonryfw.geometry.interfaces import detect_interfaces
 
 BOXES = [(0.0, 1.0, 0.0, 0.5), (1.0, 2.0, 0.0, 0.5), (0.0, 0.9, -0.5, 0.0), (1.1, 2.0, -0.5, 0.0)]
 ROLES = [0, 0, 2, 3]  # unit unit fixed_support moving_support

@@ -19,8 +19,8 @@ from click.testing import CliRunner
 
 import masonryfw as mf
 import masonryfw.plugin_api as mfp
-from masonryfw import registry
 from masonryfw.cli import cli
+from masonryfw.contract import registry
 
 
 class ToolsPlugin:
@@ -223,7 +223,7 @@ def test_debug_shows_the_traceback_and_plain_mode_does_not(tmp_path):
                            capture_output=True, text=True, timeout=120)
     assert debug.returncode == 1
     assert "Traceback (most recent call last)" in debug.stderr
-    assert f"masonryfw.errors.ModelError: {missing}: no such file" in debug.stderr
+    assert f"masonryfw.runtime.errors.ModelError: {missing}: no such file" in debug.stderr
 
 
 class FakeTerminal(io.StringIO):

@@ -1,4 +1,4 @@
-"""The share of the machine's cores a run gets now (masonryfw.cores): the load is the tasks runnable now."""
+"""The share of the machine's cores a run gets now (masonryfw.runtime.cores): the load is the tasks runnable now."""
 from __future__ import annotations
 
 import subprocess
@@ -6,7 +6,7 @@ import sys
 
 import pytest
 
-from masonryfw import cores
+from masonryfw.runtime import cores
 
 
 @pytest.mark.skipif(cores.runnable_tasks() is None, reason="needs Linux's /proc/loadavg")

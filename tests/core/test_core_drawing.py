@@ -15,7 +15,7 @@ import pytest
 import masonryfw as mf
 import masonryfw.plugin_api as mfp
 from masonryfw.datasets.drawings import generate
-from masonryfw.drawing import read_drawing
+from masonryfw.readers.drawing import read_drawing
 
 ROLE = mfp.flags("block_role")
 KIND = mfp.flags("interface_kind")

@@ -7,7 +7,7 @@ import pytest
 
 import masonryfw as mf
 import masonryfw.plugin_api as mfp
-from masonryfw import polyhedra
+from masonryfw.geometry import polyhedra
 
 MATERIAL = {"unit_weight": 20000.0, "friction_angle": 30.0}
 UNIT = {"length": 0.24, "height": 0.12}
@@ -156,7 +156,7 @@ def test_the_bundled_3d_drawing_is_the_corner_its_generator_describes(tmp_path):
 
 
 def test_a_mesh_that_is_not_text_is_refused_naming_the_file_before_it_is_read_whole(tmp_path):
-    """The OBJ is read like every drawing (masonryfw.inputs.read_text): bounded, UTF-8, a regular file."""
+    """The OBJ is read like every drawing (masonryfw.runtime.inputs.read_text): bounded, UTF-8, a regular file."""
     path = tmp_path / "box.obj"
     path.write_bytes(b"o box\nv 0 0 0\n\xff\xfe not text\n")
     with pytest.raises(mf.MasonryError, match="box.obj.*UTF-8"):

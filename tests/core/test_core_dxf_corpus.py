@@ -12,7 +12,7 @@ from support import tilted_drawing_spec
 
 import masonryfw as mf
 from masonryfw.cli import cli
-from masonryfw.drawing import read_drawing
+from masonryfw.readers.drawing import read_drawing
 
 CORPUS = Path(__file__).parents[1] / "data" / "dxf"
 #: LACT3's solver test (LACT3_SolverTest.m): tilting-table collapse angle [deg] and friction angle, c = 0.

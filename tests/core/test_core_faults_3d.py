@@ -24,7 +24,7 @@ from click.testing import CliRunner
 from support import Command, peak_memory
 
 from masonryfw.cli import cli
-from masonryfw.spec import dump_toml, read_spec
+from masonryfw.readers.spec import dump_toml, read_spec
 
 ROOT = Path(__file__).resolve().parents[2]
 HOUSE = read_spec(ROOT / "datasets" / "house-tunnel.toml")[0]
@@ -175,7 +175,7 @@ def test_ctrl_c_while_a_building_is_laid_is_answered_at_once(tmp_path):
     spec = house(**{"building.unit": {"length": 0.44 / 6, "height": 0.22 / 6}, "settlement.segment": 0.44 / 6})
     (tmp_path / "h.toml").write_text(dump_toml(spec))
     running = Command(["build", "h.toml", "-o", "h.nc"], tmp_path, python=("-X", "importtime"))
-    running.wait_for(r"import time:.*\| +masonryfw\.building\n")
+    running.wait_for(r"import time:.*\| +masonryfw\.builders\.building\n")
     status, stderr, answered = running.signal(signal.SIGINT)
     assert status == 130 and stderr.rstrip().endswith("interrupted: nothing written"), stderr[-2000:]
     assert answered < 10, f"answered {answered:.1f} s after the signal"

@@ -174,7 +174,7 @@ def test_every_kind_of_spec_names_its_drawing_before_it_is_built(tmp_path, monke
     spec's DXF and a 3D drawing's OBJ were missed, and ``-o`` onto them was refused only after the build."""
     import dataclasses
 
-    import masonryfw.kinds as kinds
+    import masonryfw.builders.kinds as kinds
 
     _drawn_folder(tmp_path)  # nothing may be built to name the files
     monkeypatch.setattr(kinds, "SPEC_KINDS", tuple(dataclasses.replace(k, builds=None) for k in kinds.SPEC_KINDS))

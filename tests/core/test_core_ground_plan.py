@@ -10,9 +10,9 @@ from scipy.integrate import trapezoid
 
 import masonryfw as mf
 import masonryfw.plugin_api as mfp
-from masonryfw.assessment import ltsm_parts, wall_profile
-from masonryfw.ground_plan import GroundInPlan, SurfaceCut
-from masonryfw.profiles import Profile
+from masonryfw.ground.assessment import ltsm_parts, wall_profile
+from masonryfw.ground.ground_plan import GroundInPlan, SurfaceCut
+from masonryfw.ground.profiles import Profile
 from tests.core.test_core_building import house_spec
 
 WIDTH, DEPTH = 3.0, 6.0  # i and z0 [m]

@@ -21,7 +21,7 @@ import pytest
 import xarray as xr
 
 import masonryfw
-from masonryfw.errors import ModelError
+from masonryfw.runtime.errors import ModelError
 
 UNIT_WEIGHT = 20_000.0  # N m-3
 THICKNESS = 0.3  # m
@@ -189,7 +189,7 @@ def test_save_round_trips_through_plain_xarray(hand_file, tmp_path):
     again = masonryfw.open_model(saved)
     for name in model.variables:
         np.testing.assert_array_equal(again[name].values, model[name].values, err_msg=name)
-    assert masonryfw.io.content_sha256(again) == masonryfw.io.content_sha256(model)
+    assert masonryfw.format.io.content_sha256(again) == masonryfw.format.io.content_sha256(model)
 
 
 def test_saved_file_is_compressed_cf(hand_file, tmp_path):

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from masonryfw import ModelError
-from masonryfw.interfaces import detect_interfaces
+from masonryfw.geometry.interfaces import detect_interfaces
 
 
 def polygons_layout(polygons):

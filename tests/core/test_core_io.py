@@ -13,8 +13,8 @@ import xarray as xr
 import masonryfw
 import masonryfw.plugin_api
 import masonryfw.testing
-from masonryfw import io as mio
-from masonryfw.errors import ModelError
+from masonryfw.format import io as mio
+from masonryfw.runtime.errors import ModelError
 
 HISTORY_LINE = re.compile(r"\d{4}-\d\d-\d\dT\d\d:\d\d:\d\dZ masonryfw (\S+): (.*)")
 

@@ -15,27 +15,52 @@ CORE = Path(mf.__file__).resolve().parent
 ROOT = Path(__file__).resolve().parents[2]
 
 
+#: Core's rooms, lowest first: a module imports only from its own room and the rooms below it (the top modules,
+#: ``api``, ``cli``, ``plugin_api``, ``testing`` and their helpers, from any room).
+ROOMS = ("runtime", "geometry", "format", "readers", "ground", "builders", "results", "contract")
+
+
+def module_name(path: Path) -> str:
+    """``room.module`` of a core file, or ``module`` for a top one."""
+    return ".".join(path.relative_to(CORE).with_suffix("").parts)
+
+
+def imported_modules(node: ast.ImportFrom, here: str, modules: set[str]) -> set[str]:
+    """The core modules (``room.module``) a ``from ... import`` in the module ``here`` names."""
+    if node.level == 0:
+        if not (node.module or "").startswith("masonryfw"):
+            return set()
+        base = (node.module or "").removeprefix("masonryfw").lstrip(".")
+    else:
+        package = here.split(".")[:-1]
+        package = package[:len(package) - (node.level - 1)] if node.level > 1 else package
+        base = ".".join([*package, *filter(None, [node.module])])
+    candidates = {base} if base in modules else {f"{base}.{a.name}".lstrip(".") for a in node.names}
+    return candidates & modules or ({base.split(".")[0]} & {"datasets"})
+
+
 def core_imports() -> tuple[dict[str, set[str]], list[str]]:
-    """Per core module, the core modules it imports at module level; and every import of a core module made
-    inside a function (``module:line``)."""
-    modules = {p.stem for p in CORE.glob("*.py")} | {"datasets"}
+    """Per core module (``room.module``), the core modules it imports at module level; and every import of a core
+    module made inside a function (``module:line``)."""
+    paths = [p for p in sorted(CORE.rglob("*.py")) if p.name != "__init__.py"]
+    modules = {module_name(p) for p in paths} | {"datasets"}
     graph, deferred = {}, []
-    for path in sorted(CORE.glob("*.py")):
+    for path in paths:
+        here = module_name(path)
         tree = ast.parse(path.read_text())
+        functions = [f for f in ast.walk(tree) if isinstance(f, (ast.FunctionDef, ast.AsyncFunctionDef))]
         top = set()
         for node in ast.walk(tree):
-            if not isinstance(node, ast.ImportFrom) or node.level == 0 and not (node.module or "").startswith("masonryfw"):
+            if not isinstance(node, ast.ImportFrom):
                 continue
-            name = (node.module or "").removeprefix("masonryfw").lstrip(".").split(".")[0]
-            targets = {name} if name else {alias.name for alias in node.names}
-            targets &= modules
+            targets = imported_modules(node, here, modules)
             if not targets:
                 continue
-            if any(node in ast.walk(f) for f in ast.walk(tree) if isinstance(f, (ast.FunctionDef, ast.AsyncFunctionDef))):
-                deferred.append(f"{path.stem}:{node.lineno}")
+            if any(node in ast.walk(f) for f in functions):
+                deferred.append(f"{here}:{node.lineno}")
             else:
                 top |= targets
-        graph[path.stem] = top - {path.stem}
+        graph[here] = top - {here}
     return graph, deferred
 
 
@@ -66,14 +91,43 @@ KIT_IMPORT = "testing"
 
 def test_core_modules_import_each_other_at_the_top_and_without_a_cycle():
     graph, deferred = core_imports()
-    assert {"api", "registry", "provenance", "options", "sources", "model", "semantics"} <= set(graph)
+    assert {"api", "contract.registry", "contract.provenance", "contract.options", "builders.sources",
+            "format.model", "results.semantics"} <= set(graph)
     assert [where for where in deferred if where.split(":")[0] not in (ENTRY_IMPORT, KIT_IMPORT)] == []
-    assert len(deferred) == 2 and graph[ENTRY_IMPORT] == {"signals"}
+    assert len(deferred) == 2 and graph[ENTRY_IMPORT] == {"runtime.signals"}
     assert cycles(graph) == []
-    # the layers the architecture names: the lowest know nothing of the plugins or of the builder
-    for low in ("model", "semantics", "options", "geometry", "schema", "errors"):
-        assert not graph[low] & {"api", "registry", "provenance", "builder", "kinds", "sources", "cli"}, (low, graph[low])
-    assert "kinds" in graph["sources"] and "sources" not in graph["kinds"]
+
+
+def test_every_core_module_lives_in_a_room_and_imports_only_downward():
+    """Core is laid out in rooms along the data path (docs/architecture.md); a room imports from itself and the
+    rooms below it, never above, and the top modules only are above every room."""
+    graph, _ = core_imports()
+    upward = []
+    for module, targets in graph.items():
+        if "." not in module:  # a top module: api, cli, plugin_api, testing, ...
+            continue
+        room = module.split(".")[0]
+        assert room in ROOMS, f"{module}: not in one of core's rooms {ROOMS}"
+        for target in targets:
+            if target == "datasets":
+                continue
+            if "." not in target or ROOMS.index(target.split(".")[0]) > ROOMS.index(room):
+                upward.append(f"{module} -> {target}")
+    assert upward == []
+    rooms = {p.parent.name for p in CORE.rglob("*.py") if p.parent != CORE}
+    assert rooms == set(ROOMS)
+
+
+def test_every_room_says_what_it_holds_and_is_in_the_wheel():
+    """Each room's ``__init__`` says what it holds and how data passes through it; the package list of
+    pyproject.toml names every room (a wheel without one could not be imported)."""
+    import tomllib
+
+    packages = tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["setuptools"]["packages"]
+    for room in ROOMS:
+        assert f"masonryfw.{room}" in packages
+        doc = ast.get_docstring(ast.parse((CORE / room / "__init__.py").read_text())) or ""
+        assert len(doc.split()) >= 25, f"{room}/__init__.py: say what the room holds and how data passes through it"
 
 
 def _documented(text: str) -> set[str]:
@@ -104,10 +158,13 @@ def test_the_page_is_the_one_the_script_writes():
 
 
 def test_the_role_codes_are_read_in_one_place():
-    """Every mask of block roles is asked of ``masonryfw.roles`` (the codes were rewritten in 13 places)."""
-    readers = [f"{path.relative_to(ROOT)}" for path in [*CORE.glob("*.py"), *(ROOT / "plugins").rglob("*.py")]
+    """Every mask of block roles is asked of ``masonryfw.format.roles`` (the codes were rewritten in 13 places)."""
+    readers = [f"{path.relative_to(ROOT)}" for path in [*CORE.rglob("*.py"), *(ROOT / "plugins").rglob("*.py")]
                if path.name != "roles.py" and re.search(r'flags\("block_role"\)', path.read_text())]
     assert readers == []
+    compared = [f"{path.relative_to(ROOT)}" for path in [*CORE.rglob("*.py"), *(ROOT / "plugins").rglob("*.py")]
+                if path.name != "roles.py" and re.search(r'[=!]= *(mfp\.)?ROLE\["\w+_support|ROLE\["\w+_support"\] *[=!]=', path.read_text())]
+    assert compared == []  # a mask of a role is asked (moving_blocks, fixed_blocks), not compared to its code
 
 
 #: The benchmarks that time a plugin's own kernels apart (its assembly, its element forces, its return map): they
@@ -151,3 +208,18 @@ def test_the_models_of_the_docs_are_read_without_pytest(tmp_path):
     assert done.returncode == 0, done.stderr
     sizes, kit = done.stdout.splitlines()
     assert all(int(n) > 10 for n in sizes.split()) and kit == "the kit needs pytest"
+
+
+@pytest.mark.parametrize("namespace", [mf, mfp], ids=["masonryfw", "plugin_api"])
+def test_each_namespace_stub_names_where_each_name_lives(namespace):
+    """``__init__.pyi`` and ``plugin_api.pyi`` are the lazy tables themselves (``lazy_loader.attach_stub``): every
+    name they import is the object of the module they name, and ``__all__`` is their names, so a type checker, an
+    IDE or a reader following a name lands where it is defined."""
+    import importlib
+
+    stub = Path(namespace.__file__).with_suffix(".pyi")
+    imports = [node for node in ast.parse(stub.read_text()).body if isinstance(node, ast.ImportFrom)]
+    named = {alias.name: node.module for node in imports for alias in node.names}
+    assert set(named) == set(namespace.__all__)
+    for name, module in named.items():
+        assert getattr(namespace, name) is getattr(importlib.import_module(f"masonryfw.{module}"), name), name

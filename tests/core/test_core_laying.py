@@ -1,4 +1,4 @@
-"""Laying a bond into an architect's outline without overlaps (masonryfw.bond): every block a simple polygon, no two
+"""Laying a bond into an architect's outline without overlaps (masonryfw.builders.bond): every block a simple polygon, no two
 sharing area, the blocks covering the masonry (the outline less its openings) to 1e-9 of its area, whatever the
 unit, the bond and the shape of the openings.
 
@@ -6,7 +6,7 @@ The outlines are drawn here: a chapel front (a stepped gable, a round-arched doo
 and a gabled front with a rectangular window, a pointed (polygonal) window and an arched one. A unit and the
 voussoir beside it used to keep different vertices along their shared curve (each piece was cleaned on its own)
 and overlapped by 14 to 41 micrometres at two of three ordinary unit sizes; now the shared boundaries are laid
-once (``masonryfw.bond.shared_boundaries``).
+once (``masonryfw.builders.bond.shared_boundaries``).
 """
 from __future__ import annotations
 

@@ -67,7 +67,8 @@ def test_a_comparison_of_n_results_checks_each_once(monkeypatch):
 def test_a_solve_from_the_command_line_checks_looks_up_resolves_and_builds_once(monkeypatch, tmp_path):
     """The CLI checked a model twice (``open_model``, then ``checked_model``), looked the solver up and resolved its
     options twice (for the estimate, then the solve), and fdem built its scene twice: once each now."""
-    from masonryfw import cli, model
+    from masonryfw import cli
+    from masonryfw.format import model
     from masonryfw_fdem import estimate, solver
 
     calls: dict[str, int] = {}

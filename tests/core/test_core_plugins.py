@@ -24,9 +24,9 @@ from click.testing import CliRunner
 
 import masonryfw as mf
 import masonryfw.plugin_api as mfp
-from masonryfw import registry
 from masonryfw.cli import cli, main
-from masonryfw.errors import ModelError, PluginError, SolveError
+from masonryfw.contract import registry
+from masonryfw.runtime.errors import ModelError, PluginError, SolveError
 
 # ---------------------------------------------------------------- in-process plugins
 
@@ -187,7 +187,7 @@ def test_result_carries_the_model_and_the_provenance(manager, model):
     assert attrs["plugin_version"] == dist_version("masonryfw")
     assert json.loads(attrs["solver_options"]) == {}
     assert 0 <= attrs["wall_time_s"] < 10
-    assert attrs["model_sha256"] == mf.io.content_sha256(model)
+    assert attrs["model_sha256"] == mfp.content_sha256(model)
     assert "input_sha256" not in attrs and "source_file" not in attrs  # not read from a file
     assert "solve: solver statics (plugin example)" in attrs["history"]
 
@@ -224,7 +224,7 @@ def test_solving_a_result_solves_its_model_only(manager, model):
     again = mf.solve(first, "statics")
     assert "collapse_multiplier" not in again and "constant_backend" not in again.attrs
     assert (again.attrs["solver"], again.attrs["solver_options"]) == ("statics", "{}")
-    assert again.attrs["model_sha256"] == first.attrs["model_sha256"] == mf.io.content_sha256(model)
+    assert again.attrs["model_sha256"] == first.attrs["model_sha256"] == mfp.content_sha256(model)
 
 
 def test_result_of_a_model_file_records_the_file_hash(manager, model_file):
@@ -305,7 +305,7 @@ def test_compare_builds_a_comparison_dataset_with_the_schema_attributes(empty_ma
     assert comparison.attrs["masonryfw_format"] == "comparison"
     assert comparison.attrs["comparator"] == "alpha-gap"
     assert re.fullmatch(r"1\.2\+[0-9a-f]{12}", comparison.attrs["comparator_version"])
-    assert comparison.attrs["input_a_sha256"] == mf.io.content_sha256(a)
+    assert comparison.attrs["input_a_sha256"] == mfp.content_sha256(a)
     assert comparison.attrs["input_a_sha256"] != comparison.attrs["input_b_sha256"]
     assert mf.check(comparison) == []
 

@@ -1,4 +1,4 @@
-"""Memory limits and the refusal of a run that cannot fit (masonryfw.resources)."""
+"""Memory limits and the refusal of a run that cannot fit (masonryfw.runtime.resources)."""
 from __future__ import annotations
 
 import re
@@ -7,7 +7,7 @@ import pytest
 
 import masonryfw as mf
 import masonryfw.plugin_api as mfp
-from masonryfw.resources import available_memory, parse_bytes, require_memory
+from masonryfw.runtime.resources import available_memory, parse_bytes, require_memory
 
 
 @pytest.mark.parametrize("text, value", [("1024", 1024.0), ("4GiB", 4 * 2**30), ("512 MiB", 512 * 2**20),

@@ -7,6 +7,7 @@ from pathlib import Path
 import pytest
 
 import masonryfw as mf
+import masonryfw.format.schema
 import masonryfw.plugin_api as mfp
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -74,7 +75,7 @@ def test_documented_flags_match_the_schema():
 
 
 def test_global_attributes_are_required_by_every_kind():
-    for kind in mf.schema.KINDS:
+    for kind in masonryfw.format.schema.KINDS:
         attrs = mfp.load_schema(kind)["global_attributes"]
         assert attrs["Conventions"]["contains"] == "CF-1.11"
         assert attrs["masonryfw_format"]["value"] == kind

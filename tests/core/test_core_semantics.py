@@ -1,4 +1,4 @@
-"""The core's result semantics (masonryfw.semantics) against independent references."""
+"""The core's result semantics (masonryfw.results.semantics) against independent references."""
 from __future__ import annotations
 
 import numpy as np

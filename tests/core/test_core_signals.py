@@ -8,7 +8,7 @@ import signal
 import pytest
 
 import masonryfw.plugin_api as mfp
-from masonryfw import signals
+from masonryfw.runtime import signals
 
 
 @pytest.fixture

@@ -1,4 +1,4 @@
-"""``masonryfw.summary``: the rows and texts ``compare`` prints and reports show."""
+"""``masonryfw.results.summary``: the rows and texts ``compare`` prints and reports show."""
 from __future__ import annotations
 
 import csv

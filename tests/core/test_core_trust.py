@@ -13,7 +13,7 @@ from click.testing import CliRunner
 import masonryfw as mf
 import masonryfw.plugin_api as mfp
 from masonryfw.cli import cli
-from masonryfw.progress import StderrBar
+from masonryfw.runtime.progress import StderrBar
 
 WALL = """title = "plausibility"
 {unit_line}

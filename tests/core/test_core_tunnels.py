@@ -9,8 +9,8 @@ import pytest
 
 import masonryfw as mf
 import masonryfw.plugin_api as mfp
-from masonryfw.assessment import E_OVER_G, deep_beam_strains, ltsm_category, ltsm_parts
-from masonryfw.profiles import Profile
+from masonryfw.ground.assessment import E_OVER_G, deep_beam_strains, ltsm_category, ltsm_parts
+from masonryfw.ground.profiles import Profile
 
 
 def timoshenko_midspan_deflection(load: float, length: float, bending_stiffness: float, shear_stiffness: float,
@@ -197,8 +197,8 @@ def small_tunnel():
 
 def test_every_result_over_a_tunnel_carries_stages_1_and_2(small_tunnel):
     """fdem runs to S_max by default and derives step_ltsm_* at every record, linear in the settlement; la's key
-    numbers assess at S_max; both equal masonryfw.assessment at that settlement (one definition)."""
-    from masonryfw.assessment import assess
+    numbers assess at S_max; both equal masonryfw.ground.assessment at that settlement (one definition)."""
+    from masonryfw.ground.assessment import assess
 
     s_max = float(small_tunnel.settlement_target)
     fdem = mf.solve(small_tunnel, "fdem")

@@ -199,7 +199,7 @@ def test_a_buildings_ltsm_plot_colours_each_wall_by_its_category_and_charts_the_
 
 
 def test_a_drawn_3d_result_has_no_walls_for_the_ltsm_plot(corner, tmp_path):
-    from masonryfw import polyhedra
+    from masonryfw.geometry import polyhedra
     from masonryfw_compare.block_plots import drawable_kinds
     from tests.core.test_core_drawing3d import write_obj
 

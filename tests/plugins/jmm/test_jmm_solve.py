@@ -111,7 +111,7 @@ def test_apex_regularisation_changes_the_reaction_by_less_than_its_size(model):
 def test_cholesky_and_lu_take_the_same_newton_path(model, monkeypatch):
     # associated flow: CHOLMOD on the SPD tangent; the SuperLU fallback (no cvxopt) must give the same iterates
     cholesky = mf.solve(model, "jmm", FIXED)
-    monkeypatch.setattr("masonryfw.linalg.has_cholmod", lambda: False)
+    monkeypatch.setattr("masonryfw.runtime.linalg.has_cholmod", lambda: False)
     lu = mf.solve(model, "jmm", FIXED)
     np.testing.assert_array_equal(lu.step_newton_iterations.values, cholesky.step_newton_iterations.values)
     np.testing.assert_allclose(lu.step_reaction.values, cholesky.step_reaction.values, rtol=1e-9)

@@ -11,7 +11,7 @@ import pytest
 
 import masonryfw as mf
 import masonryfw.plugin_api as mfp
-from masonryfw.damage import first_exceeding
+from masonryfw.results.damage import first_exceeding
 from tests.support import cli
 
 TUNNEL_WALL = """
