@@ -26,7 +26,8 @@ from .format.roles import (
     support_blocks,
 )
 from .format.schema import FORMAT_VERSION, flags, load_schema, variable_attrs
-from .geometry.geometry import (
+from .geometry.graph import connected_components
+from .geometry.polygons import (
     DERIVED_GEOMETRY_VARIABLES,
     block_bounds,
     block_offsets,
@@ -39,7 +40,6 @@ from .geometry.geometry import (
     polygon_area_centroid,
     triangulated,
 )
-from .geometry.graph import connected_components
 from .geometry.polyhedra import (
     Contacts,
     Polyhedra,

@@ -223,3 +223,14 @@ def test_each_namespace_stub_names_where_each_name_lives(namespace):
     assert set(named) == set(namespace.__all__)
     for name, module in named.items():
         assert getattr(namespace, name) is getattr(importlib.import_module(f"masonryfw.{module}"), name), name
+
+
+def test_the_architecture_page_maps_the_house_as_it_is():
+    """docs/architecture.md's rooms table lists every core module in its room, and its name counts are the code's."""
+    page = (ROOT / "docs" / "architecture.md").read_text()
+    for room in ROOMS:
+        row = re.search(rf"^\| `{room}/` \|[^|]*\| (.*) \|$", page, re.M)
+        assert row, room
+        listed = set(re.findall(r"`(\w+)`", row.group(1)))
+        assert listed == {p.stem for p in (CORE / room).glob("*.py")} - {"__init__"}, room
+    assert f"({len(mf.__all__)} names)" in page and f"{len(mfp.__all__)} names" in page

@@ -34,8 +34,8 @@ import xarray as xr
 from ..format.dofs import block_loads, load_variables
 from ..format.roles import ROLE, support_blocks
 from ..format.schema import FORMAT_VERSION, flags, variable_attrs
-from ..geometry.geometry import polygon_area_centroid
 from ..geometry.interfaces import detect_interfaces
+from ..geometry.polygons import polygon_area_centroid
 from ..readers.material import Material
 from ..runtime.errors import SpecError
 

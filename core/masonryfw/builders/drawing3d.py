@@ -30,7 +30,7 @@ from shapely.geometry.polygon import orient
 
 from ..format.roles import ROLE
 from ..geometry import polyhedra
-from ..geometry.geometry import block_offsets
+from ..geometry.polygons import block_offsets
 from ..ground.ground_plan import SETTLEMENT_3D_KEYS, GroundInPlan, profile_in_plan
 from ..ground.profiles import with_profile
 from ..readers.drawing import DRAWING_UNITS

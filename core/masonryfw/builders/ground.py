@@ -15,7 +15,7 @@ import numpy as np
 
 from ..format.derived import derive_geometry
 from ..format.roles import ROLE, masonry_blocks, support_blocks
-from ..geometry.geometry import block_bounds
+from ..geometry.polygons import block_bounds
 from ..ground.profiles import Profile, node_motion, segment_count, with_profile
 from ..readers.material import Material
 from ..runtime.errors import SpecError

@@ -37,7 +37,7 @@ import numpy as np
 
 from ..format.model import checked_model
 from ..format.roles import ROLE
-from ..geometry.geometry import block_bounds, polygon_area_centroid
+from ..geometry.polygons import block_bounds, polygon_area_centroid
 from ..ground.profiles import SETTLEMENT_KEYS, profile_segments, read_profile, with_profile
 from ..readers.drawing import DRAWING_UNITS, Drawing, read_drawing
 from ..readers.material import Material

@@ -35,7 +35,7 @@ import numpy as np
 
 from ..format.model3d import space
 from ..format.roles import masonry_blocks
-from ..geometry.geometry import block_bounds
+from ..geometry.polygons import block_bounds
 from ..ground.profiles import model_profile
 from ..readers.spec import read_spec
 

@@ -25,7 +25,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..geometry.geometry import (
+from ..geometry.overlaps import overlapping_blocks, self_intersections
+from ..geometry.polygons import (
     block_bounds,
     block_offsets,
     carrying_edges,
@@ -36,7 +37,6 @@ from ..geometry.geometry import (
     polygon_area_centroid,
     vertex_turns,
 )
-from ..geometry.overlaps import overlapping_blocks, self_intersections
 from ..geometry.polyhedra import polygon_normals, volumes_centroids
 from .dofs import upgrade
 from .model3d import interface_points, polyhedra_of, space

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import xarray as xr
 
-from ..geometry.geometry import DERIVED_GEOMETRY_VARIABLES, derive_planar_geometry
+from ..geometry.polygons import DERIVED_GEOMETRY_VARIABLES, derive_planar_geometry
 from .model3d import DERIVED_3D_VARIABLES, derive_geometry_3d, space
 
 #: What :func:`derive_geometry` adds to a model of either dimension: dropped from a file, left out of hashes.

@@ -11,7 +11,7 @@ import numpy as np
 import xarray as xr
 
 from ..geometry import polyhedra
-from ..geometry.geometry import model_scale
+from ..geometry.polygons import model_scale
 from ..runtime.errors import ModelError
 from .dofs import block_loads
 from .roles import support_blocks

@@ -1,4 +1,4 @@
-"""Geometry on arrays only: 2D polygons (``geometry``: areas, centroids, offsets, interface frames),
+"""Geometry on arrays only: 2D polygons (``polygons``: areas, centroids, offsets, interface frames),
 overlaps of polygons, the interfaces between 2D blocks, polyhedra in 3D (volumes, faces, contacts), box broad
 phases and graphs of blocks (connected components).
 

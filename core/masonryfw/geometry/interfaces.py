@@ -32,7 +32,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..runtime.errors import ModelError
-from .geometry import model_scale, next_node, node_block
+from .polygons import model_scale, next_node, node_block
 
 
 def detect_interfaces(node_x, node_y, block_node_count, *, tol=None) -> dict:

@@ -8,7 +8,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .geometry import block_bounds, block_offsets, convex_pieces, next_node, point_segment_distance
+from .polygons import block_bounds, block_offsets, convex_pieces, next_node, point_segment_distance
 
 
 def segment_distance(p0x, p0y, p1x, p1y, q0x, q0y, q1x, q1y):
@@ -163,7 +163,7 @@ def overlapping_blocks(x, y, counts, blocks, tol):
     """``(p, q, depth)``: every pair of ``blocks`` (p < q) that interpenetrate by more than ``tol``, with the
     depth, ordered by p then q; bounding boxes on a grid (:func:`candidate_pairs`), then separating axes
     (:func:`penetration`). Non-convex blocks are tested through their convex pieces
-    (:func:`masonryfw.geometry.geometry.convex_pieces`); two blocks overlap by the deepest overlap of any two of their
+    (:func:`masonryfw.geometry.polygons.convex_pieces`); two blocks overlap by the deepest overlap of any two of their
     pieces."""
     none = np.zeros(0, np.int64), np.zeros(0, np.int64), np.zeros(0)
     if blocks.size < 2:

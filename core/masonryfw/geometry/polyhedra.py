@@ -18,7 +18,7 @@ from typing import NamedTuple
 import numpy as np
 
 from .boxes import box_pairs
-from .geometry import block_offsets, next_node
+from .polygons import block_offsets, next_node
 
 #: Two faces are parallel when their unit normals differ by less than this (rounded to it).
 NORMAL_TOLERANCE = 1e-7

@@ -39,7 +39,7 @@ import numpy as np
 from ..format.model3d import space
 from ..format.roles import masonry_blocks, support_blocks
 from ..format.schema import variable_attrs
-from ..geometry.geometry import block_bounds
+from ..geometry.polygons import block_bounds
 from .ground_plan import SurfaceCut, ground_in_plan
 from .profiles import Profile, model_profile
 

@@ -35,8 +35,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..geometry.geometry import block_offsets, polygon_area_centroid
 from ..geometry.graph import connected_components
+from ..geometry.polygons import block_offsets, polygon_area_centroid
 from ..runtime.errors import SpecError
 from ..runtime.inputs import DRAWING_BYTES_FACTOR, fits_in_memory, read_text, regular_file
 from ..runtime.resources import size_text

@@ -10,7 +10,7 @@ import numpy as np
 from ..format.model3d import space
 from ..format.roles import fixed_blocks, masonry_blocks, moving_blocks, support_blocks
 from ..format.schema import flags
-from ..geometry.geometry import block_bounds, node_block
+from ..geometry.polygons import block_bounds, node_block
 from ..ground.profiles import Profile, model_profile
 
 if TYPE_CHECKING:  # annotations only

@@ -42,8 +42,8 @@ import numpy as np
 from ..format.dofs import block_loads
 from ..format.roles import masonry_blocks, masonry_joints, moving_blocks, support_blocks
 from ..format.schema import flags, variable_attrs
-from ..geometry.geometry import block_offsets, model_scale, node_block
 from ..geometry.graph import connected_components
+from ..geometry.polygons import block_offsets, model_scale, node_block
 from ..runtime.errors import ModelError
 
 if TYPE_CHECKING:  # annotations only
