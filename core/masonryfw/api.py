@@ -19,10 +19,10 @@ from .contract.records import Comparator, Estimate, Plotter, Solver
 from .contract.registry import by_name, lookup
 from .format.checks import check
 from .format.dofs import block_motion
-from .format.io import CONVENTIONS, add_history, content_sha256
+from .format.io import add_history, content_sha256
 from .format.model import checked_model, contents_digest, made_once
 from .format.model3d import require_space, space
-from .format.schema import FORMAT_VERSION, variable_attrs
+from .format.schema import FORMAT_VERSION, format_header, variable_attrs
 from .results.damage import DERIVED_STEP_VARIABLES, damage_variables, refuse_not_standing
 from .results.semantics import (
     CRACK_THRESHOLD,
@@ -275,9 +275,7 @@ def compare(
     title_a, title_b = a.attrs.get("title", ""), b.attrs.get("title", "")
     comparison.attrs = {
         **getattr(produced, "attrs", {}),
-        "Conventions": CONVENTIONS,
-        "masonryfw_format": "comparison",
-        "masonryfw_format_version": FORMAT_VERSION,
+        **format_header("comparison"),
         "title": title_a if title_a == title_b else f"{title_a} vs {title_b}",
         "comparator": record.name,
         "comparator_version": record_version(item, record.compare),

@@ -25,7 +25,7 @@ from .format.roles import (
     moving_blocks,
     support_blocks,
 )
-from .format.schema import FORMAT_VERSION, flags, load_schema, variable_attrs
+from .format.schema import FORMAT_VERSION, flags, format_header, load_schema, variable_attrs
 from .geometry.graph import connected_components
 from .geometry.polygons import (
     DERIVED_GEOMETRY_VARIABLES,
@@ -171,6 +171,7 @@ __all__ = [
     "fits_in_memory",
     "flags",
     "force_text",
+    "format_header",
     "free_cores",
     "ground_in_plan",
     "has_cholmod",

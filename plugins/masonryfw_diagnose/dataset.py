@@ -105,7 +105,7 @@ def to_dataset(diagnosis: Diagnosis, source_wall: str = "") -> xr.Dataset:
     attrs = {
         **{k: v for k, v in model.attrs.items() if k in ("title", "source_spec", "source_drawing",
                                                           "source_drawing_sha256", "settlement_profile")},
-        "masonryfw_format": "diagnosis", "masonryfw_format_version": mfp.FORMAT_VERSION,
+        **mfp.format_header("diagnosis"),
         "solver": diagnosis.solver, "solver_version": mfp.solver_version(diagnosis.solver),
         "segment": diagnosis.segment, "tolerance": diagnosis.wall.tolerance, "unit_height": diagnosis.wall.unit_height,
         "plausible_margin": PLAUSIBLE_MARGIN, "explained_threshold": EXPLAINED, "verdict": diagnosis.verdict(),

@@ -232,13 +232,6 @@ def support_wrenches(blocks: Blocks3D, state: LimitState3D) -> np.ndarray:
     return wrench
 
 
-def settlement_reaction(wrench: np.ndarray, blocks: Blocks3D) -> float:
-    """The settlement reaction at collapse [N]: the masonry's wrench on every moving support, weighted by the
-    support's motion per unit t (as in 2D, :func:`masonryfw.plugin_api.settlement_reaction`)."""
-    moving = mfp.moving_blocks(blocks.role)
-    return float((wrench[moving] * blocks.direction[moving]).sum())
-
-
 def solve(model: xr.Dataset, options: Mapping[str, Any], progress=mfp.no_progress) -> xr.Dataset:
     """``la`` on a 3D model: the collapse multiplier, the mechanism and the forces at the interfaces' vertices."""
     if options["flow"] != "associative":
@@ -272,7 +265,7 @@ def solve(model: xr.Dataset, options: Mapping[str, Any], progress=mfp.no_progres
     wrench = support_wrenches(blocks, state)
     data["support_reaction"] = (axis, -wrench[:, :3] + 0.0, mfp.variable_attrs("support_reaction", "result3d"))
     if mfp.moving_blocks(blocks.role).any():
-        data["moving_support_reaction"] = ((), settlement_reaction(wrench, blocks),
+        data["moving_support_reaction"] = ((), float(mf.settlement_reaction(model, wrench)),
                                            mfp.variable_attrs("moving_support_reaction", "result3d"))
     progress(1.0, f"la: alpha = {state.alpha:.6g}")
     method = f"cone, {backend}" if sides == 0 else f"pyramid of {sides} sides, {backend}"

@@ -268,9 +268,7 @@ def combine(plan: SweepPlan, records: Sequence[dict], output_dir: Path, store_ro
         values = [r["scalars"].get(name, (missing, None))[0] for r in records]
         data[name] = (dims, grid(values, str if kind == "text" else float), dict(attrs))
     attrs = {
-        "Conventions": "CF-1.11",
-        "masonryfw_format": "sweep",
-        "masonryfw_format_version": mfp.FORMAT_VERSION,
+        **mfp.format_header("sweep"),
         "title": f"sweep of {plan.spec.get('title', '')}".strip(),
         "solver": plan.solver,
         "solver_version": plan.solver_version,

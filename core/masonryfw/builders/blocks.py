@@ -33,7 +33,7 @@ import xarray as xr
 
 from ..format.dofs import block_loads, load_variables
 from ..format.roles import ROLE, support_blocks
-from ..format.schema import FORMAT_VERSION, flags, variable_attrs
+from ..format.schema import flags, format_header, variable_attrs
 from ..geometry.interfaces import detect_interfaces
 from ..geometry.polygons import polygon_area_centroid
 from ..readers.material import Material
@@ -254,8 +254,7 @@ def model_from_blocks(
     return xr.Dataset(
         data_vars,
         coords={"dof": ("dof", list(DOF_NAMES), variable_attrs("dof"))},
-        attrs={"Conventions": "CF-1.11", "masonryfw_format": "model", "masonryfw_format_version": FORMAT_VERSION,
-               "title": "", **(attrs or {})},
+        attrs={**format_header("model"), "title": "", **(attrs or {})},
     )
 
 

@@ -31,9 +31,8 @@ from ..runtime.inputs import HDF5_SIGNATURE, file_kind, fits_in_memory, is_netcd
 from ..runtime.version import __version__
 from .derived import DERIVED_VARIABLES
 from .dofs import upgrade
-from .schema import load_schema, variable_attrs
+from .schema import CONVENTIONS, load_schema, variable_attrs
 
-CONVENTIONS = "CF-1.11"
 COMPRESSION = {"zlib": True, "complevel": 4, "shuffle": True}
 
 _NODE_AXES = {"node_x": "X", "node_y": "Y"}

@@ -15,7 +15,7 @@ from ..geometry.polygons import model_scale
 from ..runtime.errors import ModelError
 from .dofs import block_loads
 from .roles import support_blocks
-from .schema import FORMAT_VERSION, load_schema, variable_attrs
+from .schema import format_header, load_schema, variable_attrs
 
 #: Contacts are found to this share of the model's size (its bounding-box diagonal).
 CONTACT_TOLERANCE = 1e-6
@@ -93,8 +93,7 @@ def model_from_polyhedra(poly: polyhedra.Polyhedra, contacts: polyhedra.Contacts
     ds = xr.Dataset({name: (schema[name]["dims"], np.asarray(values), variable_attrs(name, "model3d"))
                      for name, values in variables.items()})
     ds = ds.assign_coords(dof=("dof", schema["dof"]["values"], variable_attrs("dof", "model3d")))
-    ds.attrs = {"Conventions": "CF-1.11", "masonryfw_format": "model", "masonryfw_format_version": FORMAT_VERSION,
-                "masonryfw_space": 3, **attrs}
+    ds.attrs = {**format_header("model"), "masonryfw_space": 3, **attrs}
     return ds
 
 

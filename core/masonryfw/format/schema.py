@@ -13,6 +13,15 @@ from ..runtime.errors import ModelError
 
 #: The data contract's version (docs/format.md).
 FORMAT_VERSION = 2
+#: The CF conventions every dataset follows (its ``Conventions`` attribute).
+CONVENTIONS = "CF-1.11"
+
+
+def format_header(kind: str) -> dict:
+    """The global attributes that say what a dataset is: ``Conventions``, ``masonryfw_format`` (``kind``: model,
+    result, comparison, sweep, diagnosis) and ``masonryfw_format_version``; every writer of a dataset starts
+    from these."""
+    return {"Conventions": CONVENTIONS, "masonryfw_format": kind, "masonryfw_format_version": FORMAT_VERSION}
 #: Versions this code reads: older ones are upgraded in memory on reading (:func:`masonryfw.format.dofs.upgrade`).
 READABLE_VERSIONS = (1, 2)
 KINDS = ("model", "result", "comparison", "sweep", "diagnosis")
