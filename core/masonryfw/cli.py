@@ -104,11 +104,11 @@ def cli(debug: bool) -> None:
 def build(spec: str, output: str | None) -> None:
     """Build a model from SPEC (a TOML file or a bundled case name)."""
     spec_path = mfp.source_path(spec)
-    inputs = mfp.input_files(spec)
+    read_files = mfp.input_files(spec)
     out = Path(output) if output else Path(f"{Path(spec).stem}.nc")
-    mfp.check_output_path(out, inputs)
+    mfp.check_output_path(out, read_files)
     model = mf.build(spec_path)
-    mf.save(model, out, command=command_line(), protect=inputs)
+    mf.save(model, out, command=command_line(), protect=read_files)
     click.echo(f"wrote {out}: {model.sizes['block']} blocks, {model.sizes.get('interface', 0)} interfaces")
     for note in filter(None, str(model.attrs.get("laying_notes", "")).splitlines()):
         click.echo(f"  laid: {note}")
@@ -208,9 +208,9 @@ def _solved(model: str, solver: str, output: str | None, options: dict[str, str]
             force: bool):
     """Solve and write the result (``solve`` and ``capacity``): the output path checked before the work, long
     runs announced, Ctrl-C keeping what an incremental solver computed (exit 130)."""
-    inputs = mfp.input_files(model)
-    out = Path(output) if output else Path(f"{Path(model).stem if inputs else model}.{solver}.nc")
-    mfp.check_output_path(out, inputs)
+    read_files = mfp.input_files(model)
+    out = Path(output) if output else Path(f"{Path(model).stem if read_files else model}.{solver}.nc")
+    mfp.check_output_path(out, read_files)
     plan = mf.solve_plan(mf.open_model(model), solver, options)  # checked, looked up, resolved, estimated: once
     expected = plan.estimate
     if expected is not None and not expected.seconds <= UNASKED_RUN and not force:
@@ -231,7 +231,7 @@ def _solved(model: str, solver: str, output: str | None, options: dict[str, str]
     finally:
         if bar is not None:
             bar.close()
-    mf.save(result, out, command=command_line(), protect=inputs)
+    mf.save(result, out, command=command_line(), protect=read_files)
     if int(result.attrs.get("interrupted", 0)):
         raise mf.Interrupted(f"interrupted at settlement {_last_settlement(result)}: partial result written to {out}")
     return result, out, plan
@@ -413,19 +413,19 @@ def plot(results: tuple[str, ...], kind: str | None, output: str, file_format: s
 
     Kinds that overlay (history) or set side by side (compare) take several results.
     """
-    inputs = mfp.input_files(*results)
+    read_files = mfp.input_files(*results)
     wanted = f".{file_format}" if file_format else Path(output).suffix.lower()
     if wanted != Path(output).suffix.lower():
         raise mf.MasonryError(f"{output}: --format {file_format} needs a file ending in {wanted}")
     if wanted == ".csv":
-        mfp.check_output_path(output, inputs, (".csv",))
+        mfp.check_output_path(output, read_files, (".csv",))
         header, rows = mf.plot_table([_open_input(r) for r in results], kind, options)
-        mfp.save_text(mfp.csv_text(header, rows), output, protect=inputs, suffixes=(".csv",))
+        mfp.save_text(mfp.csv_text(header, rows), output, protect=read_files, suffixes=(".csv",))
         click.echo(f"table: {output} ({len(rows)} rows)")
         return
-    mfp.check_output_path(output, inputs, mfp.FIGURE_FORMATS)
+    mfp.check_output_path(output, read_files, mfp.FIGURE_FORMATS)
     figure = mf.render([_open_input(r, validate=kind != "model") for r in results], kind, options, size=size)
-    mf.save_figure(figure, output, protect=inputs, dpi=dpi, cropped=size is None)
+    mf.save_figure(figure, output, protect=read_files, dpi=dpi, cropped=size is None)
     width, height = figure.get_size_inches()
     click.echo(f"plot: {output} ({width:.3g} x {height:.3g} in at {dpi} dpi)")
 

@@ -129,7 +129,7 @@ def solve_highs(cost, constraints, live, tolerance, method: str = "highs-ds") ->
 def solve_clarabel(cost, constraints, live, tolerance, second_order: int = 0) -> LPSolution:
     """Clarabel: ``A x + s = b``, ``s`` in (zero cone: ``a.x = 1``) x (non-negative cone: ``G x >= 0``); with
     ``second_order`` = k the rows of ``G x`` are second-order cones of k rows each instead (la in 3D's Coulomb
-    cone, :mod:`.space3`), and ``y`` their multipliers, in the same cones."""
+    cone, :mod:`.limit3d`), and ``y`` their multipliers, in the same cones."""
     import clarabel
 
     n_row, n_col = constraints.shape

@@ -23,9 +23,9 @@ from .options import DEFAULT_BACKEND
 def solve(model: xr.Dataset, options: Mapping[str, Any], progress=mfp.no_progress) -> xr.Dataset:
     """Collapse multiplier, mechanism and contact forces of ``model`` (checked, options resolved by the core)."""
     if mfp.space(model) == 3:
-        from . import space3
+        from . import limit3d
 
-        return space3.solve(model, options, progress)
+        return limit3d.solve(model, options, progress)
     backend = options["solver"] or DEFAULT_BACKEND
     clock = time.perf_counter()
     progress(0.0, "la: assembling the kinematic programme")

@@ -18,6 +18,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+import masonryfw.plugin_api as mfp
+
 
 @dataclass(frozen=True)
 class Polygons:
@@ -36,8 +38,7 @@ class Polygons:
         return cls(x, y, counts, offsets, np.repeat(np.arange(counts.size), counts))
 
     def next_node(self) -> np.ndarray:
-        local = np.arange(self.x.size) - self.offsets[self.owner]
-        return self.offsets[self.owner] + (local + 1) % self.counts[self.owner]
+        return mfp.next_node(self.counts)
 
 
 @dataclass(frozen=True)
