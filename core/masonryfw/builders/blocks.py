@@ -62,7 +62,8 @@ class GroundEdge:
 @dataclass(frozen=True)
 class Support:
     """How one support block moves: ``kind`` fixed or moving; ``motion`` translation, rotation (about
-    ``pivot``) or ground (its top edge follows ``ground``).
+    ``pivot``) or ground (its top edge follows ``ground``); ``extent`` ``(start, end)`` [m] along the base for a
+    support laid under a range of it (a spec's ``[supports.*]``, a profile's segment), else None.
 
     A translating or rotating support moves ``rate`` times as fast as the settlement parameter.
     """
@@ -74,6 +75,7 @@ class Support:
     rate: float = 1.0
     ground: GroundEdge | None = None
     direction: tuple[float, float] = (0.0, -1.0)  # of a translation, a unit vector
+    extent: tuple[float, float] | None = None
 
 
 def rotation_direction(centre, pivot) -> np.ndarray:

@@ -3,34 +3,18 @@ base, or the segments of a ``[settlement]`` profile under its bottom course (:mo
 a rectangle one course high under the base (:func:`support_blocks`)."""
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import replace
 
 import numpy as np
 
 from ..ground.profiles import Profile, profile_segments
 from ..readers.spec import MOTION_KEYS, SpecTable, check_pivot, read_motion
 from ..runtime.errors import SpecError
-from . import blocks
-from .blocks import GroundEdge
+from .blocks import GroundEdge, Support
 
 #: Position tolerance, relative to the wall size.
 POSITION_TOLERANCE = 1.0e-9
 _SUPPORT_KEYS = ("kind", "start", "end", *MOTION_KEYS)
-
-
-@dataclass(frozen=True)
-class Support:
-    """A support range along the base, in SI."""
-
-    name: str
-    kind: str
-    start: float
-    end: float
-    motion: str
-    pivot: tuple[float, float] | None
-    rate: float = 1.0
-    ground: blocks.GroundEdge | None = None
-    direction: tuple[float, float] = (0.0, -1.0)
 
 
 def read_supports(top: SpecTable, x0: float, x1: float) -> tuple[Support, ...]:
@@ -55,10 +39,10 @@ def read_supports(top: SpecTable, x0: float, x1: float) -> tuple[Support, ...]:
             raise SpecError(f"spec key {entry.key('end')!r} = {entry.raw('end')!r}: must exceed start")
         motion, pivot, rate, direction = read_motion(entry, kind)
         check_pivot(entry, pivot, 0.5 * (start + end), tol)
-        supports.append(Support(name, kind, max(start, x0), min(end, x1), motion, pivot, rate, direction=direction))
-    ordered = sorted(supports, key=lambda s: s.start)
+        supports.append(Support(name, kind, motion, pivot, rate, direction=direction, extent=(max(start, x0), min(end, x1))))
+    ordered = sorted(supports, key=lambda s: s.extent[0])
     for left, right in zip(ordered, ordered[1:]):
-        if right.start < left.end - tol:
+        if right.extent[0] < left.extent[1] - tol:
             raise SpecError(f"spec keys 'supports.{left.name}' and 'supports.{right.name}': the ranges overlap")
     return tuple(supports)
 
@@ -69,9 +53,9 @@ def profile_supports(profile: Profile, x0: float, x1: float, base: np.ndarray, y
     rests on the ``base`` intervals ``(n, 2)`` at height ``y0`` (a continuous ground: :mod:`masonryfw.ground.profiles`)."""
     segments = profile_segments(profile, x0, x1, base)
     return tuple(
-        Support(f"segment {k} [{s.start:.6g}, {s.end:.6g}] m", "moving", s.start, s.end, "ground", None,
-                ground=GroundEdge((s.start, s.end), y0, s.down, s.horizontal))
-        if s.moving else Support(f"segment {k} [{s.start:.6g}, {s.end:.6g}] m", "fixed", s.start, s.end, "none", None)
+        Support(f"segment {k} [{s.start:.6g}, {s.end:.6g}] m", "moving", "ground",
+                ground=GroundEdge((s.start, s.end), y0, s.down, s.horizontal), extent=(s.start, s.end))
+        if s.moving else Support(f"segment {k} [{s.start:.6g}, {s.end:.6g}] m", extent=(s.start, s.end))
         for k, s in enumerate(segments)
     )
 
@@ -84,8 +68,7 @@ def support_label(name: str) -> str:
 def support_blocks(supports: tuple[Support, ...], y0: float, height: float):
     """``(x0, x1, y0, y1)`` rectangles of the supports under a base at ``y0``, ``height`` deep, and their
     descriptions for :func:`masonryfw.builders.blocks.model_from_blocks`."""
-    x0 = np.array([s.start for s in supports], dtype=float)
-    x1 = np.array([s.end for s in supports], dtype=float)
-    described = [blocks.Support(support_label(s.name), s.kind, s.motion, s.pivot, s.rate, s.ground, s.direction)
-                 for s in supports]
+    x0 = np.array([s.extent[0] for s in supports], dtype=float)
+    x1 = np.array([s.extent[1] for s in supports], dtype=float)
+    described = [replace(s, name=support_label(s.name)) for s in supports]
     return x0, x1, np.full(x0.size, y0 - height), np.full(x0.size, y0), described
