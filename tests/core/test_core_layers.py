@@ -20,6 +20,16 @@ ROOT = Path(__file__).resolve().parents[2]
 ROOMS = ("runtime", "geometry", "format", "readers", "ground", "builders", "results", "contract")
 
 
+#: What an installed ``masonryfw`` holds beside core's code: the bundled cases and the schemas (data packages).
+DATA_PACKAGES = ("datasets", "schemas")
+
+
+def core_files() -> list[Path]:
+    """Core's ``.py`` files (not its ``__init__``s), in the source tree or installed, without the data packages."""
+    return [p for p in sorted(CORE.rglob("*.py")) if p.name != "__init__.py"
+            and p.relative_to(CORE).parts[0] not in DATA_PACKAGES]
+
+
 def module_name(path: Path) -> str:
     """``room.module`` of a core file, or ``module`` for a top one."""
     return ".".join(path.relative_to(CORE).with_suffix("").parts)
@@ -42,7 +52,7 @@ def imported_modules(node: ast.ImportFrom, here: str, modules: set[str]) -> set[
 def core_imports() -> tuple[dict[str, set[str]], list[str]]:
     """Per core module (``room.module``), the core modules it imports at module level; and every import of a core
     module made inside a function (``module:line``)."""
-    paths = [p for p in sorted(CORE.rglob("*.py")) if p.name != "__init__.py"]
+    paths = core_files()
     modules = {module_name(p) for p in paths} | {"datasets"}
     graph, deferred = {}, []
     for path in paths:
@@ -114,7 +124,7 @@ def test_every_core_module_lives_in_a_room_and_imports_only_downward():
             if "." not in target or ROOMS.index(target.split(".")[0]) > ROOMS.index(room):
                 upward.append(f"{module} -> {target}")
     assert upward == []
-    rooms = {p.parent.name for p in CORE.rglob("*.py") if p.parent != CORE}
+    rooms = {p.parent.name for p in core_files() if p.parent != CORE}
     assert rooms == set(ROOMS)
 
 
