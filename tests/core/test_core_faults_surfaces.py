@@ -491,3 +491,18 @@ def test_ctrl_c_is_answered_within_seconds_however_long_a_record_of_the_run_is(t
         running.stop()
     assert status == 130 and "Traceback" not in stderr and "nothing written" in stderr, stderr[-2000:]
     assert answered < 60, f"answered {answered:.1f} s after the signal"
+
+
+@pytest.mark.parametrize("geometry", ["mesh = 5", 'dxf = 5\noutline_layer = "o"', "polygons = [1]"],
+                         ids=["OBJ", "outline DXF", "drawn polygons"])
+def test_a_drawing_key_that_is_no_path_is_named_by_every_walk_of_the_kinds(tmp_path, geometry):
+    """The kinds' table reads a spec's drawing key before any build: a number there is refused with a message, never
+    a traceback (``-o`` of a command finds the files a spec reads; a 3D drawing's ``mesh = 5`` raised TypeError)."""
+    (tmp_path / "w.toml").write_text(f'title = "w"\n[geometry]\n{geometry}\n')
+    assert mfp.input_files(tmp_path / "w.toml") == [tmp_path / "w.toml"]
+    with pytest.raises(mf.SpecError):
+        mf.build(tmp_path / "w.toml")
+    if geometry.startswith("mesh"):
+        with pytest.raises(mf.SpecError, match="'geometry.mesh' = 5: must be the path of an OBJ file"):
+            mf.load_spec(tmp_path / "w.toml")
+    refused(cli(["build", "w.toml", "-o", "w.nc"], tmp_path), "spec")

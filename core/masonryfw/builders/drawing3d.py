@@ -53,8 +53,12 @@ def is_drawn_3d(spec: dict) -> bool:
 
 
 def mesh_path(spec: dict, base_dir: Path | None) -> Path:
-    """The mesh's path: as written if absolute, else relative to ``base_dir`` (the spec file's folder)."""
-    return spec_relative(spec["geometry"]["mesh"], base_dir)
+    """The mesh's path: as written if absolute, else relative to ``base_dir`` (the spec file's folder); a
+    :class:`SpecError` when ``geometry.mesh`` is not a path."""
+    written = spec["geometry"]["mesh"]
+    if not isinstance(written, str):
+        raise SpecError(f"spec key 'geometry.mesh' = {written!r}: must be the path of an OBJ file")
+    return spec_relative(written, base_dir)
 
 
 def build_drawn_3d(spec: dict, text: str, base_dir: Path | None) -> xr.Dataset:
@@ -63,8 +67,6 @@ def build_drawn_3d(spec: dict, text: str, base_dir: Path | None) -> xr.Dataset:
     top = open_spec(spec, TOP_KEYS, three_d="a mesh")
     geometry = top.sub("geometry", GEOMETRY_KEYS)
     unit = DRAWING_UNITS[geometry.choice("drawing_unit", tuple(DRAWING_UNITS), "m")]
-    if not isinstance(geometry.raw("mesh"), str):
-        raise SpecError(f"spec key 'geometry.mesh' = {geometry.raw('mesh')!r}: must be the path of an OBJ file")
     path = mesh_path(spec, base_dir)
     try:
         regular_file(path, "3D drawing (an OBJ mesh)", f"spec key 'geometry.mesh' = {geometry.raw('mesh')!r}")
