@@ -53,8 +53,7 @@ class Scene:
     live: np.ndarray  # (block, 3) live load on free blocks
     unit_height: float  # median height of the masonry blocks
     support_length: float  # wall-on-support contact length
-    pair_keys: np.ndarray  # sorted a * n_block + b (a < b) of the model interfaces
-    pair_interface: np.ndarray  # interface index of every key
+    joints: mfp.PairIndex  # the model's interfaces, found by their two blocks
     friction: np.ndarray
     cohesion_per_length: np.ndarray  # c * thickness, non-dimensional
     tension_per_length: np.ndarray  # ft * thickness, non-dimensional
@@ -113,9 +112,6 @@ def build_scene(model: xr.Dataset) -> Scene:
     if not support_length > 0:
         support_length = float(np.ptp(model.node_x.values)) / length
 
-    a, b = sides.min(axis=1), sides.max(axis=1)
-    keys = a * n_block + b
-    order = np.argsort(keys, kind="stable")
     t_pair = np.minimum(thickness[sides[:, 0]], thickness[sides[:, 1]])
     per_length = t_pair * length / total
     friction = model.interface_friction.values.astype(float)
@@ -138,8 +134,7 @@ def build_scene(model: xr.Dataset) -> Scene:
         live=live,
         unit_height=unit_height,
         support_length=support_length,
-        pair_keys=keys[order],
-        pair_interface=order,
+        joints=mfp.pair_index(sides, n_block),
         friction=friction,
         cohesion_per_length=model.interface_cohesion.values * per_length,
         tension_per_length=model.interface_tensile_strength.values * per_length,
@@ -155,14 +150,8 @@ def face_properties(scene: Scene, faces: np.ndarray) -> tuple[np.ndarray, np.nda
     interface's properties; blocks that only meet during the motion get the
     model's median friction and no cohesion.
     """
-    n_block = scene.driven.size
-    a, b = faces[:, 0], faces[:, 2]
-    keys = np.minimum(a, b) * n_block + np.maximum(a, b)
-    where = np.searchsorted(scene.pair_keys, keys)
-    where = np.minimum(where, max(scene.pair_keys.size - 1, 0))
-    found = scene.pair_keys.size > 0
-    hit = (scene.pair_keys[where] == keys) if found else np.zeros(keys.size, bool)
-    interface = np.where(hit, scene.pair_interface[where] if found else -1, -1)
+    interface = mfp.find_pairs(scene.joints, faces[:, [0, 2]])
+    hit = interface >= 0
     props = np.zeros((faces.shape[0], 4))
     props[:, 0] = np.where(hit, scene.friction[interface], scene.default_friction)
     props[:, 1] = np.where(hit, scene.cohesion_per_length[interface], 0.0)

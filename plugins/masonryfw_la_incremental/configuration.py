@@ -42,8 +42,7 @@ class Reference:
     radius: np.ndarray  # (block,) largest distance of a vertex from the centroid [m]
     unit_height: float  # median height of the masonry units [m]: the length steps are measured in
     model: xr.Dataset  # where the joints' relative motion is measured (``mfp.relative_motion``)
-    pair_keys: np.ndarray  # sorted a * n + b (a < b) of the model's interfaces
-    pair_order: np.ndarray  # the model's interface of each sorted key
+    joints: mfp.PairIndex  # the model's interfaces, found by their two blocks
     block_friction: np.ndarray  # the smallest friction of a block's joints
     gap: float  # a vertex this far outside a face still touches it [m]
     cornered: np.ndarray  # sorted pair keys of blocks that meet corner to corner in the model
@@ -68,9 +67,6 @@ def reference(model: xr.Dataset, gap_share: float) -> Reference:
     masonry = mfp.masonry_blocks(wall.role)
     _, _, ymin, ymax = mfp.block_bounds(x, y, counts)
     unit_height = float(np.median((ymax - ymin)[masonry]))
-    sides = np.sort(wall.sides, axis=1)
-    keys = sides[:, 0] * counts.size + sides[:, 1]
-    order = np.argsort(keys, kind="stable")
     block_friction = np.full(counts.size, np.inf)
     for side in (0, 1):
         np.minimum.at(block_friction, wall.sides[:, side], wall.friction)
@@ -80,18 +76,14 @@ def reference(model: xr.Dataset, gap_share: float) -> Reference:
     px, py, piece_counts, piece_block = mfp.convex_pieces(x, y, counts)
     at_rest = find_contacts(Polygons.of(px, py, piece_counts), ground, gap, gap, group=piece_block)
     points = at_rest.length <= 2 * gap  # in the model's configuration every contact is a face but a corner on a corner
-    cornered = np.unique(at_rest.sides[points].min(axis=1) * counts.size + at_rest.sides[points].max(axis=1))
+    cornered = np.unique(mfp.pair_key(at_rest.sides[points], counts.size))
     return Reference(wall, wall_scales(model, wall), px, py, piece_counts, np.repeat(piece_block, piece_counts),
-                     piece_block, ground, radius, unit_height, model, keys[order], order, block_friction, gap, cornered)
+                     piece_block, ground, radius, unit_height, model, mfp.pair_index(wall.sides, counts.size), block_friction, gap, cornered)
 
 
 def model_joint(ref: Reference, sides: np.ndarray) -> np.ndarray:
     """The model's interface between each contact's two blocks, -1 where they had none."""
-    if ref.pair_keys.size == 0:
-        return np.full(sides.shape[0], -1)
-    keys = sides.min(axis=1) * ref.n_block + sides.max(axis=1)
-    at = np.clip(np.searchsorted(ref.pair_keys, keys), 0, ref.pair_keys.size - 1)
-    return np.where(ref.pair_keys[at] == keys, ref.pair_order[at], -1)
+    return mfp.find_pairs(ref.joints, sides)
 
 
 def intact_joints(ref: Reference, pose: np.ndarray, intact: np.ndarray) -> np.ndarray:

@@ -55,23 +55,13 @@ class Contacts:
 
 
 def candidate_pairs(polygons: Polygons, pad: float, skip: np.ndarray, group: np.ndarray) -> np.ndarray:
-    """``(pair, 2)`` polygons ``a < b`` whose boxes, grown by ``pad``, overlap; none of one ``group`` (the pieces of
-    one block) and none where ``skip`` holds for both groups."""
-    n = polygons.counts.size
-    start = polygons.offsets[:-1]
-    xmin, xmax = np.minimum.reduceat(polygons.x, start), np.maximum.reduceat(polygons.x, start)
-    ymin, ymax = np.minimum.reduceat(polygons.y, start), np.maximum.reduceat(polygons.y, start)
-    order = np.argsort(xmin, kind="stable")
-    sorted_min = xmin[order]
-    stop = np.searchsorted(sorted_min, xmax[order] + pad, side="right")
-    count = np.maximum(stop - np.arange(n) - 1, 0)
-    first = np.repeat(np.arange(n), count)
-    second = np.arange(count.sum()) - np.repeat(np.cumsum(count) - count, count) + first + 1
-    a, b = order[first], order[second]
-    near = (ymin[a] <= ymax[b] + pad) & (ymin[b] <= ymax[a] + pad) & ~(skip[group[a]] & skip[group[b]])
-    near &= group[a] != group[b]
-    pairs = np.sort(np.c_[a[near], b[near]], axis=1)
-    return pairs
+    """``(pair, 2)`` polygons ``a < b`` whose boxes, grown by ``pad``, overlap (core's broad phase,
+    ``mfp.box_pairs``); none of one ``group`` (the pieces of one block) and none where ``skip`` holds for both
+    groups."""
+    xmin, xmax, ymin, ymax = mfp.block_bounds(polygons.x, polygons.y, polygons.counts)
+    a, b = mfp.box_pairs(np.c_[xmin, ymin], np.c_[xmax, ymax], pad)
+    near = (group[a] != group[b]) & ~(skip[group[a]] & skip[group[b]])
+    return np.c_[a[near], b[near]]
 
 
 def separations(polygons: Polygons, pairs: np.ndarray):

@@ -149,20 +149,34 @@ def live_direction(support: Support) -> tuple[float, float]:
     return support.direction if support.motion == "translation" else (0.0, -1.0)
 
 
-def support_reactions(supports, contact: np.ndarray, weight_total: float, loading: str) -> np.ndarray:
-    """Dead-load reaction ``R = W L_m / L_total`` of every support (0 for fixed ones and under tilt)."""
+def carried_weight(weight_total: float, contact: np.ndarray, moving: np.ndarray) -> np.ndarray:
+    """The paper's support loads: the masonry's weight ``W`` spread uniformly over its contact with all the
+    supports (lengths in 2D, areas in 3D), so a moving support of contact ``L_m`` carries ``W L_m / L_total``
+    (up as dead load, the same along its motion as live load); fixed supports carry none (0)."""
     total = contact.sum()
     if total <= 0:
         raise SpecError("supports: no masonry rests on any support")
-    reaction = np.zeros(len(supports))
-    if loading != "settlement":
-        return reaction
-    for i, support in enumerate(supports):
-        if support.kind == "moving":
-            if contact[i] <= 0:
-                raise SpecError(f"{support.name}: no masonry rests on this moving support")
-            reaction[i] = weight_total * contact[i] / total
-    return reaction
+    return np.where(moving, weight_total * contact / total, 0.0)
+
+
+def support_reactions(supports, contact: np.ndarray, weight_total: float, loading: str) -> np.ndarray:
+    """Dead-load reaction ``R = W L_m / L_total`` of every support (:func:`carried_weight`; none under tilt); a
+    moving support on which no masonry rests is refused."""
+    moving = np.array([loading == "settlement" and s.kind == "moving" for s in supports], dtype=bool)
+    for support, length, carries in zip(supports, contact, moving):
+        if carries and length <= 0:
+            raise SpecError(f"{support.name}: no masonry rests on this moving support")
+    return carried_weight(weight_total, contact, moving)
+
+
+def support_loads(supports, reaction: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``(support, 3)`` dead and live loads of the support blocks that carry ``reaction``: up, and along each
+    one's :func:`live_direction`."""
+    dead = np.zeros((len(supports), 3))
+    live = np.zeros((len(supports), 3))
+    dead[:, 1] = reaction
+    live[:, :2] = reaction[:, None] * np.array([live_direction(s) for s in supports]).reshape(-1, 2)
+    return dead, live
 
 
 def model_from_blocks(
@@ -218,8 +232,7 @@ def model_from_blocks(
     dead = np.zeros((n_block, 3))
     live = np.zeros((n_block, 3))
     dead[:, 1] = -weight
-    dead[supported, 1] = reaction
-    live[supported, :2] = reaction[:, None] * np.array([live_direction(s) for s in supports]).reshape(-1, 2)
+    dead[supported], live[supported] = support_loads(supports, reaction)
     if loading == "tilt":
         live[~is_support, 0] = tilt_direction * weight[~is_support]
     fixed = np.zeros((n_block, 3), dtype=np.int8)
@@ -278,10 +291,10 @@ def with_supports(model: xr.Dataset, supports) -> xr.Dataset:
     dead = block_loads(model, "dead").copy()
     masonry = np.ones(role.size, dtype=bool)
     masonry[supported] = False
-    reaction = support_reactions(supports, contact, -dead[masonry, 1].sum(), "settlement")
     live = np.zeros_like(dead)
-    dead[supported, 1] = reaction
-    live[supported, :2] = reaction[:, None] * np.array([live_direction(s) for s in supports]).reshape(-1, 2)
+    dead[supported], live[supported] = support_loads(supports, support_reactions(supports, contact,
+                                                                                -dead[masonry, 1].sum(),
+                                                                                "settlement"))
     fixed = model.block_fixed.values.copy()
     fixed[supported] = s_fixed
     direction = np.zeros((role.size, 3))

@@ -18,11 +18,11 @@ import xarray as xr
 
 from ..format.model3d import model_from_polyhedra
 from ..format.roles import ROLE
+from ..format.schema import flags
 from ..geometry import polyhedra
 from ..readers.spec import Material
 from ..runtime.errors import SpecError
-
-KIND = {"bed": 0, "head": 1, "support": 2, "other": 3}
+from .blocks import carried_weight
 
 
 def model_on_ground(poly: polyhedra.Polyhedra, masonry_role: np.ndarray, weight: np.ndarray, ground_motion: np.ndarray,
@@ -44,17 +44,18 @@ def model_on_ground(poly: polyhedra.Polyhedra, masonry_role: np.ndarray, weight:
     motion[~moving] = 0.0
     contacts = polyhedra.find_contacts(poly, tol)
     refuse_unconnected(contacts.sides, n_masonry, n, label)
-    share = np.sum(weight) * support_contact_shares(contacts, ground)
+    share = carried_weight(np.sum(weight), support_contact_areas(contacts, ground), moving)
     dead = np.zeros((n, 3))
     live = np.zeros((n, 3))
     dead[:n_masonry, 2] = -np.asarray(weight)
-    dead[moving, 2] = share[moving]  # the paper's convention: up the weight it carries uniformly, the same down live
+    dead[moving, 2] = share[moving]  # the paper's convention (carried_weight): up, the same down as live load
     live[moving, 2] = -share[moving]
     fixed = np.zeros((n, 6), dtype=np.int8)
     fixed[ground & ~moving] = 1
     normal_z = np.abs(contacts.normal[:, 2])
     support = ground[contacts.sides].any(axis=1)
-    kind = np.where(support, KIND["support"], np.where(normal_z > 0.5, KIND["bed"], KIND["head"])).astype(np.int8)
+    kind = flags("interface_kind")
+    kind = np.where(support, kind["support"], np.where(normal_z > 0.5, kind["bed"], kind["head"])).astype(np.int8)
     m = contacts.n_interface
     arrays = {"block_role": role, "block_unit_weight": np.where(ground, 0.0, material.unit_weight),
               "interface_kind": kind, "interface_friction": np.full(m, material.friction),
@@ -69,14 +70,14 @@ def model_on_ground(poly: polyhedra.Polyhedra, masonry_role: np.ndarray, weight:
     return model_from_polyhedra(poly, contacts, arrays, attrs)
 
 
-def support_contact_shares(contacts: polyhedra.Contacts, ground: np.ndarray) -> np.ndarray:
-    """``(block,)``: each ground block's share of the masonry's weight, the area of its contacts with the masonry
-    over that of all the ground's (0 for the masonry, and for ground that touches none)."""
+def support_contact_areas(contacts: polyhedra.Contacts, ground: np.ndarray) -> np.ndarray:
+    """``(block,)``: the area of each ground block's contacts with the masonry (0 for the masonry, and for ground
+    that touches none)."""
     on_ground = ground[contacts.sides]
     masonry_on = on_ground.any(axis=1) & ~on_ground.all(axis=1)
     support = np.where(on_ground[:, 0], contacts.sides[:, 0], contacts.sides[:, 1])[masonry_on]
     area = np.bincount(support, weights=contacts.area[masonry_on], minlength=ground.size)
-    return area / area.sum()
+    return area
 
 
 def refuse_unconnected(sides: np.ndarray, n_masonry: int, n: int, label: Callable[[int], str]) -> None:

@@ -11,6 +11,7 @@ import numpy as np
 import xarray as xr
 
 from ..geometry import polyhedra
+from ..geometry.graph import find_pairs, pair_index
 from ..geometry.polygons import model_scale
 from ..runtime.errors import ModelError
 from .dofs import block_loads
@@ -144,16 +145,7 @@ def twin(model: xr.Dataset) -> xr.Dataset:
 
 def planar_joint(model: xr.Dataset, sides: np.ndarray) -> np.ndarray:
     """The planar model's interface between each contact's two blocks (the first of several), -1 where none."""
-    n = model.sizes["block"]
-    pairs = np.sort(model.interface_blocks.values.astype(np.int64), axis=1)
-    keys = pairs[:, 0] * n + pairs[:, 1]
-    order = np.argsort(keys, kind="stable")
-    wanted = np.sort(sides, axis=1)
-    wanted_keys = wanted[:, 0] * n + wanted[:, 1]
-    if keys.size == 0:
-        return np.full(len(sides), -1)
-    at = np.clip(np.searchsorted(keys[order], wanted_keys), 0, keys.size - 1)
-    return np.where(keys[order][at] == wanted_keys, order[at], -1)
+    return find_pairs(pair_index(model.interface_blocks.values, model.sizes["block"]), sides)
 
 
 def _joint_values(values: np.ndarray, joint: np.ndarray, default) -> np.ndarray:

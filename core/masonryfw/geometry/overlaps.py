@@ -8,6 +8,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .boxes import box_pairs, ragged_expand
 from .polygons import block_bounds, block_offsets, convex_pieces, next_node, point_segment_distance
 
 
@@ -70,51 +71,13 @@ def self_intersections(x, y, counts, candidates, tol):
     return np.asarray(blocks_out, dtype=np.int64)[order], [points_out[o] for o in order]
 
 
-def ragged_expand(counts):
-    """For rows with ``counts`` items each: the row of every item and its position in the row."""
-    counts = np.asarray(counts, dtype=np.int64)
-    row = np.repeat(np.arange(counts.size), counts)
-    position = np.arange(counts.sum()) - np.repeat(np.cumsum(counts) - counts, counts)
-    return row, position
-
-
-def candidate_pairs(xmin, xmax, ymin, ymax, blocks, tol):
-    """Pairs (a < b) of ``blocks`` whose bounding boxes, shrunk by tol, overlap; by a uniform grid.
-
-    Each block is entered in every grid cell its shrunk box covers; pairs are
-    formed only inside a cell, so the work grows with the number of blocks
-    rather than its square.
-    """
-    if blocks.size < 2:
-        return np.zeros(0, np.int64), np.zeros(0, np.int64)
-    x0, x1 = xmin[blocks] + tol, xmax[blocks] - tol
-    y0, y1 = ymin[blocks] + tol, ymax[blocks] - tol
-    cell = float(np.median(np.maximum(x1 - x0, y1 - y0)))
-    cell = cell if cell > 0 else 1.0
-    gx0, gy0 = x0.min(), y0.min()
-    ix0, ix1 = np.floor((x0 - gx0) / cell).astype(np.int64), np.floor((x1 - gx0) / cell).astype(np.int64)
-    iy0, iy1 = np.floor((y0 - gy0) / cell).astype(np.int64), np.floor((y1 - gy0) / cell).astype(np.int64)
-    ix1, iy1 = np.maximum(ix1, ix0), np.maximum(iy1, iy0)
-    nx_cells = int(ix1.max()) + 1
-    wide, high = ix1 - ix0 + 1, iy1 - iy0 + 1
-    row, pos = ragged_expand(wide * high)
-    cell_id = (iy0[row] + pos // wide[row]) * nx_cells + ix0[row] + pos % wide[row]
-    order = np.lexsort((row, cell_id))
-    member, cell_id = row[order], cell_id[order]
-    group_start = np.flatnonzero(np.concatenate(([True], np.diff(cell_id) != 0)))
-    group_end = np.append(group_start[1:], cell_id.size)
-    size = group_end - group_start
-    end_of = np.repeat(group_end, size)
-    partners = end_of - np.arange(cell_id.size) - 1
-    left, offset = ragged_expand(partners)
-    right = left + 1 + offset
-    a, b = member[left], member[right]
-    a, b = np.minimum(a, b), np.maximum(a, b)
-    key = np.sort(a * blocks.size + b)  # sort + diff: faster than np.unique's hashing here
-    key = key[np.concatenate(([True], np.diff(key) != 0))]
-    a, b = key // blocks.size, key % blocks.size
-    boxes_meet = (x0[a] < x1[b]) & (x0[b] < x1[a]) & (y0[a] < y1[b]) & (y0[b] < y1[a])
-    return blocks[a[boxes_meet]], blocks[b[boxes_meet]]
+def candidate_pairs(xmin, xmax, ymin, ymax, tol):
+    """Pairs (a < b) of blocks whose bounding boxes, shrunk by tol, overlap (strictly: boxes that only touch
+    once shrunk do not), found by the one broad phase (:func:`masonryfw.geometry.boxes.box_pairs`)."""
+    low, high = np.c_[xmin, ymin] + tol, np.c_[xmax, ymax] - tol
+    a, b = box_pairs(low, high)
+    overlap = ((low[a] < high[b]) & (low[b] < high[a])).all(axis=1)
+    return a[overlap], b[overlap]
 
 
 @dataclass(frozen=True)
@@ -172,7 +135,7 @@ def overlapping_blocks(x, y, counts, blocks, tol):
     nodes = np.repeat(start[blocks], counts[blocks]) + ragged_expand(counts[blocks])[1]
     px, py, pc, owner = convex_pieces(x[nodes], y[nodes], counts[blocks], tol)
     pieces = ConvexPolygons(px, py, pc, blocks[owner])
-    a, b = candidate_pairs(*block_bounds(px, py, pc), np.arange(pc.size), tol)
+    a, b = candidate_pairs(*block_bounds(px, py, pc), tol)
     other = pieces.owner[a] != pieces.owner[b]
     a, b = a[other], b[other]
     if a.size == 0:
