@@ -237,13 +237,22 @@ def _solved(model: str, solver: str, output: str | None, options: dict[str, str]
     return result, out, plan
 
 
+def SOLVER_RUN(command):  # a decorator, named like OPTIONS and PROGRESS
+    """``-o``, ``--option``, ``--progress`` and ``--force``: the options of one solver run (solve, capacity)."""
+    for option in reversed((
+        click.option("-o", "--output", type=click.Path(dir_okay=False), help="[default: <model>.<plugin>.nc]"),
+        OPTIONS,
+        PROGRESS,
+        click.option("--force", is_flag=True, help=f"Start a run estimated longer than {UNASKED_RUN / 3600:g} h."),
+    )):
+        command = option(command)
+    return command
+
+
 @cli.command()
 @click.argument("model")
 @click.option("--plugin", "solver", required=True, help="Name of the solver (see `masonryfw plugins`).")
-@click.option("-o", "--output", type=click.Path(dir_okay=False), help="[default: <model>.<plugin>.nc]")
-@OPTIONS
-@PROGRESS
-@click.option("--force", is_flag=True, help=f"Start a run estimated longer than {UNASKED_RUN / 3600:g} h.")
+@SOLVER_RUN
 def solve(model: str, solver: str, output: str | None, options: dict[str, str], progress: bool | None,
           force: bool) -> None:
     """Solve MODEL (a model file, a spec file or a bundled case name) with a solver plugin.
@@ -283,10 +292,7 @@ PLATEAU_STOP = "plateau_tolerance"
 @click.option("--settlement", type=mfp.LENGTH, help="Run to this settlement parameter [m] (a tunnel's S_max).")
 @click.option("--volume-loss", "volume_loss", type=mfp.Number("%", above=0.0, at_most=100.0),
               help="Run a tunnel to this volume loss [%].")
-@click.option("-o", "--output", type=click.Path(dir_okay=False), help="[default: <model>.<plugin>.nc]")
-@OPTIONS
-@PROGRESS
-@click.option("--force", is_flag=True, help=f"Start a run estimated longer than {UNASKED_RUN / 3600:g} h.")
+@SOLVER_RUN
 def capacity(model: str, solver: str, category: int | None, settlement: float | None, volume_loss: float | None,
              output: str | None, options: dict[str, str], progress: bool | None, force: bool) -> None:
     """How much settlement (a tunnel: volume loss) MODEL takes before each damage category, from one run.

@@ -39,10 +39,12 @@ from .kernels import (
     TIME,
     WORK_GRAVITY,
     WORK_SUPPORT,
-    EndLaw,
     contact_end,
+    end_point,
     face_geometry,
+    face_law,
     next_node,
+    release_face,
     settlement_rate,
     smooth_share,
 )
@@ -298,42 +300,29 @@ def node_contact_forces(offs, mesh, pairs, law, motion, force, dt, update_histor
     faces, props, shear, bonded, normal, energy = pairs.faces, pairs.props, pairs.shear, pairs.bonded, \
         pairs.normal, pairs.energy
     x, y, vel, acc = motion.x, motion.y, motion.vel, motion.acc
-    kn, kt, min_half, contact_damping = law
+    min_half = law[2]
     inv_mass = mesh.inv_mass
     stored = 0.0
     for f in range(faces.shape[0]):
         a, ea, b, eb = faces[f, 0], faces[f, 1], faces[f, 2], faces[f, 3]
         ka, kb = next_node(ea, a, offs), next_node(eb, b, offs)
         g = face_geometry(x, y, offs, a, ea, b, eb)
-        nx, ny, ox, oy, s_lo, s_hi = g[0], g[1], g[2], g[3], g[4], g[5]
+        nx, ny = g[0], g[1]
         tx, ty = ny, -nx
-        half = 0.5 * (s_hi - s_lo)
+        half, end_law = face_law(law, g, props[f], 0.5 * (inv_mass[ea] + inv_mass[ka] + inv_mass[eb] + inv_mass[kb]))
         if half <= min_half:
-            if update_history:
-                for e in range(2):
-                    acc[RELEASED] += energy[f, e]
-                    energy[f, e] = 0.0
-                    shear[f, e] = 0.0
-                    bonded[f, e] = 0
-            normal[f, 0] = normal[f, 1] = 0.0
+            held = release_face(f, energy, shear, bonded, normal, update_history)
+            for e in range(2):
+                acc[RELEASED] += held[e]
             continue
-        knp = kn * half
-        ktp = kt * half
-        m_inv = 0.5 * (inv_mass[ea] + inv_mass[ka] + inv_mass[eb] + inv_mass[kb])
-        dashpot = 2.0 * contact_damping * np.sqrt(knp / m_inv) if m_inv > 0.0 else 0.0
-        end_law = EndLaw(knp, ktp, dashpot, props[f, 0], props[f, 1] * half, props[f, 2] * half)
         for e in range(2):
-            s = s_lo if e == 0 else s_hi
-            gap = g[6] if e == 0 else g[7]
-            h = g[8] if e == 0 else g[9]
-            px = ox + s * tx + h * nx
-            py = oy + s * ty + h * ny
+            px, py, gap = end_point(g, e)
             wa = edge_weight(x, y, ea, ka, px, py)
             wb = edge_weight(x, y, eb, kb, px, py)
             dvx = ((1.0 - wb) * vel[eb, 0] + wb * vel[kb, 0]) - ((1.0 - wa) * vel[ea, 0] + wa * vel[ka, 0])
             dvy = ((1.0 - wb) * vel[eb, 1] + wb * vel[kb, 1]) - ((1.0 - wa) * vel[ea, 1] + wa * vel[ka, 1])
             is_open, fn, ft, bond, spring, friction_1, friction_2, damping = contact_end(
-                -knp * gap, dvx * nx + dvy * ny, dvx * tx + dvy * ty, shear[f, e], bonded[f, e], end_law, dt,
+                -end_law.knp * gap, dvx * nx + dvy * ny, dvx * tx + dvy * ty, shear[f, e], bonded[f, e], end_law, dt,
                 update_history)
             acc[DISSIPATED_FRICTION] += friction_1
             acc[DISSIPATED_FRICTION] += friction_2

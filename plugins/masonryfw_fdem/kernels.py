@@ -386,6 +386,46 @@ def wake_sleepers(bodies, pairs, law, motion, vx, vy, wake_speed):
 
 
 @jit
+def face_law(law, g, props_f, m_inv):
+    """Half the overlap of a face pair (frame ``g``: :func:`face_geometry`) and the :class:`EndLaw` of each of
+    its two ends: the stiffnesses per length times that half, the dashpot of ``contact_damping`` on the pair's
+    inverse mass ``m_inv``, the interface's friction and its cohesion and tension per length times the half."""
+    kn, kt, _, contact_damping = law
+    half = 0.5 * (g[5] - g[4])
+    knp = kn * half
+    ktp = kt * half
+    dashpot = 2.0 * contact_damping * np.sqrt(knp / m_inv) if m_inv > 0.0 else 0.0
+    return half, EndLaw(knp, ktp, dashpot, props_f[0], props_f[1] * half, props_f[2] * half)
+
+
+@jit
+def end_point(g, e):
+    """The contact point ``o + s t + h n`` of end ``e`` (0: low, 1: high) of a face pair (:func:`face_geometry`)
+    and its gap."""
+    nx, ny, ox, oy = g[0], g[1], g[2], g[3]
+    tx, ty = ny, -nx
+    s = g[4] if e == 0 else g[5]
+    gap = g[6] if e == 0 else g[7]
+    h = g[8] if e == 0 else g[9]
+    return ox + s * tx + h * nx, oy + s * ty + h * ny, gap
+
+
+@jit
+def release_face(f, energy, shear, bonded, normal, update_history):
+    """A face pair whose faces slid apart: the contact (and any bond) is gone. Returns the spring energy its two
+    ends held (released; 0 unless the history is updated)."""
+    held_0 = held_1 = 0.0
+    if update_history:
+        held_0, held_1 = energy[f, 0], energy[f, 1]
+        for e in range(2):
+            energy[f, e] = 0.0
+            shear[f, e] = 0.0
+            bonded[f, e] = 0
+    normal[f, 0] = normal[f, 1] = 0.0
+    return held_0, held_1
+
+
+@jit
 def contact_end(fn_elastic, opening_rate, slip_rate, ft, bonded, law, dt, update_history):
     """The contact law at one end of a face pair, for rigid blocks and for nodes alike.
 
@@ -470,7 +510,7 @@ def contact_forces(bodies, pairs, law, motion, vx, vy, force, dt, update_history
     offs, inv_mass = bodies.offs, bodies.inv_mass
     faces, props, shear, bonded, normal, energy, face_force = pairs
     pos, vel, active, calm, acc = motion.pos, motion.vel, motion.active, motion.calm, motion.acc
-    kn, kt, min_half, contact_damping = law
+    min_half = law[2]
     if wake_speed > 0.0:
         wake_sleepers(bodies, pairs, law, motion, vx, vy, wake_speed)
     stored = 0.0
@@ -484,34 +524,21 @@ def contact_forces(bodies, pairs, law, motion, vx, vy, force, dt, update_history
             continue
         fbx = fby = mb = ma = 0.0
         g = face_geometry(vx, vy, offs, a, ea, b, eb)
-        nx, ny, ox, oy, s_lo, s_hi = g[0], g[1], g[2], g[3], g[4], g[5]
+        nx, ny = g[0], g[1]
         tx, ty = ny, -nx
-        half = 0.5 * (s_hi - s_lo)
+        half, end_law = face_law(law, g, props[f], inv_mass[a] + inv_mass[b])
         if half <= min_half:
-            if update_history:  # the faces slid apart: the contact (and any bond) is gone
-                for e in range(2):
-                    released += energy[f, e]
-                    energy[f, e] = 0.0
-                    shear[f, e] = 0.0
-                    bonded[f, e] = 0
-            normal[f, 0] = normal[f, 1] = 0.0
+            held = release_face(f, energy, shear, bonded, normal, update_history)
+            for e in range(2):
+                released += held[e]
             face_force[f, 0] = face_force[f, 1] = face_force[f, 2] = face_force[f, 3] = 0.0
             continue
-        knp = kn * half
-        ktp = kt * half
-        m_inv = inv_mass[a] + inv_mass[b]
-        dashpot = 2.0 * contact_damping * np.sqrt(knp / m_inv) if m_inv > 0.0 else 0.0
-        end_law = EndLaw(knp, ktp, dashpot, props[f, 0], props[f, 1] * half, props[f, 2] * half)
         for e in range(2):
-            s = s_lo if e == 0 else s_hi
-            gap = g[6] if e == 0 else g[7]
-            h = g[8] if e == 0 else g[9]
-            px = ox + s * tx + h * nx
-            py = oy + s * ty + h * ny
+            px, py, gap = end_point(g, e)
             dvx = (vel[b, 0] - vel[b, 2] * (py - pos[b, 1])) - (vel[a, 0] - vel[a, 2] * (py - pos[a, 1]))
             dvy = (vel[b, 1] + vel[b, 2] * (px - pos[b, 0])) - (vel[a, 1] + vel[a, 2] * (px - pos[a, 0]))
             is_open, fn, ft, bond, spring, friction_1, friction_2, damping = contact_end(
-                -knp * gap, dvx * nx + dvy * ny, dvx * tx + dvy * ty, shear[f, e], bonded[f, e], end_law, dt,
+                -end_law.knp * gap, dvx * nx + dvy * ny, dvx * tx + dvy * ty, shear[f, e], bonded[f, e], end_law, dt,
                 update_history)
             if friction_1 != 0.0:  # each term on its own, as the law adds them (numba: one reduction a branch)
                 d_friction += friction_1
