@@ -216,7 +216,7 @@ def estimate(model: xr.Dataset, plugin: str, options: Mapping[str, Any] | None =
 
 def _checked_estimate(solver: Solver, model: xr.Dataset, resolved: Mapping[str, Any]) -> Estimate | None:
     """The solver's estimate on a checked ``model``, made once per model contents and options
-    (:func:`masonryfw.made_once`), and the memory it needs refused when it does not fit."""
+    (:func:`masonryfw.plugin_api.made_once`), and the memory it needs refused when it does not fit."""
     if solver.estimate is None:
         return None
 

@@ -3,7 +3,7 @@
 Everything is inside the file: the figures are PNGs in ``data:`` URLs, the style
 sheet is inline, there is no script and no link to the network, so it opens
 anywhere and can be attached to an assessment. The numbers are the core's
-(:func:`masonryfw.headline_rows`, :func:`masonryfw.score_rows`): each table cell
+(:func:`masonryfw.plugin_api.headline_rows`, :func:`masonryfw.plugin_api.score_rows`): each table cell
 carries its full-precision value in ``data-value`` so that a reader (or a test)
 can check it against the result files.
 """
@@ -70,7 +70,7 @@ def _value_attribute(value: float | None) -> str:
 
 
 def _table(header: Sequence[str], rows: Sequence[mfp.Row], table_id: str, columns: Sequence[str]) -> str:
-    """An HTML table of :class:`masonryfw.Row`; each cell says its row key, column and full value."""
+    """An HTML table of :class:`masonryfw.plugin_api.Row`; each cell says its row key, column and full value."""
     head = "".join(f"<th>{html.escape(h)}</th>" for h in header) + "<th>what it means</th>"
     body = []
     for row in rows:

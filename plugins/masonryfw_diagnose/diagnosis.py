@@ -58,7 +58,7 @@ class Candidate:
 class Diagnosis:
     model: xr.Dataset  # the wall on its ground segments, every segment held
     survey: Survey
-    wall: scoring.Wall
+    wall: scoring.WallJoints
     observed: scoring.Observed
     candidates: list[Candidate]  # ranked, best first
     solver: str

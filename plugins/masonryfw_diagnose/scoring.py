@@ -6,7 +6,7 @@ height ``h`` (the median masonry block height):
 - a **joint is observed** when at least half of its points lie within the tolerance (default h / 2) of a
   surveyed line; a **line matches no joint** when none of its points does;
 - **predicted cracks** are the joints within the masonry that the scenario's mechanism opens or slides,
-  read at :data:`SURVEY_THRESHOLD` (the core's definition, :func:`masonryfw.indicator_at`), each point
+  read at :data:`SURVEY_THRESHOLD` (the core's definition, :func:`masonryfw.plugin_api.indicator_at`), each point
   weighted by its joint's ``crack_indicator``;
 - a point at distance d from the other side counts ``w(d) = exp(-(d / 0.7 h)^2 / 2)``: 1 on it, 0.78 half a
   joint off, 0.36 a joint (one unit height) off, 0.02 two joints off. **Recall** is the mean ``w`` of the surveyed points (how much
@@ -78,7 +78,7 @@ def distances(points: np.ndarray, to: np.ndarray) -> np.ndarray:
 
 
 @dataclass(frozen=True)
-class Wall:
+class WallJoints:
     """What scoring needs of the wall, computed once: its joints within the masonry, sampled."""
 
     unit_height: float
@@ -87,7 +87,7 @@ class Wall:
     joints: Samples  # the inner joints' points (owner: interface index)
 
 
-def wall_joints(model: xr.Dataset, tolerance: float | None = None) -> Wall:
+def wall_joints(model: xr.Dataset, tolerance: float | None = None) -> WallJoints:
     role = model.block_role.values
     masonry = mfp.masonry_blocks(role)
     _, _, ymin, ymax = mfp.block_bounds(model.node_x.values, model.node_y.values, model.block_node_count.values)
@@ -97,7 +97,7 @@ def wall_joints(model: xr.Dataset, tolerance: float | None = None) -> Wall:
     lines = [np.c_[model.interface_x.values[i], model.interface_y.values[i]] for i in index]
     joints = sample(lines, height / 4)
     joints = Samples(joints.xy, index[joints.owner], joints.length)
-    return Wall(height, 0.5 * height if tolerance is None else tolerance, inner, joints)
+    return WallJoints(height, 0.5 * height if tolerance is None else tolerance, inner, joints)
 
 
 @dataclass(frozen=True)
@@ -109,7 +109,7 @@ class Observed:
     unmatched: tuple[int, ...]  # lines within the tolerance of no joint
 
 
-def observe(wall: Wall, cracks) -> Observed:
+def observe(wall: WallJoints, cracks) -> Observed:
     points = sample(cracks, wall.unit_height / 4)
     near_line = distances(wall.joints.xy, points.xy) <= wall.tolerance
     share = np.bincount(wall.joints.owner, weights=near_line * wall.joints.length, minlength=wall.inner.size)
@@ -149,7 +149,7 @@ class Score(Match):
         return self.crack if self.levelling is None else float(np.sqrt(self.crack * self.levelling))
 
 
-def match(wall: Wall, observed: Observed, indicator: np.ndarray) -> Match:
+def match(wall: WallJoints, observed: Observed, indicator: np.ndarray) -> Match:
     """The crack score of joints cracked as ``indicator`` says (``(interface,)`` in [0, 1], 0: uncracked)."""
     predicted = wall.inner[wall.joints.owner] & (indicator[wall.joints.owner] > 0)
     pred_xy = wall.joints.xy[predicted]
@@ -167,7 +167,7 @@ def match(wall: Wall, observed: Observed, indicator: np.ndarray) -> Match:
     return Match(crack, precision, recall, tuple(int(k) for k in np.flatnonzero(per_line < 0.5)), int(unseen.sum()))
 
 
-def score(wall: Wall, observed: Observed, result: xr.Dataset, widths_mm, levelled: np.ndarray | None = None,
+def score(wall: WallJoints, observed: Observed, result: xr.Dataset, widths_mm, levelled: np.ndarray | None = None,
           ground_rate: np.ndarray | None = None, sigma: float = 0.0) -> Score:
     """How well ``result`` (a mechanism per unit settlement) explains the survey's cracks (module docstring), and
     its fit to the levelling ``levelled`` (``x, y, dy``; the ground's rate under each point ``ground_rate``, the

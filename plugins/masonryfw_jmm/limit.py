@@ -408,7 +408,7 @@ def limit_mechanism(domain: Domain, lp: LimitLP, sol: LPSolution, model: xr.Data
     The static LP's kinematic side: the duals of the equilibrium rows ``V (div s + b) = 0`` are the
     triangles' velocities, scaled so that the moving support settles at unit rate (the cost is its
     reaction; checked: the fastest point moves at 1.000). They are projected onto each block's rigid
-    motions at the triangles' centroids, weighted by volume (:func:`masonryfw.rigid_fit`); the
+    motions at the triangles' centroids, weighted by volume (:func:`masonryfw.plugin_api.rigid_fit`); the
     supports move along their ``settlement_direction`` (0 when fixed). None where a block gets no
     motion (no triangle)."""
     field, H = lp.field, domain.length

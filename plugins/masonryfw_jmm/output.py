@@ -39,7 +39,7 @@ def point_variables(xy: np.ndarray, failure: np.ndarray, stress: np.ndarray, whe
 
 def block_mechanism(model: xr.Dataset, block, x, y, ux, uy, weight, settlement: float) -> np.ndarray | None:
     """A continuum's field ``(ux, uy)`` at weighted points ``(x, y)`` of blocks ``block`` [m] as block motions
-    (block, 3): projected onto each block's rigid motions (:func:`masonryfw.rigid_fit`), the supports moving
+    (block, 3): projected onto each block's rigid motions (:func:`masonryfw.plugin_api.rigid_fit`), the supports moving
     by ``settlement`` along their ``settlement_direction`` (fixed ones stay). None when a block gets no
     motion (no point in it)."""
     fitted = mfp.rigid_fit(block, x, y, ux, uy, weight, model.block_centroid_x.values, model.block_centroid_y.values)

@@ -348,7 +348,7 @@ def load_factor_variables(history: History, displacement: float) -> dict:
 
 def mechanism(problem: Problem, model: xr.Dataset, history: History) -> np.ndarray | None:
     """Block motions (block, 3) [m, rad] of the last steps: the displacement increment over the steps the
-    plateau test looks at, projected onto each block's rigid motions (:func:`masonryfw.rigid_fit`) at the
+    plateau test looks at, projected onto each block's rigid motions (:func:`masonryfw.plugin_api.rigid_fit`) at the
     quadrature points; the supports move by their settlement increment. None before two steps."""
     if len(history.recent) < 2:
         return None

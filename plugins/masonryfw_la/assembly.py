@@ -167,7 +167,7 @@ class KinematicLP:
 
 
 def model_scales(model: xr.Dataset, wall: Wall) -> Scales:
-    """The model's scales (:func:`masonryfw.model_scales`), the force being the total dead load
+    """The model's scales (:func:`masonryfw.plugin_api.model_scales`), the force being the total dead load
     (the live load's when there is no dead load): the dual forces are then of order one."""
     scales = mfp.model_scales(model)
     for loads in (wall.dead, wall.live):

@@ -18,8 +18,8 @@ from support import cli, refused
 import masonryfw as mf
 import masonryfw.plugin_api as mfp
 from masonryfw.builders.bond import Bond, Head, lay
-from masonryfw.builders.builder import masonry_blocks, parse_spec
 from masonryfw.builders.kinds import load_spec
+from masonryfw.builders.parametric import masonry_rectangles, parse_spec
 
 DRAWINGS = Path(mf.bundled_spec_path("gable-house")).parent
 GABLE = """title = "gable"
@@ -75,7 +75,7 @@ def blocks_of(model):
     """Every masonry block as a shapely polygon, with its role."""
     rings = np.split(np.c_[model.node_x.values, model.node_y.values],
                      mfp.block_offsets(model.block_node_count.values)[1:-1])
-    masonry = mfp.masonry_blocks(model.block_role.values)
+    masonry = mfp.masonry_rectangles(model.block_role.values)
     return [Polygon(r) for r, m in zip(rings, masonry) if m], model.block_role.values[masonry]
 
 
@@ -180,7 +180,7 @@ def test_the_engine_lays_the_rectangle_walls_with_the_builders_blocks(name):
     """The rectangle walls the builder lays (its own vectorised rules) come out of the engine the same: the same
     blocks, to a micrometre, lintels included."""
     wall = parse_spec(load_spec(mf.bundled_spec_path(name)))
-    x0, x1, y0, y1, role = masonry_blocks(wall)
+    x0, x1, y0, y1, role = masonry_rectangles(wall)
     expected = sorted(zip(*(np.round(v, 6).tolist() for v in (x0, x1, y0, y1)), role.tolist()))
     openings = [box(o.x0, o.course0 * wall.unit_height, o.x1, o.course1 * wall.unit_height) for o in wall.openings]
     heads = [Head("lintel", 1, o.lintel_bearing) if o.lintel_bearing > 0 else Head("none") for o in wall.openings]

@@ -19,7 +19,7 @@ The rules, each stated in the notes :func:`lay` returns where it acts:
   shorter than ``min_piece`` of a unit length is merged with its neighbour across a head joint (the right
   one if there is one), else with the piece below it (a gable's tip): no sliver stands alone.
 
-Plain geometry (shapely) on polygons in metres; :mod:`masonryfw.outline_walls` turns specs and drawings into
+Plain geometry (shapely) on polygons in metres; :mod:`masonryfw.builders.outlined` turns specs and drawings into
 its inputs and its units into models.
 """
 from __future__ import annotations
@@ -74,7 +74,7 @@ class Head:
 
 
 @dataclass
-class Laid:
+class LaidWall:
     """The wall laid: every block's polygon (counter-clockwise, no repeated last point) and role, course by
     course and left to right, then the heads; and the notes that say what the rules did."""
 
@@ -84,11 +84,11 @@ class Laid:
 
 
 def lay(outline: Polygon, openings: list[Polygon], bond: Bond, heads: list[Head], names: list[str] | None = None
-        ) -> Laid:
+        ) -> LaidWall:
     """The units and heads of ``outline`` less ``openings`` (each bridged by its ``heads`` entry; ``names`` say
     which opening a note speaks of); see the module docstring."""
     names = names or [f"openings[{k}]" for k in range(len(openings))]
-    laid = Laid()
+    laid = LaidWall()
     size = math.hypot(outline.bounds[2] - outline.bounds[0], outline.bounds[3] - outline.bounds[1])
     tol = 1e-9 * size
     clean = CLEAN * size

@@ -64,7 +64,7 @@ MIN_SUPPORT_DEPTH = 0.01
 
 
 @dataclass(frozen=True)
-class Wall:
+class PlanWall:
     name: str
     start: np.ndarray  # (2,) [m]
     end: np.ndarray
@@ -99,7 +99,7 @@ def is_building(spec: dict) -> bool:
 
 
 def read_walls(building: SpecTable, unit_length: float, unit_height: float, unit_depth: float | None,
-               notes: list[str]) -> list[Wall]:
+               notes: list[str]) -> list[PlanWall]:
     raw = building.raw("walls")
     if not isinstance(raw, list) or not raw:
         raise SpecError(f"spec key {building.key('walls')!r} must be a list of tables [[building.walls]]")
@@ -119,7 +119,7 @@ def read_walls(building: SpecTable, unit_length: float, unit_height: float, unit
         bond = wall.choice("bond", BONDS, building.choice("bond", BONDS, "running"))
         every = wall.integer("header_every", building.integer("header_every", 2, minimum=2), minimum=2)
         leaves = read_leaves(wall, name, bond, thickness, unit_length, unit_depth, notes)
-        walls.append(Wall(name, start, end, round(courses) * unit_height, thickness, read_openings(wall, unit_length),
+        walls.append(PlanWall(name, start, end, round(courses) * unit_height, thickness, read_openings(wall, unit_length),
                           bond, every, leaves))
     names = [w.name for w in walls]
     if len(set(names)) != len(names):
@@ -197,7 +197,7 @@ class Junctions(NamedTuple):
     cuts: list[tuple[int, int, int]]
 
 
-def junctions(walls: list[Wall], tol: float) -> Junctions:
+def junctions(walls: list[PlanWall], tol: float) -> Junctions:
     """The corners (two walls' ends at one point), T-junctions (a wall's end on another's base line between its
     ends, or three walls' ends at a point, two of them in line) and crossings (two base lines crossing between
     their ends, or four walls' ends at a point in two lines) of ``walls``, each at :data:`MIN_ANGLE` or more. A
@@ -226,7 +226,7 @@ def junctions(walls: list[Wall], tol: float) -> Junctions:
     return Junctions(meets, cuts)
 
 
-def ends_together(walls: list[Wall], tol: float) -> list[list[tuple[int, int]]]:
+def ends_together(walls: list[PlanWall], tol: float) -> list[list[tuple[int, int]]]:
     """The walls' ends, ``(wall, end)``, grouped by the point they are at (within ``tol``), groups of two or more."""
     groups: list[tuple[np.ndarray, list[tuple[int, int]]]] = []
     for w, wall in enumerate(walls):
@@ -239,7 +239,7 @@ def ends_together(walls: list[Wall], tol: float) -> list[list[tuple[int, int]]]:
     return [group for _, group in groups if len(group) > 1]
 
 
-def meeting(walls: list[Wall], group: list[tuple[int, int]]) -> dict[tuple[int, int], End]:
+def meeting(walls: list[PlanWall], group: list[tuple[int, int]]) -> dict[tuple[int, int], End]:
     """How the walls whose ends are at one point meet: two at an angle (a corner), three of which two are in line
     (a T), four in two lines (a crossing)."""
     def outward(w: int, e: int) -> np.ndarray:
@@ -273,7 +273,7 @@ def meeting(walls: list[Wall], group: list[tuple[int, int]]) -> dict[tuple[int, 
                     "of which two are in line (a T) or four in two lines (a crossing) are toothed, not this")
 
 
-def base_lines_cross(a: Wall, b: Wall, tol: float) -> bool:
+def base_lines_cross(a: PlanWall, b: PlanWall, tol: float) -> bool:
     """Whether the base lines of ``a`` and ``b`` cross between the ends of both (further than ``tol`` from every
     end)."""
     matrix = np.c_[a.along, -b.along]
@@ -283,7 +283,7 @@ def base_lines_cross(a: Wall, b: Wall, tol: float) -> bool:
     return bool(tol < s < a.length - tol and tol < r < b.length - tol)
 
 
-def steep_enough(walls: list[Wall], a: int, b: int) -> None:
+def steep_enough(walls: list[PlanWall], a: int, b: int) -> None:
     """Refuse two meeting walls at less than :data:`MIN_ANGLE` to each other."""
     sine = abs(float(walls[a].along @ walls[b].across))
     if sine < math.sin(math.radians(MIN_ANGLE)):
@@ -292,14 +292,14 @@ def steep_enough(walls: list[Wall], a: int, b: int) -> None:
                         "degrees or more")
 
 
-def face_cut(wall: Wall, other: Wall, side: float) -> Cut:
+def face_cut(wall: PlanWall, other: PlanWall, side: float) -> Cut:
     """Where ``other``'s face on ``side`` (+1: its left, -1: its right) crosses ``wall``, in ``wall``'s frame."""
     along, across = float(wall.along @ other.across), float(wall.across @ other.across)
     return Cut((0.5 * side * other.thickness - float((wall.start - other.start) @ other.across)) / along,
                -across / along)
 
 
-def course_extent(walls: list[Wall], joins: Junctions, courses: list[int], w: int, course: int) -> tuple[Cut, Cut]:
+def course_extent(walls: list[PlanWall], joins: Junctions, courses: list[int], w: int, course: int) -> tuple[Cut, Cut]:
     """The wall's ends in ``course``: through a junction it runs through in this course (to the other wall's far
     face), short of one it does not (to the other's near face); square where it is free (or the other wall has
     no such course)."""
@@ -317,7 +317,7 @@ def course_extent(walls: list[Wall], joins: Junctions, courses: list[int], w: in
     return extent[0], extent[1]
 
 
-def junction_gaps(walls: list[Wall], joins: Junctions, courses: list[int], v: int
+def junction_gaps(walls: list[PlanWall], joins: Junctions, courses: list[int], v: int
                   ) -> dict[int, list[tuple[Cut, Cut]]]:
     """``{course: [(start, end)]}``: where another wall runs through wall ``v`` (a T's abutting wall in odd
     courses, a crossing wall in the courses it runs through), between its two faces."""
@@ -330,7 +330,7 @@ def junction_gaps(walls: list[Wall], joins: Junctions, courses: list[int], v: in
     return gaps
 
 
-def course_cells(wall: Wall, course: int, origin: float, a: float, b: float, unit_length: float
+def course_cells(wall: PlanWall, course: int, origin: float, a: float, b: float, unit_length: float
                  ) -> tuple[np.ndarray, np.ndarray]:
     """The starts of the bond's cells covering ``[a, b]`` in ``course`` (the pattern repeated both ways from
     ``origin``) and whether each is a header (through the wall's thickness) or a stretcher (one per leaf)."""
@@ -386,7 +386,7 @@ def whole_at_end(parts: list[tuple[Cut, Cut, bool]], unit_length: float) -> list
 
 
 @dataclass
-class Laid:
+class LaidMasonry:
     """Blocks in walls' frames as they are laid: wall, along from ``s0`` to ``s1`` (their ends' cuts: boxes, or
     prisms with a slanted end where walls meet at an angle), across [q0, q1] (from the wall's base line), course
     (z0, z1), role, extra dead load."""
@@ -407,11 +407,11 @@ class Laid:
             getattr(self, name).append(value)
 
 
-def lay_masonry(walls: list[Wall], joins: Junctions, unit_length: float, unit_height: float, notes: list[str]) -> Laid:
+def lay_masonry(walls: list[PlanWall], joins: Junctions, unit_length: float, unit_height: float, notes: list[str]) -> LaidMasonry:
     """Every wall's courses: units in its bond between its course extents, openings left out, a lintel over each
     opening (module docstring)."""
     courses = [round(wall.height / unit_height) for wall in walls]
-    laid = Laid()
+    laid = LaidMasonry()
     for w, wall in enumerate(walls):
         gaps = junction_gaps(walls, joins, courses, w)  # course: the ranges left open (by openings, other walls)
         lintels: dict[int, list[tuple[Cut, Cut]]] = {}  # course: the ranges of the lintels
@@ -454,7 +454,7 @@ def lay_masonry(walls: list[Wall], joins: Junctions, unit_length: float, unit_he
     return laid
 
 
-def plan_corners(walls: list[Wall], laid: Laid) -> np.ndarray:
+def plan_corners(walls: list[PlanWall], laid: LaidMasonry) -> np.ndarray:
     """``(block, 4, 2)``: every laid block's corners in plan, anticlockwise: its ends' cuts at its two faces."""
     w = np.asarray(laid.wall)
     start = np.array([wall.start for wall in walls])[w]
@@ -467,7 +467,7 @@ def plan_corners(walls: list[Wall], laid: Laid) -> np.ndarray:
     return start[:, None] + s[..., None] * along[:, None] + q[..., None] * across[:, None]
 
 
-def refuse_overlaps(walls: list[Wall], laid: Laid, unit_length: float) -> None:
+def refuse_overlaps(walls: list[PlanWall], laid: LaidMasonry, unit_length: float) -> None:
     """Refuse walls laid into one another (parallel walls closer than their half thicknesses, a wall ending inside
     another short of its base line): two boxes of one course whose plans share an area, the walls and the place
     named."""
@@ -490,7 +490,7 @@ def refuse_overlaps(walls: list[Wall], laid: Laid, unit_length: float) -> None:
                             "walls meet at their ends or on another's base line, or keep clear of each other")
 
 
-def oriented_boxes(walls: list[Wall], laid: Laid) -> polyhedra.Polyhedra:
+def oriented_boxes(walls: list[PlanWall], laid: LaidMasonry) -> polyhedra.Polyhedra:
     """The laid blocks: their plans (:func:`plan_corners`) from ``z0`` to ``z1``, eight vertices and six faces
     each (a box, or a prism with a slanted end)."""
     plan = plan_corners(walls, laid)[:, [0, 1, 3, 2]]  # the box template's order: along fastest, then across
@@ -524,7 +524,7 @@ class BuildingPlan(NamedTuple):
     """A ``[building]`` spec read and checked, before anything is laid (what ``load_spec`` validates)."""
 
     top: SpecTable
-    walls: list[Wall]
+    walls: list[PlanWall]
     joins: Junctions
     floors: list[Floor]
     material: Material
@@ -599,7 +599,7 @@ def build_building(spec: dict, text: str) -> xr.Dataset:
     return with_profile(model, profile)
 
 
-def expected_blocks(walls: list[Wall], unit_length: float, unit_height: float) -> float:
+def expected_blocks(walls: list[PlanWall], unit_length: float, unit_height: float) -> float:
     """About how many units and lintels the walls lay (a bound within about twice the count): per course, a leaf's
     row of stretchers on each leaf, and a row of headers where the bond has them."""
     count = 0.0
@@ -611,7 +611,7 @@ def expected_blocks(walls: list[Wall], unit_length: float, unit_height: float) -
     return count
 
 
-def refuse_too_big(walls: list[Wall], unit_length: float, unit_height: float, segment: float, building: SpecTable,
+def refuse_too_big(walls: list[PlanWall], unit_length: float, unit_height: float, segment: float, building: SpecTable,
                    top: SpecTable) -> None:
     """Refuse, before any laying, a building whose blocks and ground segments (counted from its keys) would not fit
     in the memory available (:func:`masonryfw.runtime.inputs.fits_in_memory`), naming the keys that size it."""
@@ -634,7 +634,7 @@ class Floor(NamedTuple):
     load: float
 
 
-def read_floors(building: SpecTable, walls: list[Wall], unit_height: float) -> list[Floor]:
+def read_floors(building: SpecTable, walls: list[PlanWall], unit_height: float) -> list[Floor]:
     """Each ``[[building.floors]]`` on the named walls' course whose top is nearest its height; a
     :class:`SpecError` names a wall that is not there or a height where none of its walls has a course."""
     names = [wall.name for wall in walls]
@@ -653,7 +653,7 @@ def read_floors(building: SpecTable, walls: list[Wall], unit_height: float) -> l
     return floors
 
 
-def add_floors(floors: list[Floor], walls: list[Wall], laid: Laid, unit_height: float) -> None:
+def add_floors(floors: list[Floor], walls: list[PlanWall], laid: LaidMasonry, unit_height: float) -> None:
     """Each floor's line load on its walls' course, a block taking the load on its length and on its share of the
     wall's thickness."""
     for floor in floors:

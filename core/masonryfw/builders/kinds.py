@@ -16,11 +16,11 @@ from ..format.model import checked_model
 from ..format.model3d import twin
 from ..readers.spec import read_spec
 from ..runtime.errors import MasonryError, SpecError
-from .builder import build_parametric, parse_spec
 from .building import build_building, read_building
-from .drawing3d import build_drawn_3d, mesh_path
-from .imported import build_drawn, parse_drawn_spec, resolved_drawing
+from .drawn import build_drawn, parse_drawn_spec, resolved_drawing
+from .drawn3d import build_drawn_3d, mesh_path
 from .outlined import build_outlined, drawing_paths, is_outlined
+from .parametric import build_parametric, parse_spec
 from .plausibility import warn_implausible
 
 if TYPE_CHECKING:  # annotations only
@@ -132,11 +132,11 @@ def build(spec, *, validate: bool = True) -> xr.Dataset:
     """Build the model dataset of a spec (a dict, a path, a Traversable or TOML text).
 
     The spec goes to the first of :data:`SPEC_KINDS` that claims it: a ``[building]`` (:mod:`masonryfw.builders.building`),
-    a 3D drawing (``geometry.mesh``, :mod:`masonryfw.builders.drawing3d`), a wall laid in its outline (a drawing's
+    a 3D drawing (``geometry.mesh``, :mod:`masonryfw.builders.drawn3d`), a wall laid in its outline (a drawing's
     ``outline_layer``, a gable, shaped openings, an English or Flemish bond, a height that is not whole courses:
-    :mod:`masonryfw.builders.outlined`), a drawn wall (any other ``[geometry]``: :mod:`masonryfw.builders.imported`; its drawing's
+    :mod:`masonryfw.builders.outlined`), a drawn wall (any other ``[geometry]``: :mod:`masonryfw.builders.drawn`; its drawing's
     path is relative to the spec file, else to the working folder) or a wall of rectangular units
-    (:mod:`masonryfw.builders.builder`). ``space = 3`` builds a 2D kind's wall one block thick in 3D
+    (:mod:`masonryfw.builders.parametric`). ``space = 3`` builds a 2D kind's wall one block thick in 3D
     (:func:`masonryfw.format.model3d.twin`). Raises :class:`SpecError` naming the key at fault. The model is returned
     checked (:func:`masonryfw.checked_model`), unless ``validate`` is False. Values outside the range of real
     masonry give a :class:`masonryfw.PlausibilityWarning` each (:mod:`masonryfw.builders.plausibility`).

@@ -1,5 +1,5 @@
 """A 3D model of masonry standing on ground blocks that follow a settlement profile: what a building laid from a
-spec (:mod:`masonryfw.builders.building`) and a drawn 3D model (:mod:`masonryfw.builders.drawing3d`) share once their blocks and
+spec (:mod:`masonryfw.builders.building`) and a drawn 3D model (:mod:`masonryfw.builders.drawn3d`) share once their blocks and
 the ground's motions are known.
 
 The masonry comes first, then the ground blocks. A ground block that moves is a moving support carrying the

@@ -48,8 +48,8 @@ from ..runtime.errors import SpecError
 from ..runtime.inputs import fits_in_memory
 from ..runtime.resources import count_text
 from . import blocks
-from .bond import HEADS, PATTERNS, Bond, Head, Laid, lay
-from .supports import profile_supports, read_supports, support_blocks
+from .bond import HEADS, PATTERNS, Bond, Head, LaidWall, lay
+from .supports import profile_supports, read_supports, support_rectangles
 
 if TYPE_CHECKING:  # annotations only
     import xarray as xr
@@ -92,7 +92,7 @@ def _not_whole_courses(height, unit_height) -> bool:
 
 
 @dataclass(frozen=True)
-class Elevation:
+class ElevationToLay:
     """What is laid: the outline and the openings (metres), each opening's head and name."""
 
     outline: Polygon
@@ -126,7 +126,7 @@ def build_outlined(spec_dict: dict, text: str, base_dir: Path | None, validate: 
     else:
         supports = read_supports(top, x0, x1)
     loading, direction = read_loading(top, profile is not None or any(s.kind == "moving" for s in supports))
-    s_x0, s_x1, s_y0, s_y1, described = support_blocks(supports, y0, bond.unit_height)
+    s_x0, s_x1, s_y0, s_y1, described = support_rectangles(supports, y0, bond.unit_height)
     rectangles = [np.array([[a, c], [b, c], [b, d], [a, d]]) for a, b, c, d in zip(s_x0, s_x1, s_y0, s_y1)]
     rings = laid.polygons + rectangles
     roles = np.array(laid.roles + [ROLE["fixed_support"]] * len(rectangles), dtype=np.int8)
@@ -140,7 +140,7 @@ def build_outlined(spec_dict: dict, text: str, base_dir: Path | None, validate: 
     return checked_model(ds, repr(attrs["title"])) if validate else ds
 
 
-def _refuse_too_big(elevation: Elevation, bond: Bond, top: SpecTable) -> None:
+def _refuse_too_big(elevation: ElevationToLay, bond: Bond, top: SpecTable) -> None:
     """Refuse, before any laying, an outline whose units (counted from its extent) would not fit in the memory
     available, naming what sizes it: a drawing in mm read as metres, a unit in the wrong unit."""
     x0, y0, x1, y1 = elevation.outline.bounds
@@ -154,7 +154,7 @@ def _refuse_too_big(elevation: Elevation, bond: Bond, top: SpecTable) -> None:
                    else "are [unit], [wall] and length_unit what was meant?")
 
 
-def _refuse_one_block(laid: Laid, elevation: Elevation) -> None:
+def _refuse_one_block(laid: LaidWall, elevation: ElevationToLay) -> None:
     """A wall of one block is no masonry wall (a unit as large as the outline): refused, not warned."""
     if len(laid.polygons) < 2:
         x0, y0, x1, y1 = elevation.outline.bounds
@@ -171,7 +171,7 @@ def drawing_paths(spec: dict, base_dir: Path | None) -> dict[str, Path]:
     return {k: spec_relative(geometry[k], base_dir) for k in ("dxf", "polygons") if isinstance(geometry.get(k), str)}
 
 
-def _drawn(top: SpecTable, base_dir: Path | None, bond: Bond) -> Elevation:
+def _drawn(top: SpecTable, base_dir: Path | None, bond: Bond) -> ElevationToLay:
     from shapely.geometry import Polygon
 
     geometry = top.sub("geometry", _GEOMETRY_KEYS)
@@ -193,7 +193,7 @@ def _drawn(top: SpecTable, base_dir: Path | None, bond: Bond) -> Elevation:
                            geometry.number("chord_tolerance", None, positive=True))
     heads = _heads(top, len(drawn.openings), bond, _extent(drawn.outline))
     names = [f"openings[{k}] ({source} in {path.name!r})" for k, source in enumerate(drawn.opening_sources)]
-    return Elevation(_valid(Polygon(drawn.outline), f"the outline ({drawn.outline_source} in {path.name!r})"),
+    return ElevationToLay(_valid(Polygon(drawn.outline), f"the outline ({drawn.outline_source} in {path.name!r})"),
                      [_valid(Polygon(o), name) for o, name in zip(drawn.openings, names)],
                      [_arched_default(h, o) for h, o in zip(heads, drawn.openings)], names, path, drawn.notes)
 
@@ -248,7 +248,7 @@ def _valid(polygon: Polygon, name: str) -> Polygon:
 
 # ---------------------------------------------------------------- a parametric outline
 
-def _parametric(top: SpecTable, bond: Bond) -> Elevation:
+def _parametric(top: SpecTable, bond: Bond) -> ElevationToLay:
     from shapely.geometry import Polygon
 
     wall = top.sub("wall", _WALL_KEYS)
@@ -270,7 +270,7 @@ def _parametric(top: SpecTable, bond: Bond) -> Elevation:
     tables = [SpecTable(t, f"openings[{k}]", _OPENING_KEYS, top.scale) for k, t in enumerate(entries)]
     names = [f"spec key {t.path!r}" for t in tables]
     openings = [_valid(_opening(t), name) for t, name in zip(tables, names)]
-    return Elevation(_valid(Polygon(outline), "spec key 'wall.outline'"), openings,
+    return ElevationToLay(_valid(Polygon(outline), "spec key 'wall.outline'"), openings,
                      _heads(top, len(tables), bond, _extent(outline), tables), names, None)
 
 

@@ -50,7 +50,7 @@ def source_path(path_or_name: str | os.PathLike) -> Path:
 def input_files(*names: str | os.PathLike | None) -> list[Path]:
     """The user's files that ``names`` (paths, or bundled case names, as commands take them) stand for, and the
     files those read: a spec and its drawing, a dataset file. A command checks its output against them before
-    its work (:func:`masonryfw.check_output_path`); what it reads later is guarded too (``inputs.guard_reads``)."""
+    its work (:func:`masonryfw.plugin_api.check_output_path`); what it reads later is guarded too (``inputs.guard_reads``)."""
     files = []
     for name in names:
         path = Path(name) if name is not None else None

@@ -1,6 +1,6 @@
 """The supports of a wall the core lays (parametric or by its outline): the ranges of ``[supports.*]`` along its
 base, or the segments of a ``[settlement]`` profile under its bottom course (:mod:`masonryfw.ground.profiles`); each
-a rectangle one course high under the base (:func:`support_blocks`)."""
+a rectangle one course high under the base (:func:`support_rectangles`)."""
 from __future__ import annotations
 
 from dataclasses import replace
@@ -65,7 +65,7 @@ def support_label(name: str) -> str:
     return f"settlement {name}" if name.startswith("segment ") else f"spec key 'supports.{name}'"
 
 
-def support_blocks(supports: tuple[Support, ...], y0: float, height: float):
+def support_rectangles(supports: tuple[Support, ...], y0: float, height: float):
     """``(x0, x1, y0, y1)`` rectangles of the supports under a base at ``y0``, ``height`` deep, and their
     descriptions for :func:`masonryfw.builders.blocks.model_from_blocks`."""
     x0 = np.array([s.extent[0] for s in supports], dtype=float)

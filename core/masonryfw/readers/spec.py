@@ -1,7 +1,7 @@
 """Reading specs: TOML files or text, typed access to their tables, the keys every wall shares, TOML output.
 
-Shared by the parametric builder (:mod:`masonryfw.builders.builder`) and drawn walls
-(:mod:`masonryfw.builders.imported`): ``[material]``, ``[loading]``, a support's
+Shared by the parametric builder (:mod:`masonryfw.builders.parametric`) and drawn walls
+(:mod:`masonryfw.builders.drawn`): ``[material]``, ``[loading]``, a support's
 ``motion``/``pivot``, ``length_unit``. A :class:`SpecError` names the key at fault.
 """
 from __future__ import annotations

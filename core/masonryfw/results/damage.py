@@ -3,7 +3,7 @@ categories and the distortion of the imposed settlement profile.
 
 - **crack width** of a state: the widest opening of a joint *within the masonry*
   (both sides masonry blocks), from the block motions
-  (:func:`masonryfw.relative_motion`). The joint between the wall and the ground
+  (:func:`masonryfw.plugin_api.relative_motion`). The joint between the wall and the ground
   is no crack in the masonry: its widest opening is the **base gap**, reported
   apart. Solvers report per recorded step ``step_crack_width_max``, the joint it
   is at (``step_crack_interface``) and ``step_base_gap_max``

@@ -55,7 +55,8 @@ from ..readers.spec import (
 from ..runtime.errors import SpecError
 from ..runtime.inputs import fits_in_memory
 from . import blocks
-from .supports import Support, profile_supports, read_supports, support_blocks
+from .bond import pattern_cells
+from .supports import Support, profile_supports, read_supports, support_rectangles
 
 if TYPE_CHECKING:  # annotations only
     import xarray as xr
@@ -81,7 +82,7 @@ class Opening:
 
 
 @dataclass(frozen=True)
-class Wall:
+class ParametricWall:
     """A validated spec, every length in metres."""
 
     title: str
@@ -114,7 +115,7 @@ _TOP_KEYS = ("title", "description", "space", "length_unit", "wall", "unit", "bo
 _OPENING_KEYS = ("x", "y", "width", "height", "lintel_bearing")
 
 
-def parse_spec(spec: dict) -> Wall:
+def parse_spec(spec: dict) -> ParametricWall:
     """Validate a spec dict and return it in SI; a :class:`SpecError` names the offending key."""
     top = open_spec(spec, _TOP_KEYS)
     unit_name = top.raw("length_unit", "m")
@@ -140,7 +141,7 @@ def parse_spec(spec: dict) -> Wall:
     supports = () if top.has("settlement") else read_supports(top, 0.0, width)
     kind, direction = read_loading(top, top.has("settlement") or any(s.kind == "moving" for s in supports))
 
-    result = Wall(
+    result = ParametricWall(
         title=top.text("title"),
         description=top.text("description", ""),
         width=width,
@@ -165,7 +166,7 @@ def parse_spec(spec: dict) -> Wall:
                        f"{sized} over {segments:,} ground segments of {table.key('segment')} = "
                        f"{result.profile.segment:.3g} m (about {blocks_expected + segments:.3g} blocks)",
                        "a longer segment")
-        mx0, mx1, my0, _, _ = masonry_blocks(result)
+        mx0, mx1, my0, _, _ = masonry_rectangles(result)
         bottom = my0 <= result.tol
         result = replace(result, supports=profile_supports(result.profile, 0.0, result.width,
                                                            np.c_[mx0[bottom], mx1[bottom]]))
@@ -182,7 +183,7 @@ def _whole_courses(value: float, unit_height: float, key: str, shown) -> int:
     return int(count)
 
 
-def _openings(top: SpecTable, wall: Wall) -> tuple[Opening, ...]:
+def _openings(top: SpecTable, wall: ParametricWall) -> tuple[Opening, ...]:
     entries = top.raw("openings", [])
     if not isinstance(entries, list):
         raise SpecError(f"spec key 'openings' must be an array of tables ([[openings]]), got {entries!r}")
@@ -237,32 +238,32 @@ def _void_boxes(openings):
 # --------------------------------------------------------------------------- geometry
 
 
-def course_starts_full(wall: Wall) -> np.ndarray:
-    """Per course, whether it starts at the left with a full unit."""
-    course = np.arange(wall.courses)
-    first_full = wall.first_course == "full"
-    if wall.pattern == "stack":
-        return np.full(wall.courses, first_full)
-    return (course % 2 == 0) == first_full
+def first_joints(wall: ParametricWall) -> np.ndarray:
+    """Per course, its first head joint from the wall's left end: the bond's one definition of where a course
+    starts (:func:`masonryfw.builders.bond.pattern_cells`: a half unit in, or a full one)."""
+    return np.array([pattern_cells(course, wall.pattern, wall.unit_length, wall.unit_length, wall.first_course)[0]
+                     or wall.unit_length for course in range(wall.courses)])
 
 
-def _bond_joints(wall: Wall, start_full: bool) -> np.ndarray:
-    """Head-joint positions of one course, wall ends included."""
-    first = wall.unit_length if start_full else 0.5 * wall.unit_length
+def _bond_joints(wall: ParametricWall, first: float) -> np.ndarray:
+    """Head-joint positions of a course whose first joint is at ``first``, wall ends included: the pattern's
+    cells of one unit (running and stack bond) repeated across the width."""
     count = max(0, math.ceil((wall.width - wall.tol - first) / wall.unit_length))
     inner = first + wall.unit_length * np.arange(count)
     inner = inner[inner < wall.width - wall.tol]
     return np.concatenate(([0.0], inner, [wall.width]))
 
 
-def _course_breakpoints(wall: Wall):
-    """Sorted breakpoints ``(course, x, is_head_joint)`` of all courses: head joints and cut edges."""
-    starts_full = course_starts_full(wall)
+def _course_breakpoints(wall: ParametricWall):
+    """Sorted breakpoints ``(course, x, is_head_joint)`` of all courses: head joints and cut edges. The fast
+    path of a rectangular wall in running or stack bond (the other bonds and outlines are laid by
+    :func:`masonryfw.builders.bond.lay`): the courses that start alike share one row of joints."""
+    first_joint = first_joints(wall)
     courses = np.arange(wall.courses)
     xs, cs, joint = [], [], []
-    for full in (True, False):
-        rows = courses[starts_full == full]
-        line = _bond_joints(wall, full)
+    for first in np.unique(first_joint)[::-1]:
+        rows = courses[first_joint == first]
+        line = _bond_joints(wall, float(first))
         xs.append(np.tile(line, rows.size))
         cs.append(np.repeat(rows, line.size))
         inner = np.ones(line.size, dtype=bool)
@@ -298,7 +299,7 @@ def _in_voids(course, x0, x1, voids) -> np.ndarray:
     return np.any((mid > vx0) & (mid < vx1) & (row >= vc0) & (row < vc1), axis=1)
 
 
-def unit_rectangles(wall: Wall):
+def unit_rectangles(wall: ParametricWall):
     """``(course, x0, x1)`` of every unit after the bond, the cuts and the sliver merging."""
     c, x, joint = _course_breakpoints(wall)
     voids = _void_boxes(wall.openings)[:4]
@@ -322,7 +323,7 @@ def unit_rectangles(wall: Wall):
         c, x, joint = c[keep], x[keep], joint[keep]
 
 
-def masonry_blocks(wall: Wall):
+def masonry_rectangles(wall: ParametricWall):
     """``(x0, x1, y0, y1, role)`` of units and lintels, course by course, left to right."""
     course, x0, x1 = unit_rectangles(wall)
     lintels = [o for o in wall.openings if o.lintel_bearing > 0]
@@ -344,8 +345,8 @@ def masonry_blocks(wall: Wall):
 def build_parametric(spec_dict: dict, text: str, validate: bool = True) -> xr.Dataset:
     """The model of a wall of rectangular units (module docstring); checked unless ``validate`` is False."""
     wall = parse_spec(spec_dict)
-    mx0, mx1, my0, my1, m_role = masonry_blocks(wall)
-    s_x0, s_x1, s_y0, s_y1, supports = support_blocks(wall.supports, 0.0, wall.unit_height)
+    mx0, mx1, my0, my1, m_role = masonry_rectangles(wall)
+    s_x0, s_x1, s_y0, s_y1, supports = support_rectangles(wall.supports, 0.0, wall.unit_height)
     x0, x1 = np.concatenate((mx0, s_x0)), np.concatenate((mx1, s_x1))
     y0, y1 = np.concatenate((my0, s_y0)), np.concatenate((my1, s_y1))
     role = np.concatenate((m_role, np.full(s_x0.size, ROLE["fixed_support"], dtype=np.int8)))

@@ -1,5 +1,5 @@
 """Walls and buildings drawn in 3D: a spec whose ``[geometry]`` points at an OBJ ``mesh`` of closed polyhedra,
-one per block (:mod:`masonryfw.readers.mesh_drawing`), standing on ground made under them that follows a settlement
+one per block (:mod:`masonryfw.readers.drawing3d`), standing on ground made under them that follows a settlement
 profile in plan (docs/import.md, "3D drawings")::
 
     space = 3
@@ -34,17 +34,17 @@ from ..geometry.polygons import block_offsets
 from ..ground.ground_plan import SETTLEMENT_3D_KEYS, GroundInPlan, profile_in_plan
 from ..ground.profiles import with_profile
 from ..readers.drawing import DRAWING_UNITS
-from ..readers.mesh_drawing import MeshDrawing, read_obj
+from ..readers.drawing3d import MeshDrawing, read_obj
 from ..readers.spec import SpecTable, model_attributes, open_spec, read_material, spec_relative
 from ..runtime.errors import SpecError
 from ..runtime.inputs import InputError, regular_file
-from .imported import LAYER_ROLES as DRAWN_LAYER_ROLES
+from .drawn import LAYER_ROLES
 from .on_ground import model_on_ground, plane_motion
 
 GEOMETRY_KEYS = ("mesh", "drawing_unit", "snap_tolerance", "ground_depth", "layers")
 TOP_KEYS = ("title", "description", "space", "length_unit", "geometry", "material", "settlement")
 #: A layer's role (the 2D drawings' names) as the block role it gives; -1 leaves its blocks out.
-LAYER_ROLES = {name: ROLE.get(name, -1) for name in DRAWN_LAYER_ROLES}
+LAYER_ROLE_CODES = {name: ROLE.get(name, -1) for name in LAYER_ROLES}
 
 
 def is_drawn_3d(spec: dict) -> bool:
@@ -128,13 +128,13 @@ def _layer_roles(geometry: SpecTable, drawing: MeshDrawing) -> np.ndarray:
     if not isinstance(table, dict):
         raise SpecError(f"spec key 'geometry.layers' = {table!r}: must be a table of layer = role")
     for layer, role in table.items():
-        if role not in LAYER_ROLES:
+        if role not in LAYER_ROLE_CODES:
             raise SpecError(f"spec key 'geometry.layers.{layer}' = {role!r}: must be one of "
-                            f"{', '.join(map(repr, LAYER_ROLES))}")
+                            f"{', '.join(map(repr, LAYER_ROLE_CODES))}")
         if layer not in drawing.layers:
             raise SpecError(f"spec key 'geometry.layers.{layer}': no block of the drawing is on that layer (its "
                             f"layers: {', '.join(sorted(set(drawing.layers)))})")
-    roles = np.array([LAYER_ROLES[table.get(layer, "unit")] for layer in drawing.layers])
+    roles = np.array([LAYER_ROLE_CODES[table.get(layer, "unit")] for layer in drawing.layers])
     if not (roles >= 0).any():
         raise SpecError("spec key 'geometry.layers': every block of the drawing is left out")
     return roles

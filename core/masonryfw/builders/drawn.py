@@ -268,7 +268,7 @@ def _masonry_roles(spec: DrawnSpec, drawing: Drawing, masonry: np.ndarray) -> li
 def _drawn_supports_model(spec: DrawnSpec, drawing: Drawing, kept: np.ndarray, path: Path,
                           attrs: dict) -> tuple[xr.Dataset, list[str]]:
     """The model of a wall on its drawn supports (``[supports.*]``) and the drawing entity of every block."""
-    chosen = _support_blocks(spec, drawing, kept)
+    chosen = _chosen_supports(spec, drawing, kept)
     supports_of = np.full(len(drawing.layers), -1)
     for index, members in enumerate(chosen):
         supports_of[members] = index
@@ -386,7 +386,7 @@ def _ground_blocks(table: SpecTable, drawing: Drawing, kept: np.ndarray) -> np.n
     return best
 
 
-def _support_blocks(spec: DrawnSpec, drawing: Drawing, kept: np.ndarray) -> list[np.ndarray]:
+def _chosen_supports(spec: DrawnSpec, drawing: Drawing, kept: np.ndarray) -> list[np.ndarray]:
     """The drawing's blocks of every support, in spec order; a selection matching nothing or twice is refused."""
     xmin, xmax, ymin, _ = block_bounds(drawing.node_x, drawing.node_y, drawing.block_node_count)
     taken = np.full(kept.size, -1)
