@@ -75,7 +75,7 @@ def blocks_of(model):
     """Every masonry block as a shapely polygon, with its role."""
     rings = np.split(np.c_[model.node_x.values, model.node_y.values],
                      mfp.block_offsets(model.block_node_count.values)[1:-1])
-    masonry = mfp.masonry_rectangles(model.block_role.values)
+    masonry = mfp.masonry_blocks(model.block_role.values)
     return [Polygon(r) for r, m in zip(rings, masonry) if m], model.block_role.values[masonry]
 
 
