@@ -1,0 +1,125 @@
+"""fdem's 3D kernels (rigid polyhedra, face-pair contacts, exact rotations) against closed forms: a block at rest
+on a base (reaction and penetration), sliding down an incline at ``g (sin theta - mu cos theta)`` and held below
+the friction angle, tipping over an edge once the sideways load passes ``b / h`` of its weight, and the
+torque-free precession of a symmetric top. Units are the kernels' own: g = 1, unit weight 1 a volume."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import masonryfw.plugin_api as mfp
+from masonryfw_fdem import kernels3d as k3
+from masonryfw_fdem import scene3d as s3
+
+KN = 1e4  # normal stiffness per area: a unit cube of weight 1 sinks 1e-4
+BUFFER = 0.05
+MIN_COS = np.cos(np.radians(30.0))
+
+
+def block_on_base(size=(1.0, 1.0, 1.0), base=(8.0, 8.0)):
+    """A free box of ``size`` standing centred on a fixed base slab 0.5 thick."""
+    bx, by = base
+    sx, sy, sz = size
+    poly = mfp.boxes(np.array([[-bx / 2, -by / 2, -0.5], [-sx / 2, -sy / 2, 0.0]]),
+                     np.array([[bx / 2, by / 2, 0.0], [sx / 2, sy / 2, sz]]))
+    return s3.bodies_of(poly, np.array([0.0, 1.0]), np.array([True, False]), np.zeros(2, bool), np.zeros((2, 6)))
+
+
+def run(bodies, load, friction, steps, dt=1e-3, damping=0.0, dashpot=0.2, ramp=0.0):
+    """``steps`` steps from rest under ``load`` (block, 6; ramped in over ``ramp``) on joints of ``friction``, face
+    pairs found again whenever the kernel asks; returns the motion, the last pairs and the wrench on the
+    supports."""
+    motion = s3.at_rest(bodies)
+    law = k3.ContactLaw3(KN, 0.5 * KN, 1e-12, dashpot)
+    loading = k3.Loading3(load, ramp, 0.0, 0.0, 0.0, 0.0)
+    stepping = k3.Stepping3(dt, damping, 0.5 * BUFFER)
+    pairs, wrench, left = None, np.zeros((bodies.pos0.shape[0], 6)), steps
+    while left > 0:
+        faces = s3.face_pairs(bodies, motion, BUFFER, 0.2, MIN_COS)
+        pairs = s3.new_pairs(bodies, faces, np.tile([friction, 0.0, 0.0], (len(faces), 1)), np.zeros(len(faces)),
+                             pairs)
+        done, rebuild, *_ = k3.advance3(left, bodies, pairs, law, motion, loading, stepping, wrench)
+        left -= done
+        motion.pos_detect[:] = motion.pos
+        motion.quat_detect[:] = motion.quat
+    return motion, pairs, wrench
+
+
+def weight_load(bodies, tilt=0.0, sideways=0.0):
+    """The blocks' weight, turned ``tilt`` radians about y (an incline), plus ``sideways`` of it along x."""
+    load = np.zeros((bodies.pos0.shape[0], 6))
+    load[:, 0] = bodies.mass * (np.sin(tilt) + sideways)
+    load[:, 2] = -bodies.mass * np.cos(tilt)
+    return load
+
+
+def test_a_block_at_rest_presses_its_weight_into_the_base_with_the_closed_form_penetration():
+    bodies = block_on_base()
+    motion, pairs, wrench = run(bodies, weight_load(bodies), 0.6, 4000, damping=0.8)
+    assert wrench[0, 2] == pytest.approx(-1.0, rel=1e-9)  # the block's whole weight on the support
+    assert np.count_nonzero(pairs.keys[0] >= 0) == 4  # the four corners of its base
+    assert pairs.normal[0][pairs.keys[0] >= 0] == pytest.approx(np.full(4, 0.25), rel=1e-9)
+    assert 0.0 - (motion.pos[1, 2] - 0.5) == pytest.approx(1.0 / KN, rel=1e-6)  # W / (kn A)
+    assert np.abs(motion.pos[1, :2]).max() < 1e-12
+
+
+@pytest.mark.parametrize("tilt_deg", [25.0, 35.0])
+def test_a_block_slides_down_an_incline_at_the_coulomb_acceleration(tilt_deg):
+    """On an incline steeper than the friction angle the block accelerates at ``g (sin theta - mu cos theta)``
+    (no damping), measured between 0.5 and 1.5 time units (the normal force builds up over the first hundredth)."""
+    bodies, mu, dt = block_on_base(), 0.3, 1e-3
+    theta = np.radians(tilt_deg)
+    early, _, _ = run(bodies, weight_load(bodies, theta), mu, 500, dt=dt)
+    late, _, _ = run(bodies, weight_load(bodies, theta), mu, 1500, dt=dt)
+    acceleration = (late.vel[1, 0] - early.vel[1, 0]) / (1000 * dt)
+    assert acceleration == pytest.approx(np.sin(theta) - mu * np.cos(theta), rel=2e-3)
+    assert abs(late.vel[1, 1]) < 1e-9 * late.vel[1, 0]
+    assert np.abs(late.omega[1]).max() < 1e-6
+
+
+def test_a_block_holds_on_an_incline_below_the_friction_angle():
+    """Below the friction angle the block moves by the give of its springs, then stays (no creep)."""
+    bodies = block_on_base()
+    early, _, _ = run(bodies, weight_load(bodies, np.radians(15.0)), 0.3, 1500, damping=0.3)
+    late, _, _ = run(bodies, weight_load(bodies, np.radians(15.0)), 0.3, 3000, damping=0.3)
+    assert abs(late.pos[1, 0]) < 1e-3
+    assert abs(late.pos[1, 0] - early.pos[1, 0]) < 1e-8
+    assert abs(late.vel[1, 0]) < 1e-8
+
+
+@pytest.mark.parametrize(("share", "tips"), [(0.9, False), (1.1, True)])
+def test_a_slender_block_tips_over_its_edge_once_the_sideways_load_passes_b_over_h(share, tips):
+    """A block b wide and h high under a sideways load lambda W (friction high enough not to slide) stays while
+    lambda < b / h and turns about its edge beyond."""
+    b, h = 0.5, 1.5
+    bodies = block_on_base((b, 1.0, h))
+    motion, _, _ = run(bodies, weight_load(bodies, sideways=share * b / h), 0.9, 4000, damping=0.3, ramp=1.0)
+    angle = k3.rotation_angle(motion.quat[1], np.array([1.0, 0.0, 0.0, 0.0]))
+    assert (angle > 0.05) == tips, angle
+    if not tips:
+        assert angle < 5e-3 and abs(motion.pos[1, 0]) < 1e-3
+    else:
+        assert motion.omega[1, 1] > 0.0 and abs(motion.omega[1, 0]) + abs(motion.omega[1, 2]) < 1e-6
+
+
+def test_a_free_symmetric_top_keeps_its_angular_momentum_and_precesses_at_l_over_i1():
+    """No contact, no load: the angular momentum stays (world frame) and the symmetry axis turns about it at
+    ``|L| / I1`` (I1 the inertia about a transverse axis)."""
+    poly = mfp.boxes(np.array([[-0.5, -0.5, -1.0]]), np.array([[0.5, 0.5, 1.0]]))
+    bodies = s3.bodies_of(poly, np.array([1.0]), np.array([False]), np.zeros(1, bool), np.zeros((1, 6)))
+    motion = s3.at_rest(bodies)
+    motion.omega[0] = (0.6, 0.0, 2.0)
+    pairs = s3.new_pairs(bodies, np.zeros((0, 2), dtype=np.int64), np.zeros((0, 3)), np.zeros(0))
+    momentum = bodies.inertia[0] @ motion.omega[0]
+    steps, dt = 20000, 1e-4
+    k3.advance3(steps, bodies, pairs, k3.ContactLaw3(KN, KN, 0.0, 0.0), motion,
+                k3.Loading3(np.zeros((1, 6)), 0.0, 0.0, 0.0, 0.0, 0.0), k3.Stepping3(dt, 0.0, 1e9), np.zeros((1, 6)))
+    r = k3.rotation_matrix(motion.quat[0])
+    after = r @ bodies.inertia[0] @ r.T @ motion.omega[0]
+    assert np.linalg.norm(after - momentum) < 1e-3 * np.linalg.norm(momentum)
+    axis, along = r[:, 2], momentum / np.linalg.norm(momentum)
+    across0 = np.array([0.0, 0.0, 1.0]) - along[2] * along
+    across = axis - (axis @ along) * along
+    turned = np.arctan2(np.cross(across0, across) @ along, across0 @ across)
+    expected = np.linalg.norm(momentum) / bodies.inertia[0][0, 0] * steps * dt
+    assert np.mod(turned, 2 * np.pi) == pytest.approx(np.mod(expected, 2 * np.pi), abs=2e-3)
