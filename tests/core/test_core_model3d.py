@@ -138,3 +138,29 @@ def test_the_supports_carry_the_masonry_the_house_weighs():
     load = -model.dead_load.values[masonry].sum(axis=0)
     np.testing.assert_allclose(reaction.sum(axis=0), load, atol=1e-7 * abs(load[2]))
     assert np.abs(reaction[masonry]).max() == 0.0
+
+
+def test_a_finite_motion_opens_the_3d_twin_at_its_vertices_as_it_opens_the_plane_at_its_ends():
+    """Block motions with finite rotations (to 0.3 rad) of a planar wall and the same motions of its 3D twin
+    (x, z in the plane, the rotation about -y): every interface opens and slips as much at its vertices (the
+    rotation vector's Rodrigues matrix) as the planar one at its ends (the planar finite motion), and the
+    widest crack is the same joint, as wide."""
+    from masonryfw.results.semantics3d import padded, vertex_motion
+
+    planar = mf.open_model("panel-5")
+    twin = mf.checked_model(mfp.twin(planar))
+    u = np.random.default_rng(5).normal(scale=[0.01, 0.01, 0.1], size=(planar.sizes["block"], 3))
+    u3 = np.c_[u[:, 0], np.zeros(len(u)), u[:, 1], np.zeros(len(u)), -u[:, 2], np.zeros(len(u))]
+    opening, slip = mfp.relative_motion(planar, u, "finite")
+    count = twin.interface_node_count.values.astype(np.int64)
+    opening_3d, slip_3d = (padded(v, count) for v in vertex_motion(twin, u3, "finite"))
+    index = {tuple(sorted(p)): i for i, p in enumerate(twin.interface_blocks.values.tolist())}
+    same = np.array([index[tuple(sorted(p))] for p in planar.interface_blocks.values.tolist()])
+    scale = np.abs(opening).max()
+    np.testing.assert_allclose(np.sort(opening_3d[same], axis=1)[:, [0, -1]],
+                               np.sort(opening, axis=1), atol=1e-12 * scale)
+    np.testing.assert_allclose(np.abs(slip_3d[same]).max(axis=1), np.abs(slip).max(axis=1), atol=1e-12 * scale)
+    a, b = mf.widest_crack(planar, u, "finite"), mf.widest_crack(twin, u3, "finite")
+    assert b.width == pytest.approx(a.width, rel=1e-12) and a.width > 0.01
+    assert same[a.interface] == b.interface
+    assert b.base_gap == pytest.approx(a.base_gap, rel=1e-12)

@@ -44,11 +44,13 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ..format.model3d import space
 from ..format.roles import masonry_blocks, support_blocks
 from ..format.schema import variable_attrs
 from ..ground.assessment import ltsm_thresholds, ltsm_variables, screen_threshold, volume_loss_per_settlement
 from ..runtime.errors import SolveError
 from .semantics import relative_motion
+from .semantics3d import padded, vertex_motion
 
 if TYPE_CHECKING:  # annotations only
     import xarray as xr
@@ -78,8 +80,13 @@ class Cracks:
 
 
 def widest_crack(model: xr.Dataset, u: np.ndarray, rotations: str = "finite") -> Cracks:
-    """The widest crack in the masonry and the widest base gap under block motions ``u`` (block, 3)."""
-    opening, _ = relative_motion(model, u, rotations)
+    """The widest crack in the masonry and the widest base gap under block motions ``u`` (block, 3; a 3D model's
+    (block, 6), its openings at the interfaces' vertices: :func:`masonryfw.results.semantics3d.vertex_motion`)."""
+    if space(model) == 3:
+        vertex_opening, _ = vertex_motion(model, u, rotations)
+        opening = padded(vertex_opening, model.interface_node_count.values.astype(np.int64))
+    else:
+        opening, _ = relative_motion(model, u, rotations)
     opening = np.maximum(opening, 0.0).max(axis=1, initial=0.0)
     masonry = masonry_blocks(model.block_role.values)[model.interface_blocks.values.astype(np.int64)]
     inside, base = masonry.all(axis=1), masonry.any(axis=1) & ~masonry.all(axis=1)

@@ -27,9 +27,23 @@ from .semantics import (
 )
 
 
-def vertex_motion(model: xr.Dataset, u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Opening and slip ``(interface_node,)`` of block motions ``u`` ``(block, 6)`` (side 1 minus side 0), by the
-    linearised rigid motion ``u_c + r x (p - c)`` (a mechanism)."""
+def rotation_matrices(rotation: np.ndarray) -> np.ndarray:
+    """``(k, 3, 3)``: the rotations of the rotation vectors ``(k, 3)`` (axis times angle; Rodrigues' formula)."""
+    rotation = np.asarray(rotation, dtype=float).reshape(-1, 3)
+    angle = np.linalg.norm(rotation, axis=1)
+    axis = rotation / np.where(angle > 0, angle, 1.0)[:, None]
+    cross = np.zeros((rotation.shape[0], 3, 3))
+    cross[:, 0, 1], cross[:, 0, 2], cross[:, 1, 2] = -axis[:, 2], axis[:, 1], -axis[:, 0]
+    cross -= cross.transpose(0, 2, 1)
+    sin, cos = np.sin(angle)[:, None, None], np.cos(angle)[:, None, None]
+    return np.eye(3) + sin * cross + (1.0 - cos) * cross @ cross
+
+
+def vertex_motion(model: xr.Dataset, u: np.ndarray, rotations: str = "small") -> tuple[np.ndarray, np.ndarray]:
+    """Opening and slip ``(interface_node,)`` of block motions ``u`` ``(block, 6)`` (side 1 minus side 0): by the
+    linearised rigid motion ``u_c + r x (p - c)`` of a mechanism (``rotations = "small"``), or by the finite one
+    ``u_c + (R(r) - I)(p - c)`` of a displacement whose rotation vector is ``r`` (``"finite"``); measured along
+    the interface's normal and in its plane as the model has them."""
     count = model.interface_node_count.values.astype(np.int64)
     points = interface_points(model)
     normal = np.c_[model.interface_normal_x.values, model.interface_normal_y.values, model.interface_normal_z.values]
@@ -37,7 +51,14 @@ def vertex_motion(model: xr.Dataset, u: np.ndarray) -> tuple[np.ndarray, np.ndar
     sides = model.interface_blocks.values.astype(np.int64)[owner]
     centroid = np.c_[model.block_centroid_x.values, model.block_centroid_y.values, model.block_centroid_z.values]
     u = np.asarray(u, dtype=float)
-    moved = [u[sides[:, k], :3] + np.cross(u[sides[:, k], 3:], points - centroid[sides[:, k]]) for k in (0, 1)]
+    turning = rotation_matrices(u[:, 3:]) if rotations == "finite" else None
+    moved = []
+    for k in (0, 1):
+        arm = points - centroid[sides[:, k]]
+        if turning is None:
+            moved.append(u[sides[:, k], :3] + np.cross(u[sides[:, k], 3:], arm))
+        else:
+            moved.append(u[sides[:, k], :3] + np.einsum("pij,pj->pi", turning[sides[:, k]], arm) - arm)
     relative = moved[1] - moved[0]
     n = normal[owner]
     opening = np.einsum("pd,pd->p", relative, n)
@@ -57,11 +78,10 @@ def padded(values: np.ndarray, count: np.ndarray) -> np.ndarray:
 def derived_variables_3d(model: xr.Dataset, u: np.ndarray, rotations: str, flow_rule: str,
                          share: float = CRACK_THRESHOLD) -> dict[str, tuple]:
     """The comparable result variables of block motions ``u`` (block, 6) on a 3D ``model`` (derived geometry): a
-    mechanism's (``rotations = "small"``; finite rotations in 3D are refused until a solver returns them)."""
-    if rotations != "small":
-        raise SolveError(f"rotations = {rotations!r} in 3D: the comparable fields of finite 3D motions are not "
-                         "derived yet (a mechanism's, rotations = 'small', are)")
-    opening, slip = vertex_motion(model, u)
+    mechanism's (``rotations = "small"``) or a displacement's (``"finite"``, the rotation a rotation vector)."""
+    if rotations not in ("small", "finite"):
+        raise SolveError(f"rotations = {rotations!r}: must be 'small' or 'finite'")
+    opening, slip = vertex_motion(model, u, rotations)
     count = model.interface_node_count.values.astype(np.int64)
     opening_2d, slip_2d = padded(opening, count), padded(slip, count)
     motion = joint_motion(opening_2d, slip_2d)
