@@ -27,5 +27,6 @@ def masonryfw_solvers():
             options=OPTIONS,
             estimate=mfp.lazy("masonryfw_fdem.estimate:estimate"),
             history=True,
+            spaces=(2, 3),
         )
     ]

@@ -11,6 +11,7 @@ import numpy as np
 
 from .costs import call_steps
 from .scene import Scene
+from .scene3d import Scene3
 from .threads import Threads
 
 
@@ -61,38 +62,21 @@ SEARCH_TRIAL_TIME = 20.0
 GRAVITY_TIME = 0.4
 
 
-def critical_time_step(scene: Scene, kn: float) -> float:
-    """2 / omega_max, omega^2 bounded per free block by the stiffness of springs all round
-    its perimeter: kn P / m in translation, kn P R^2 / I in rotation."""
-    free = ~scene.driven
-    translation = kn * scene.perimeter[free] / scene.mass[free, 0]
-    rotation = kn * scene.perimeter[free] * scene.radius[free] ** 2 / scene.mass[free, 2]
-    omega = np.sqrt(max(translation.max(initial=0.0), rotation.max(initial=0.0)))
-    return 2.0 / omega if omega > 0 else np.inf
-
-
-def masonry_height(scene: Scene) -> float:
-    """Height of the masonry (non-dimensional): top of the highest minus bottom of the lowest free block."""
-    y = scene.pos0[:, 1][np.repeat(np.arange(scene.driven.size), np.diff(scene.offs))] + scene.ly
-    free_nodes = ~np.repeat(scene.driven, np.diff(scene.offs))
-    return float(np.ptp(y[free_nodes]))
-
-
 #: The reaction plateau that stops a run when the target is not the model's own (share of the dead reaction).
 PLATEAU_TOLERANCE = 0.005
 
 
-def target_settlement(scene: Scene, options: Mapping[str, Any]) -> float:
+def target_settlement(scene: Scene | Scene3, options: Mapping[str, Any]) -> float:
     """The settlement a run goes to [m]: the option, else the model's settlement_target, else a share of the
     masonry height."""
     if options["settlement"] is not None:
         return options["settlement"]
     if "settlement_target" in scene.model:
         return float(scene.model.settlement_target.values)
-    return options["settlement_ratio"] * masonry_height(scene) * scene.scales.length
+    return options["settlement_ratio"] * scene.masonry_height() * scene.scales.length
 
 
-def plateau_tolerance(scene: Scene, options: Mapping[str, Any]) -> float:
+def plateau_tolerance(scene: Scene | Scene3, options: Mapping[str, Any]) -> float:
     """The option, else none when the run goes to the model's settlement_target (the damage there is the
     answer), else :data:`PLATEAU_TOLERANCE`."""
     if options["plateau_tolerance"] is not None:
@@ -100,16 +84,15 @@ def plateau_tolerance(scene: Scene, options: Mapping[str, Any]) -> float:
     return 0.0 if options["settlement"] is None and "settlement_target" in scene.model else PLATEAU_TOLERANCE
 
 
-def make_controls(scene: Scene, options: Mapping[str, Any]) -> Controls:
+def make_controls(scene: Scene | Scene3, options: Mapping[str, Any]) -> Controls:
     length, force = scene.scales.length, scene.scales.force
     if options["contact_stiffness"] is not None:
         kn = options["contact_stiffness"] * length**2 / force
     else:
-        base_pressure = 1.0 / scene.support_length
-        kn = base_pressure / (options["penetration_ratio"] * scene.unit_height)
-    dt_critical = critical_time_step(scene, kn)
+        kn = scene.base_pressure / (options["penetration_ratio"] * scene.unit_height)
+    dt_critical = scene.critical_time_step(kn)
     dt = options["dt_safety"] * dt_critical
-    height = masonry_height(scene)
+    height = scene.masonry_height()
     target = target_settlement(scene, options) / length
     rate = options["loading_rate"] * np.sqrt(height)
     target_time = target / rate if rate > 0 else 0.0
@@ -131,7 +114,7 @@ def make_controls(scene: Scene, options: Mapping[str, Any]) -> Controls:
         rest_tolerance=options["rest_tolerance"],
         max_steps=options["max_steps"],
         record_steps=record_steps,
-        call_steps=call_steps(scene.driven.size),
+        call_steps=call_steps(scene.driven.size, polyhedra=scene.DOFS == 6),
         threads=Threads.chosen(options["threads"], scene.driven.size, numba.config.NUMBA_NUM_THREADS),
         buffer=options["buffer_ratio"] * scene.unit_height,
         max_penetration=0.25 * scene.unit_height,
@@ -152,6 +135,6 @@ def make_controls(scene: Scene, options: Mapping[str, Any]) -> Controls:
     )
 
 
-def searches(scene: Scene, options: Mapping[str, Any]) -> bool:
+def searches(scene: Scene | Scene3, options: Mapping[str, Any]) -> bool:
     """The load-factor search runs when load_factor is auto, no support moves and the masonry has a live load."""
     return options["load_factor"] is None and not scene.moving.any() and bool(np.any(scene.live != 0))

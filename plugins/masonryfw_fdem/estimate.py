@@ -23,8 +23,8 @@ import xarray as xr
 import masonryfw.plugin_api as mfp
 
 from .controls import make_controls
-from .costs import DEFORMABLE_FACTOR, STEP_SECONDS_PER_BLOCK
-from .scene import build_scene
+from .costs import DEFORMABLE_FACTOR, POLYHEDRA_FACTOR, STEP_SECONDS_PER_BLOCK
+from .scene3d import scene_of
 
 PARALLEL_EFFICIENCY = 0.55  # two threads 1.53x one on the 2,432-block wall (2026-11-27 evening; 1.59x on Facade 3)
 BASE_MEMORY = 250 * 2**20
@@ -32,7 +32,7 @@ MEMORY_PER_BLOCK = 20e3
 
 
 def estimate(model: xr.Dataset, options: Mapping[str, Any]) -> mfp.Estimate:
-    scene = mfp.made_once(model, "fdem scene", build_scene)
+    scene = scene_of(model)
     controls = make_controls(scene, options)
     blocks = model.sizes["block"]
     steps = controls.gravity_steps_expected + (controls.target / (controls.rate * controls.dt) if controls.rate > 0 else 0.0)
@@ -41,7 +41,7 @@ def estimate(model: xr.Dataset, options: Mapping[str, Any]) -> mfp.Estimate:
     else:
         count = controls.threads.current
         seconds = steps * blocks * STEP_SECONDS_PER_BLOCK / (1 + PARALLEL_EFFICIENCY * (count - 1)) \
-            / mfp.core_share(mfp.cores(), mfp.machine_load())
+            / mfp.core_share(mfp.cores(), mfp.machine_load()) * (POLYHEDRA_FACTOR if scene.DOFS == 6 else 1.0)
     return mfp.Estimate(seconds=seconds, memory=BASE_MEMORY + MEMORY_PER_BLOCK * blocks,
                        basis=f"{mfp.count_text(steps)} time steps, of {blocks:,} blocks, as fitted on the 2-core machine "
                              "of docs/benchmarks.md",

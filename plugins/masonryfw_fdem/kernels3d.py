@@ -9,9 +9,10 @@ onto that plane and the projection of ``fa`` is clipped by that of ``fb`` (Suthe
 overlap polygon. Each of its vertices is a contact point with a tributary area (half of each triangle of the fan
 from the polygon's centre that it bounds, so the points of a face pair share its overlap area and its stiffness
 grows with the overlap), and its gap is the distance along ``n`` between the two faces' planes there (negative:
-penetration). A vertex is named by the two lines it lies on (edges of ``fa`` or of ``fb``): the name holds while
-the faces slide, so a point's history (shear spring, bond) follows it from step to step, as the two ends of a 2D
-face pair keep theirs. A block that rocks about an edge keeps its points along that edge, a corner on a face the
+penetration). A point keeps its history (shear spring, bond) from step to step as the two ends of a 2D face pair
+keep theirs: it is the last step's point nearest to it in block A's frame (within a tenth of the pair's overlap
+size, each old point taken once). Names by the edges a vertex lies on would not do: aligned blocks have faces
+whose edges coincide, and round-off then picks either edge from one step to the next. A block that rocks about an edge keeps its points along that edge, a corner on a face the
 point at that corner; faces up to ``acos(min_cos)`` apart still pair, so a rotated block does not pass through.
 
 Rotations are integrated exactly: a block's orientation is a unit quaternion, turned each step by the rotation
@@ -22,6 +23,7 @@ from __future__ import annotations
 from typing import NamedTuple
 
 import numpy as np
+from numba import prange
 
 from .kernels import (
     DISSIPATED_DAMPING,
@@ -31,12 +33,16 @@ from .kernels import (
     WORK_GRAVITY,
     WORK_SUPPORT,
     jit,
+    pjit,
     settlement_rate,
     smooth_share,
 )
 
 #: The most vertices a face may have (a face pair's overlap has at most the sum of its faces').
 MAX_FACE_VERTICES = 32
+#: A vertex within this share of a clipping edge's length of its line is on it (inside): the faces of aligned
+#: blocks have edges that coincide, which round-off would otherwise cut anywhere along their length.
+ON_LINE = 1e-9
 
 
 class Bodies3(NamedTuple):
@@ -64,12 +70,14 @@ class Bodies3(NamedTuple):
 
 class Pairs3(NamedTuple):
     """The face pairs (pair, 2: face of A, face of B), their properties (pair, 3: friction coefficient, cohesion
-    and tensile strength per area) and their points' histories (pair, point): each point's name (-1: none), shear
-    spring force (pair, point, 3), bond and normal force."""
+    and tensile strength per area) and their points' histories (pair, point): whether each slot holds a point
+    (1; 0: none; -1 in every slot of a pair that never had one), its place in block A's frame (pair, point, 3),
+    its shear spring force (pair, point, 3), bond and normal force."""
 
     faces: np.ndarray
     props: np.ndarray
-    keys: np.ndarray
+    held: np.ndarray
+    points: np.ndarray
     shear: np.ndarray
     bonded: np.ndarray
     normal: np.ndarray
@@ -123,22 +131,46 @@ class Stepping3(NamedTuple):
 # ----------------------------------------------------------------------------------------------- rotations
 
 @jit
-def quat_multiply(a, b):
-    """The quaternion product ``a b`` (the rotation ``b`` first, then ``a``)."""
-    return np.array([a[0] * b[0] - a[1] * b[1] - a[2] * b[2] - a[3] * b[3],
-                     a[0] * b[1] + a[1] * b[0] + a[2] * b[3] - a[3] * b[2],
-                     a[0] * b[2] - a[1] * b[3] + a[2] * b[0] + a[3] * b[1],
-                     a[0] * b[3] + a[1] * b[2] - a[2] * b[1] + a[3] * b[0]])
+def quat_of_rotation(rx, ry, rz):
+    """The unit quaternion ``(w, x, y, z)`` of the rotation vector ``(rx, ry, rz)`` (its angle is its length)."""
+    angle = np.sqrt(rx * rx + ry * ry + rz * rz)
+    if angle < 1e-300:
+        return 1.0, 0.0, 0.0, 0.0
+    s = np.sin(0.5 * angle) / angle
+    return np.cos(0.5 * angle), s * rx, s * ry, s * rz
 
 
 @jit
-def quat_of_rotation(rx, ry, rz):
-    """The unit quaternion of the rotation vector ``(rx, ry, rz)`` (its angle is the vector's length)."""
-    angle = np.sqrt(rx * rx + ry * ry + rz * rz)
-    if angle < 1e-300:
-        return np.array([1.0, 0.0, 0.0, 0.0])
-    s = np.sin(0.5 * angle) / angle
-    return np.array([np.cos(0.5 * angle), s * rx, s * ry, s * rz])
+def rotate(q, vx, vy, vz):
+    """The vector ``v`` turned by the unit quaternion ``q`` (``q v q*``)."""
+    w, x, y, z = q[0], q[1], q[2], q[3]
+    tx = 2.0 * (y * vz - z * vy)
+    ty = 2.0 * (z * vx - x * vz)
+    tz = 2.0 * (x * vy - y * vx)
+    return (vx + w * tx + y * tz - z * ty, vy + w * ty + z * tx - x * tz, vz + w * tz + x * ty - y * tx)
+
+
+@jit
+def rotate_back(q, vx, vy, vz):
+    """The vector ``v`` turned by the inverse of the unit quaternion ``q``."""
+    w, x, y, z = q[0], -q[1], -q[2], -q[3]
+    tx = 2.0 * (y * vz - z * vy)
+    ty = 2.0 * (z * vx - x * vz)
+    tz = 2.0 * (x * vy - y * vx)
+    return (vx + w * tx + y * tz - z * ty, vy + w * ty + z * tx - x * tz, vz + w * tz + x * ty - y * tx)
+
+
+@jit
+def turn(q, rx, ry, rz):
+    """``q`` turned in place by the rotation vector ``(rx, ry, rz)`` (world frame), normalised."""
+    a0, a1, a2, a3 = quat_of_rotation(rx, ry, rz)
+    b0, b1, b2, b3 = q[0], q[1], q[2], q[3]
+    w = a0 * b0 - a1 * b1 - a2 * b2 - a3 * b3
+    x = a0 * b1 + a1 * b0 + a2 * b3 - a3 * b2
+    y = a0 * b2 - a1 * b3 + a2 * b0 + a3 * b1
+    z = a0 * b3 + a1 * b2 - a2 * b1 + a3 * b0
+    norm = np.sqrt(w * w + x * x + y * y + z * z)
+    q[0], q[1], q[2], q[3] = w / norm, x / norm, y / norm, z / norm
 
 
 @jit
@@ -151,165 +183,184 @@ def rotation_matrix(q):
 
 
 @jit
-def turned(q, rx, ry, rz):
-    """``q`` turned by the rotation vector ``(rx, ry, rz)`` (world frame), normalised."""
-    out = quat_multiply(quat_of_rotation(rx, ry, rz), q)
-    return out / np.sqrt(out[0] ** 2 + out[1] ** 2 + out[2] ** 2 + out[3] ** 2)
-
-
-@jit
 def rotation_angle(q, p):
     """The angle of the rotation from ``p`` to ``q``."""
     dot = abs(q[0] * p[0] + q[1] * p[1] + q[2] * p[2] + q[3] * p[3])
     return 2.0 * np.arccos(min(dot, 1.0))
 
 
-@jit
+@pjit
 def place_vertices3(pos, quat, bodies, world):
     """Every vertex's position (vertex, 3) at the centroids ``pos`` and orientations ``quat``."""
     offs, local = bodies.vertex_offs, bodies.vertices
-    for b in range(pos.shape[0]):
-        r = rotation_matrix(quat[b])
+    for b in prange(pos.shape[0]):
         for k in range(offs[b], offs[b + 1]):
-            for d in range(3):
-                world[k, d] = pos[b, d] + r[d, 0] * local[k, 0] + r[d, 1] * local[k, 1] + r[d, 2] * local[k, 2]
+            x, y, z = rotate(quat[b], local[k, 0], local[k, 1], local[k, 2])
+            world[k, 0], world[k, 1], world[k, 2] = pos[b, 0] + x, pos[b, 1] + y, pos[b, 2] + z
 
 
 # ------------------------------------------------------------------------------------------ face geometry
 
-@jit
-def face_normal_centre(world, face_offs, face_vertices, f):
-    """The unit outward normal (Newell's) and the vertex mean of face ``f``."""
-    nx = ny = nz = 0.0
-    cx = cy = cz = 0.0
-    start, stop = face_offs[f], face_offs[f + 1]
-    for k in range(start, stop):
-        p = world[face_vertices[k]]
-        q = world[face_vertices[k + 1 if k + 1 < stop else start]]
-        nx += (p[1] - q[1]) * (p[2] + q[2])
-        ny += (p[2] - q[2]) * (p[0] + q[0])
-        nz += (p[0] - q[0]) * (p[1] + q[1])
-        cx += p[0]
-        cy += p[1]
-        cz += p[2]
-    norm = np.sqrt(nx * nx + ny * ny + nz * nz)
-    count = stop - start
-    return np.array([nx / norm, ny / norm, nz / norm]), np.array([cx / count, cy / count, cz / count])
+@pjit
+def face_frames3(world, bodies, normal, centre):
+    """Every face's unit outward normal (Newell's) and vertex mean, into ``normal`` and ``centre`` (face, 3)."""
+    face_offs, face_vertices = bodies.face_offs, bodies.face_vertices
+    for f in prange(face_offs.size - 1):
+        nx = ny = nz = 0.0
+        cx = cy = cz = 0.0
+        start, stop = face_offs[f], face_offs[f + 1]
+        for k in range(start, stop):
+            p = face_vertices[k]
+            q = face_vertices[k + 1 if k + 1 < stop else start]
+            nx += (world[p, 1] - world[q, 1]) * (world[p, 2] + world[q, 2])
+            ny += (world[p, 2] - world[q, 2]) * (world[p, 0] + world[q, 0])
+            nz += (world[p, 0] - world[q, 0]) * (world[p, 1] + world[q, 1])
+            cx += world[p, 0]
+            cy += world[p, 1]
+            cz += world[p, 2]
+        norm = np.sqrt(nx * nx + ny * ny + nz * nz)
+        count = stop - start
+        normal[f, 0], normal[f, 1], normal[f, 2] = nx / norm, ny / norm, nz / norm
+        centre[f, 0], centre[f, 1], centre[f, 2] = cx / count, cy / count, cz / count
+
+
+class Scratch(NamedTuple):
+    """The work arrays of one face pair's points, made once per thread: the two projected faces, the clipped
+    polygon and its next version, each with the line from every vertex on."""
+
+    ax: np.ndarray
+    ay: np.ndarray
+    bx: np.ndarray
+    by: np.ndarray
+    cx: np.ndarray
+    cy: np.ndarray
+    cline: np.ndarray
+    nx: np.ndarray
+    ny: np.ndarray
+    nline: np.ndarray
 
 
 @jit
-def plane_axes(n):
-    """Two unit vectors ``t1``, ``t2`` with ``t1 x t2 = n``."""
-    if abs(n[0]) < 0.9:
-        t1 = np.array([0.0, -n[2], n[1]])
-    else:
-        t1 = np.array([n[2], 0.0, -n[0]])
-    t1 /= np.sqrt(t1[0] ** 2 + t1[1] ** 2 + t1[2] ** 2)
-    t2 = np.array([n[1] * t1[2] - n[2] * t1[1], n[2] * t1[0] - n[0] * t1[2], n[0] * t1[1] - n[1] * t1[0]])
-    return t1, t2
+def scratch(most):
+    return Scratch(np.empty(most), np.empty(most), np.empty(most), np.empty(most), np.empty(2 * most),
+                   np.empty(2 * most), np.empty(2 * most, dtype=np.int64), np.empty(2 * most), np.empty(2 * most),
+                   np.empty(2 * most, dtype=np.int64))
 
 
 @jit
-def clip_convex(ax, ay, bx, by, out_x, out_y, out_line):
-    """The overlap of the convex polygons ``a`` and ``b`` (both counter-clockwise), ``a`` clipped by every edge
-    of ``b`` (Sutherland-Hodgman). Lines are numbered ``a``'s edges first (edge ``i`` from vertex ``i``), then
-    ``b``'s; ``out_line[k]`` is the line from output vertex ``k`` to the next. Returns the vertex count."""
-    na, nb = ax.size, bx.size
-    cur_x = np.empty(na + nb)
-    cur_y = np.empty(na + nb)
-    cur_line = np.empty(na + nb, dtype=np.int64)
+def clip_convex(w, na, nb):
+    """The overlap of the convex polygons ``w.a`` (``na`` vertices) and ``w.b`` (``nb``), both counter-clockwise:
+    ``a`` clipped by every edge of ``b`` (Sutherland-Hodgman), into ``w.cx``, ``w.cy``. Lines are numbered
+    ``a``'s edges first (edge ``i`` from vertex ``i``), then ``b``'s; ``w.cline[k]`` is the line from vertex
+    ``k`` to the next. Returns the vertex count."""
+    cx, cy, cline, nx, ny, nline = w.cx, w.cy, w.cline, w.nx, w.ny, w.nline
     n = na
     for i in range(na):
-        cur_x[i], cur_y[i], cur_line[i] = ax[i], ay[i], i
-    nxt_x = np.empty(na + nb)
-    nxt_y = np.empty(na + nb)
-    nxt_line = np.empty(na + nb, dtype=np.int64)
+        cx[i], cy[i], cline[i] = w.ax[i], w.ay[i], i
     for j in range(nb):
         if n == 0:
             break
-        x0, y0 = bx[j], by[j]
-        ex, ey = bx[(j + 1) % nb] - x0, by[(j + 1) % nb] - y0
+        x0, y0 = w.bx[j], w.by[j]
+        j1 = j + 1 if j + 1 < nb else 0
+        ex, ey = w.bx[j1] - x0, w.by[j1] - y0
+        near = ON_LINE * np.sqrt(ex * ex + ey * ey)
+        on_line = near * np.sqrt(ex * ex + ey * ey)  # sp of a vertex ``near`` the clip line: on it, inside
         m = 0
         for k in range(n):
-            k1 = (k + 1) % n
-            sp = ex * (cur_y[k] - y0) - ey * (cur_x[k] - x0)
-            sq = ex * (cur_y[k1] - y0) - ey * (cur_x[k1] - x0)
-            if sp >= 0.0:
-                nxt_x[m], nxt_y[m], nxt_line[m] = cur_x[k], cur_y[k], cur_line[k]
+            k1 = k + 1 if k + 1 < n else 0
+            sp = ex * (cy[k] - y0) - ey * (cx[k] - x0)
+            sq = ex * (cy[k1] - y0) - ey * (cx[k1] - x0)
+            if sp >= -on_line:
+                nx[m], ny[m], nline[m] = cx[k], cy[k], cline[k]
                 m += 1
-            if (sp >= 0.0) != (sq >= 0.0) and m < na + nb:
+            if ((sp < -on_line and sq > on_line) or (sp > on_line and sq < -on_line)) and m < nx.size:
                 s = sp / (sp - sq)
-                nxt_x[m] = cur_x[k] + s * (cur_x[k1] - cur_x[k])
-                nxt_y[m] = cur_y[k] + s * (cur_y[k1] - cur_y[k])
-                nxt_line[m] = na + j if sp >= 0.0 else cur_line[k]
+                nx[m] = cx[k] + s * (cx[k1] - cx[k])
+                ny[m] = cy[k] + s * (cy[k1] - cy[k])
+                nline[m] = na + j if sp >= 0.0 else cline[k]
                 m += 1
-        n = m
-        for k in range(n):
-            cur_x[k], cur_y[k], cur_line[k] = nxt_x[k], nxt_y[k], nxt_line[k]
-    for k in range(n):
-        out_x[k], out_y[k], out_line[k] = cur_x[k], cur_y[k], cur_line[k]
+        n = 0
+        for k in range(m):  # vertices that coincide (a corner of a on an edge of b) are one
+            previous = n - 1 if n > 0 else -1
+            if previous >= 0 and abs(nx[k] - cx[previous]) + abs(ny[k] - cy[previous]) <= near:
+                continue
+            cx[n], cy[n], cline[n] = nx[k], ny[k], nline[k]
+            n += 1
+        if n > 1 and abs(cx[n - 1] - cx[0]) + abs(cy[n - 1] - cy[0]) <= near:
+            n -= 1
     return n
 
 
 @jit
-def face_pair_points(world, bodies, fa, fb, px, py, pz, gap, area, key):
-    """The contact points of the face pair ``fa`` (block A), ``fb`` (block B) at the vertices ``world``: their
-    positions, gaps along the pair's normal (negative: penetration), tributary areas and names. Returns the
-    point count (0: the projections do not overlap, or the faces are not anti-parallel) and the normal."""
+def face_pair_points(world, bodies, normal, centre, fa, fb, w, px, py, pz, gap, area):
+    """The contact points of the face pair ``fa`` (block A), ``fb`` (block B) at the vertices ``world`` (their
+    faces' ``normal`` and ``centre``): positions, gaps along the pair's normal (negative: penetration) and
+    tributary areas. Returns the point count (0: the projections do not overlap) and the normal."""
     face_offs, face_vertices = bodies.face_offs, bodies.face_vertices
-    na_, ca = face_normal_centre(world, face_offs, face_vertices, fa)
-    nb_, cb = face_normal_centre(world, face_offs, face_vertices, fb)
-    n = na_ - nb_
-    norm = np.sqrt(n[0] ** 2 + n[1] ** 2 + n[2] ** 2)
+    nx, ny, nz = normal[fa, 0] - normal[fb, 0], normal[fa, 1] - normal[fb, 1], normal[fa, 2] - normal[fb, 2]
+    norm = np.sqrt(nx * nx + ny * ny + nz * nz)
     if norm < 1e-12:
-        return 0, n
-    n /= norm
-    t1, t2 = plane_axes(n)
+        return 0, nx, ny, nz
+    nx, ny, nz = nx / norm, ny / norm, nz / norm
+    if abs(nx) < 0.9:  # t1 normal to n and to x, t2 = n x t1
+        t1x, t1y, t1z = 0.0, -nz, ny
+    else:
+        t1x, t1y, t1z = nz, 0.0, -nx
+    size = np.sqrt(t1x * t1x + t1y * t1y + t1z * t1z)
+    t1x, t1y, t1z = t1x / size, t1y / size, t1z / size
+    t2x, t2y, t2z = ny * t1z - nz * t1y, nz * t1x - nx * t1z, nx * t1y - ny * t1x
     sa, sb = face_offs[fa + 1] - face_offs[fa], face_offs[fb + 1] - face_offs[fb]
-    o = (ca * sa + cb * sb) / (sa + sb)
-    ax, ay = np.empty(sa), np.empty(sa)
+    ox = (centre[fa, 0] * sa + centre[fb, 0] * sb) / (sa + sb)
+    oy = (centre[fa, 1] * sa + centre[fb, 1] * sb) / (sa + sb)
+    oz = (centre[fa, 2] * sa + centre[fb, 2] * sb) / (sa + sb)
     for k in range(sa):
-        d = world[face_vertices[face_offs[fa] + k]] - o
-        ax[k], ay[k] = d @ t1, d @ t2
-    bx, by = np.empty(sb), np.empty(sb)
+        v = face_vertices[face_offs[fa] + k]
+        dx, dy, dz = world[v, 0] - ox, world[v, 1] - oy, world[v, 2] - oz
+        w.ax[k], w.ay[k] = dx * t1x + dy * t1y + dz * t1z, dx * t2x + dy * t2y + dz * t2z
     for k in range(sb):  # b's vertices in reverse: counter-clockwise about n
-        d = world[face_vertices[face_offs[fb + 1] - 1 - k]] - o
-        bx[k], by[k] = d @ t1, d @ t2
-    cx, cy = np.empty(sa + sb), np.empty(sa + sb)
-    line = np.empty(sa + sb, dtype=np.int64)
-    count = clip_convex(ax, ay, bx, by, cx, cy, line)
+        v = face_vertices[face_offs[fb + 1] - 1 - k]
+        dx, dy, dz = world[v, 0] - ox, world[v, 1] - oy, world[v, 2] - oz
+        w.bx[k], w.by[k] = dx * t1x + dy * t1y + dz * t1z, dx * t2x + dy * t2y + dz * t2z
+    count = clip_convex(w, sa, sb)
     if count < 3:
-        return 0, n
-    mx, my = cx[:count].mean(), cy[:count].mean()
-    cos_a, cos_b = na_ @ n, nb_ @ n
+        return 0, nx, ny, nz
+    mx = my = 0.0
     for k in range(count):
+        mx += w.cx[k]
+        my += w.cy[k]
         area[k] = 0.0
+    mx, my = mx / count, my / count
     for k in range(count):
-        k1 = (k + 1) % count
-        half_triangle = 0.25 * abs((cx[k] - mx) * (cy[k1] - my) - (cy[k] - my) * (cx[k1] - mx))
+        k1 = k + 1 if k + 1 < count else 0
+        half_triangle = 0.25 * abs((w.cx[k] - mx) * (w.cy[k1] - my) - (w.cy[k] - my) * (w.cx[k1] - mx))
         area[k] += half_triangle
         area[k1] += half_triangle
-    lines = sa + sb
+    cos_a = normal[fa, 0] * nx + normal[fa, 1] * ny + normal[fa, 2] * nz
+    cos_b = normal[fb, 0] * nx + normal[fb, 1] * ny + normal[fb, 2] * nz
     for k in range(count):
-        w = o + cx[k] * t1 + cy[k] * t2
-        h_a = (na_ @ (ca - w)) / cos_a
-        h_b = (nb_ @ (cb - w)) / cos_b
+        wx = ox + w.cx[k] * t1x + w.cy[k] * t2x
+        wy = oy + w.cx[k] * t1y + w.cy[k] * t2y
+        wz = oz + w.cx[k] * t1z + w.cy[k] * t2z
+        h_a = (normal[fa, 0] * (centre[fa, 0] - wx) + normal[fa, 1] * (centre[fa, 1] - wy)
+               + normal[fa, 2] * (centre[fa, 2] - wz)) / cos_a
+        h_b = (normal[fb, 0] * (centre[fb, 0] - wx) + normal[fb, 1] * (centre[fb, 1] - wy)
+               + normal[fb, 2] * (centre[fb, 2] - wz)) / cos_b
         gap[k] = h_b - h_a
-        p = w + 0.5 * (h_a + h_b) * n
-        px[k], py[k], pz[k] = p[0], p[1], p[2]
-        key[k] = line[(k + count - 1) % count] * lines + line[k]
-    return count, n
+        mid = 0.5 * (h_a + h_b)
+        px[k], py[k], pz[k] = wx + mid * nx, wy + mid * ny, wz + mid * nz
+    return count, nx, ny, nz
 
 
 # ---------------------------------------------------------------------------------------- contact law
 
 @jit
-def contact_point(fn_elastic, opening_rate, slip, ft, bonded, knp, ktp, dashpot, mu, coh, ten, dt, update_history):
-    """The contact law at one point, the 2D law (:func:`.kernels.contact_end`) with a shear force vector ``ft``
-    (3, changed in place) and the slip velocity vector ``slip`` (in the contact plane): a bond breaks in
-    tension beyond ``ten`` or at the first slip; a dry point that opens carries nothing; the dashpot keeps a dry
-    point's normal force compressive; the shear trial is capped by Coulomb's ``mu fn (+ coh while bonded)`` on
-    its length. Returns ``(open, fn, bonded, spring, friction, damping)``."""
+def contact_point(fn_elastic, opening_rate, sx, sy, sz, fx, fy, fz, bonded, knp, ktp, dashpot, mu, coh, ten, dt,
+                  update_history):
+    """The contact law at one point, the 2D law (:func:`.kernels.contact_end`) with a shear force vector ``f``
+    and the slip velocity vector ``s`` (in the contact plane): a bond breaks in tension beyond ``ten`` or at
+    the first slip; a dry point that opens carries nothing; the dashpot keeps a dry point's normal force
+    compressive; the shear trial is capped by Coulomb's ``mu fn (+ coh while bonded)`` on its length. Returns
+    ``(open, fn, fx, fy, fz, bonded, spring, friction, damping)``."""
     friction = 0.0
     damping = 0.0
     if bonded and fn_elastic < -ten and update_history:
@@ -317,16 +368,16 @@ def contact_point(fn_elastic, opening_rate, slip, ft, bonded, knp, ktp, dashpot,
         friction += 0.5 * fn_elastic * fn_elastic / knp
     if not bonded and fn_elastic <= 0.0:
         if update_history:
-            friction += 0.5 * (ft[0] ** 2 + ft[1] ** 2 + ft[2] ** 2) / ktp
-            ft[:] = 0.0
-        return True, 0.0, bonded, 0.0, friction, damping
+            friction += 0.5 * (fx * fx + fy * fy + fz * fz) / ktp
+            fx = fy = fz = 0.0
+        return True, 0.0, fx, fy, fz, bonded, 0.0, friction, damping
     fn = fn_elastic - dashpot * opening_rate
     if not bonded and fn < 0.0:
         fn = 0.0
     if update_history:
         damping = (fn - fn_elastic) * opening_rate * dt
-        trial = ft - ktp * dt * slip
-        size = np.sqrt(trial[0] ** 2 + trial[1] ** 2 + trial[2] ** 2)
+        fx, fy, fz = fx - ktp * dt * sx, fy - ktp * dt * sy, fz - ktp * dt * sz
+        size = np.sqrt(fx * fx + fy * fy + fz * fz)
         cap = mu * max(fn, 0.0) + (coh if bonded else 0.0)
         if size > cap:
             if bonded:
@@ -337,96 +388,144 @@ def contact_point(fn_elastic, opening_rate, slip, ft, bonded, knp, ktp, dashpot,
                     fn_elastic = 0.0
                 cap = mu * fn
             friction += cap * (size - cap) / ktp
-            ft[:] = trial * (cap / size)
-        else:
-            ft[:] = trial
-    spring = 0.5 * fn_elastic * fn_elastic / knp + 0.5 * (ft[0] ** 2 + ft[1] ** 2 + ft[2] ** 2) / ktp
-    return False, fn, bonded, spring, friction, damping
+            share = cap / size
+            fx, fy, fz = fx * share, fy * share, fz * share
+    spring = 0.5 * fn_elastic * fn_elastic / knp + 0.5 * (fx * fx + fy * fy + fz * fz) / ktp
+    return False, fn, fx, fy, fz, bonded, spring, friction, damping
+
+
+#: Face pairs a thread takes at a time in the contact pass (its work arrays made once for them).
+PAIR_BLOCK = 64
+#: A point takes over the history of the last step's point nearest to it within this share of the square root
+#: of its pair's overlap area.
+MATCH_SHARE = 0.1
+
+
+@pjit
+def pair_forces3(bodies, pairs, law, motion, world, normal, centre, pair_force, pair_energy, dt, update_history):
+    """Every face pair's force and moments, in parallel: ``pair_force`` (pair, 9) the force on B and the
+    moments on B and on A about their centroids (A takes the opposite force), ``pair_energy`` (pair, 3) its
+    stored spring energy, friction and dashpot dissipation."""
+    faces, props, held, points, shear, bonded, normal_force = pairs
+    pos, vel, omega, quat = motion.pos, motion.vel, motion.omega, motion.quat
+    most = held.shape[1]
+    n_pair = faces.shape[0]
+    for chunk in prange((n_pair + PAIR_BLOCK - 1) // PAIR_BLOCK):
+        w = scratch(most)
+        px, py, pz = np.empty(most), np.empty(most), np.empty(most)
+        gap, area = np.empty(most), np.empty(most)
+        old_held = np.empty(most, dtype=np.int64)
+        old_points = np.empty((most, 3))
+        old_shear = np.empty((most, 3))
+        old_bonded = np.empty(most, dtype=np.int64)
+        for f in range(chunk * PAIR_BLOCK, min(n_pair, (chunk + 1) * PAIR_BLOCK)):
+            fa, fb = faces[f, 0], faces[f, 1]
+            a, b = bodies.face_block[fa], bodies.face_block[fb]
+            count, nx, ny, nz = face_pair_points(world, bodies, normal, centre, fa, fb, w, px, py, pz, gap, area)
+            total = 0.0
+            for k in range(count):
+                total += area[k]
+            if total <= law.min_area:
+                count = 0
+            fresh = held[f, 0] == -1
+            for k in range(most):  # the points as they were
+                old_held[k], old_bonded[k] = held[f, k], bonded[f, k]
+                for d in range(3):
+                    old_points[k, d], old_shear[k, d] = points[f, k, d], shear[f, k, d]
+            reach = (MATCH_SHARE * MATCH_SHARE) * total
+            m_inv = (0.0 if bodies.driven[a] else 1.0 / bodies.mass[a]) + (0.0 if bodies.driven[b] else
+                                                                              1.0 / bodies.mass[b])
+            fbx = fby = fbz = mbx = mby = mbz = max_ = may = maz = 0.0
+            stored = friction_sum = damping_sum = 0.0
+            for k in range(count):
+                lx, ly, lz = rotate_back(quat[a], px[k] - pos[a, 0], py[k] - pos[a, 1], pz[k] - pos[a, 2])
+                fx = fy = fz = 0.0
+                bond = old_bonded[0] if fresh else 0  # a new pair's points start as its joint is
+                nearest, best = -1, reach
+                for j in range(most):
+                    if old_held[j] == 1:
+                        dx, dy, dz = old_points[j, 0] - lx, old_points[j, 1] - ly, old_points[j, 2] - lz
+                        d2 = dx * dx + dy * dy + dz * dz
+                        if d2 < best:
+                            nearest, best = j, d2
+                if nearest >= 0:
+                    old_held[nearest] = 0  # taken
+                    fx, fy, fz = old_shear[nearest, 0], old_shear[nearest, 1], old_shear[nearest, 2]
+                    bond = old_bonded[nearest]
+                size = np.sqrt(fx * fx + fy * fy + fz * fz)  # the spring kept in the turned plane, its length kept
+                along = fx * nx + fy * ny + fz * nz
+                fx, fy, fz = fx - along * nx, fy - along * ny, fz - along * nz
+                turned_size = np.sqrt(fx * fx + fy * fy + fz * fz)
+                if turned_size > 0.0:
+                    fx, fy, fz = fx * size / turned_size, fy * size / turned_size, fz * size / turned_size
+                rax, ray, raz = px[k] - pos[a, 0], py[k] - pos[a, 1], pz[k] - pos[a, 2]
+                rbx, rby, rbz = px[k] - pos[b, 0], py[k] - pos[b, 1], pz[k] - pos[b, 2]
+                dvx = (vel[b, 0] + omega[b, 1] * rbz - omega[b, 2] * rby) - (vel[a, 0] + omega[a, 1] * raz
+                                                                           - omega[a, 2] * ray)
+                dvy = (vel[b, 1] + omega[b, 2] * rbx - omega[b, 0] * rbz) - (vel[a, 1] + omega[a, 2] * rax
+                                                                           - omega[a, 0] * raz)
+                dvz = (vel[b, 2] + omega[b, 0] * rby - omega[b, 1] * rbx) - (vel[a, 2] + omega[a, 0] * ray
+                                                                           - omega[a, 1] * rax)
+                opening = dvx * nx + dvy * ny + dvz * nz
+                knp, ktp = law.kn * area[k], law.kt * area[k]
+                dashpot = 2.0 * law.damping * np.sqrt(knp / m_inv) if m_inv > 0.0 else 0.0
+                is_open, fn, fx, fy, fz, bond, spring, friction, damping = contact_point(
+                    -knp * gap[k], opening, dvx - opening * nx, dvy - opening * ny, dvz - opening * nz, fx, fy, fz,
+                    bond, knp, ktp, dashpot, props[f, 0], props[f, 1] * area[k], props[f, 2] * area[k], dt,
+                    update_history)
+                friction_sum += friction
+                damping_sum += damping
+                if update_history:
+                    held[f, k] = 1
+                    points[f, k, 0], points[f, k, 1], points[f, k, 2] = lx, ly, lz
+                    bonded[f, k] = bond
+                    shear[f, k, 0], shear[f, k, 1], shear[f, k, 2] = fx, fy, fz
+                    normal_force[f, k] = fn
+                if is_open:
+                    continue
+                stored += spring
+                gx, gy, gz = fn * nx + fx, fn * ny + fy, fn * nz + fz  # on B; A takes the opposite
+                fbx += gx
+                fby += gy
+                fbz += gz
+                mbx += rby * gz - rbz * gy
+                mby += rbz * gx - rbx * gz
+                mbz += rbx * gy - rby * gx
+                max_ -= ray * gz - raz * gy
+                may -= raz * gx - rax * gz
+                maz -= rax * gy - ray * gx
+            if update_history:
+                for k in range(count, most):
+                    held[f, k] = 0
+                    bonded[f, k] = 0
+                    normal_force[f, k] = 0.0
+                    shear[f, k, 0] = shear[f, k, 1] = shear[f, k, 2] = 0.0
+            pair_force[f, 0], pair_force[f, 1], pair_force[f, 2] = fbx, fby, fbz
+            pair_force[f, 3], pair_force[f, 4], pair_force[f, 5] = mbx, mby, mbz
+            pair_force[f, 6], pair_force[f, 7], pair_force[f, 8] = max_, may, maz
+            pair_energy[f, 0], pair_energy[f, 1], pair_energy[f, 2] = stored, friction_sum, damping_sum
 
 
 @jit
-def contact_forces3(bodies, pairs, law, motion, world, force, dt, update_history):
-    """Add the contact forces and moments (block, 6) of every face pair to ``force``, the vertices at ``world``,
-    in pair order (the same sums on any number of threads). Returns the stored spring energy, and adds the
-    friction and dashpot dissipation to the accumulators when ``update_history``."""
-    faces, props, keys, shear, bonded, normal = pairs
-    pos, vel, omega, acc = motion.pos, motion.vel, motion.omega, motion.acc
-    inv_mass = np.where(bodies.driven, 0.0, 1.0 / bodies.mass)
-    most = keys.shape[1]
-    px, py, pz = np.empty(most), np.empty(most), np.empty(most)
-    gap, area = np.empty(most), np.empty(most)
-    key = np.empty(most, dtype=np.int64)
-    old_key = np.empty(most, dtype=np.int64)
-    old_shear = np.empty((most, 3))
-    old_bonded = np.empty(most, dtype=np.int64)
-    ft = np.empty(3)
+def contact_forces3(bodies, pairs, law, motion, world, normal, centre, pair_force, pair_energy, force, dt,
+                    update_history):
+    """Add the contact forces and moments (block, 6) of every face pair to ``force`` (:func:`pair_forces3`, then
+    summed in pair order: the same sums on any number of threads). Returns the stored spring energy, and adds
+    the friction and dashpot dissipation to the accumulators when ``update_history``."""
+    face_frames3(world, bodies, normal, centre)
+    pair_forces3(bodies, pairs, law, motion, world, normal, centre, pair_force, pair_energy, dt, update_history)
     stored = 0.0
-    for f in range(faces.shape[0]):
-        fa, fb = faces[f, 0], faces[f, 1]
-        a, b = bodies.face_block[fa], bodies.face_block[fb]
-        count, n = face_pair_points(world, bodies, fa, fb, px, py, pz, gap, area, key)
-        total = 0.0
-        for k in range(count):
-            total += area[k]
-        if total <= law.min_area:
-            count = 0
-        for k in range(most):  # the points by name, as they were
-            old_key[k], old_bonded[k] = keys[f, k], bonded[f, k]
-            for d in range(3):
-                old_shear[k, d] = shear[f, k, d]
-        m_inv = inv_mass[a] + inv_mass[b]
-        for k in range(count):
-            ft[:] = 0.0
-            bond = old_bonded[0] if old_key[0] == -1 else 0  # a new pair's points start as the joint is
-            for j in range(most):
-                if old_key[j] == key[k]:
-                    ft[:] = old_shear[j]
-                    bond = old_bonded[j]
-                    break
-            tangential = ft[0] * n[0] + ft[1] * n[1] + ft[2] * n[2]  # keep the spring in the turned plane
-            size = np.sqrt(ft[0] ** 2 + ft[1] ** 2 + ft[2] ** 2)
-            ft -= tangential * n
-            turned_size = np.sqrt(ft[0] ** 2 + ft[1] ** 2 + ft[2] ** 2)
-            if turned_size > 0.0:
-                ft *= size / turned_size
-            x = np.array([px[k], py[k], pz[k]])
-            ra, rb = x - pos[a], x - pos[b]
-            va = vel[a] + np.cross(omega[a], ra)
-            vb = vel[b] + np.cross(omega[b], rb)
-            dv = vb - va
-            opening = dv @ n
-            slip = dv - opening * n
-            knp, ktp = law.kn * area[k], law.kt * area[k]
-            dashpot = 2.0 * law.damping * np.sqrt(knp / m_inv) if m_inv > 0.0 else 0.0
-            is_open, fn, bond, spring, friction, damping = contact_point(
-                -knp * gap[k], opening, slip, ft, bond, knp, ktp, dashpot, props[f, 0], props[f, 1] * area[k],
-                props[f, 2] * area[k], dt, update_history)
-            if update_history:
-                keys[f, k] = key[k]
-                bonded[f, k] = bond
-                for d in range(3):
-                    shear[f, k, d] = ft[d]
-                normal[f, k] = fn
-                acc[DISSIPATED_FRICTION] += friction
-                acc[DISSIPATED_DAMPING] -= damping
-            if is_open:
-                continue
-            stored += spring
-            push = fn * n + ft  # on B; A takes the opposite
-            moment_b = np.cross(rb, push)
-            moment_a = np.cross(ra, push)
-            for d in range(3):
-                force[b, d] += push[d]
-                force[a, d] -= push[d]
-                force[b, 3 + d] += moment_b[d]
-                force[a, 3 + d] -= moment_a[d]
+    for f in range(pairs.faces.shape[0]):
+        a, b = bodies.face_block[pairs.faces[f, 0]], bodies.face_block[pairs.faces[f, 1]]
+        for d in range(3):
+            force[b, d] += pair_force[f, d]
+            force[a, d] -= pair_force[f, d]
+            force[b, 3 + d] += pair_force[f, 3 + d]
+            force[a, 3 + d] += pair_force[f, 6 + d]
+        stored += pair_energy[f, 0]
         if update_history:
-            for k in range(count, most):
-                keys[f, k] = -1
-                bonded[f, k] = 0
-                normal[f, k] = 0.0
-                for d in range(3):
-                    shear[f, k, d] = 0.0
+            motion.acc[DISSIPATED_FRICTION] += pair_energy[f, 1]
+            motion.acc[DISSIPATED_DAMPING] -= pair_energy[f, 2]
     return stored
 
 
@@ -442,17 +541,19 @@ def damped(f, v, damping):
     return f
 
 
-@jit
+@pjit
 def step_blocks(bodies, motion, loading, stepping, force, load_share, rate_now, settlement):
-    """One velocity and position update of every block: driven blocks follow their settlement motion, free ones
-    their unbalanced force and moment (Euler's equations in the world frame, the inertia turned with the
-    block), each component damped (Cundall). Returns the work of the supports and of the loads, and the
-    damping's dissipation."""
+    """One velocity and position update of every block, in parallel: driven blocks follow their settlement
+    motion, free ones their unbalanced force and moment (Euler's equations in the block's frame, so its
+    inertia turns with it), each world component damped (Cundall). Returns the work of the supports and of the
+    loads, and the damping's dissipation."""
     pos, quat, vel, omega = motion.pos, motion.quat, motion.vel, motion.omega
     dt, damping = stepping.dt, stepping.damping
     load, direction = loading.load, bodies.direction
-    work_support = work_load = dissipated = 0.0
-    for i in range(pos.shape[0]):
+    work_support = 0.0
+    work_load = 0.0
+    dissipated = 0.0
+    for i in prange(pos.shape[0]):
         if bodies.driven[i]:
             for d in range(3):
                 v = rate_now * direction[i, d]
@@ -461,43 +562,53 @@ def step_blocks(bodies, motion, loading, stepping, force, load_share, rate_now, 
                 vel[i, d] = v
                 omega[i, d] = w
                 pos[i, d] = bodies.pos0[i, d] + settlement * direction[i, d]
-            quat[i] = quat_of_rotation(settlement * direction[i, 3], settlement * direction[i, 4],
-                                       settlement * direction[i, 5])
+            q0, q1, q2, q3 = quat_of_rotation(settlement * direction[i, 3], settlement * direction[i, 4],
+                                              settlement * direction[i, 5])
+            quat[i, 0], quat[i, 1], quat[i, 2], quat[i, 3] = q0, q1, q2, q3
             continue
-        r = rotation_matrix(quat[i])
-        inertia = r @ bodies.inertia[i] @ r.T
-        inv_inertia = r @ bodies.inv_inertia[i] @ r.T
-        spin = inertia @ omega[i]
-        gyroscopic = np.cross(omega[i], spin)
         for d in range(3):
             applied = load_share * load[i, d]
             total = damped(force[i, d] + applied, vel[i, d], damping)
             dissipated += (force[i, d] + applied - total) * vel[i, d] * dt
             vel[i, d] += dt * total / bodies.mass[i]
             work_load += applied * vel[i, d] * dt
-        moment = np.empty(3)
+        mx = damped(force[i, 3] + load_share * load[i, 3], omega[i, 0], damping)
+        my = damped(force[i, 4] + load_share * load[i, 4], omega[i, 1], damping)
+        mz = damped(force[i, 5] + load_share * load[i, 5], omega[i, 2], damping)
         for d in range(3):
             applied = load_share * load[i, 3 + d]
-            moment[d] = damped(force[i, 3 + d] + applied, omega[i, d], damping)
-            dissipated += (force[i, 3 + d] + applied - moment[d]) * omega[i, d] * dt
+            dissipated += (force[i, 3 + d] + applied - (mx, my, mz)[d]) * omega[i, d] * dt
             work_load += applied * omega[i, d] * dt
-        omega[i] += dt * (inv_inertia @ (moment - gyroscopic))
+        wx, wy, wz = rotate_back(quat[i], omega[i, 0], omega[i, 1], omega[i, 2])  # in the block's frame
+        tx, ty, tz = rotate_back(quat[i], mx, my, mz)
+        inertia, inverse = bodies.inertia[i], bodies.inv_inertia[i]
+        lx = inertia[0, 0] * wx + inertia[0, 1] * wy + inertia[0, 2] * wz
+        ly = inertia[1, 0] * wx + inertia[1, 1] * wy + inertia[1, 2] * wz
+        lz = inertia[2, 0] * wx + inertia[2, 1] * wy + inertia[2, 2] * wz
+        rx, ry, rz = tx - (wy * lz - wz * ly), ty - (wz * lx - wx * lz), tz - (wx * ly - wy * lx)
+        ax = inverse[0, 0] * rx + inverse[0, 1] * ry + inverse[0, 2] * rz
+        ay = inverse[1, 0] * rx + inverse[1, 1] * ry + inverse[1, 2] * rz
+        az = inverse[2, 0] * rx + inverse[2, 1] * ry + inverse[2, 2] * rz
+        gx, gy, gz = rotate(quat[i], ax, ay, az)
+        omega[i, 0] += dt * gx
+        omega[i, 1] += dt * gy
+        omega[i, 2] += dt * gz
         for d in range(3):
             pos[i, d] += dt * vel[i, d]
-        quat[i] = turned(quat[i], dt * omega[i, 0], dt * omega[i, 1], dt * omega[i, 2])
+        turn(quat[i], dt * omega[i, 0], dt * omega[i, 1], dt * omega[i, 2])
     return work_support, work_load, dissipated
 
 
-@jit
-def farthest_move3(motion, radius):
+@pjit
+def farthest_move3(motion, radius, moved):
     """The largest motion of a block since the last detection (centroid, plus rotation angle times radius)."""
-    most = 0.0
-    for i in range(motion.pos.shape[0]):
-        d = motion.pos[i] - motion.pos_detect[i]
-        moved = np.sqrt(d[0] ** 2 + d[1] ** 2 + d[2] ** 2) + rotation_angle(motion.quat[i],
-                                                                              motion.quat_detect[i]) * radius[i]
-        most = max(most, moved)
-    return most
+    for i in prange(motion.pos.shape[0]):
+        dx = motion.pos[i, 0] - motion.pos_detect[i, 0]
+        dy = motion.pos[i, 1] - motion.pos_detect[i, 1]
+        dz = motion.pos[i, 2] - motion.pos_detect[i, 2]
+        moved[i] = np.sqrt(dx * dx + dy * dy + dz * dz) + rotation_angle(motion.quat[i],
+                                                                           motion.quat_detect[i]) * radius[i]
+    return moved.max()
 
 
 @jit
@@ -510,6 +621,11 @@ def advance3(n_steps, bodies, pairs, law, motion, loading, stepping, wrench):
     acc = motion.acc
     force = np.zeros((n_block, 6))
     world = np.empty_like(bodies.vertices)
+    n_face = bodies.face_offs.size - 1
+    normal, centre = np.empty((n_face, 3)), np.empty((n_face, 3))
+    pair_force = np.empty((pairs.faces.shape[0], 9))
+    pair_energy = np.empty((pairs.faces.shape[0], 3))
+    moved = np.empty(n_block)
     dt = stepping.dt
     steps = 0
     rebuild = False
@@ -518,7 +634,7 @@ def advance3(n_steps, bodies, pairs, law, motion, loading, stepping, wrench):
         place_vertices3(motion.pos, motion.quat, bodies, world)
         time = acc[TIME]
         rate_now = settlement_rate(time + 0.5 * dt, loading.rate, loading.rate_ramp, loading.start)
-        contact_forces3(bodies, pairs, law, motion, world, force, dt, True)
+        contact_forces3(bodies, pairs, law, motion, world, normal, centre, pair_force, pair_energy, force, dt, True)
         load_share = smooth_share(time, loading.load_ramp)
         settlement = acc[SETTLEMENT] + rate_now * dt
         work_support, work_load, dissipated = step_blocks(bodies, motion, loading, stepping, force, load_share,
@@ -529,14 +645,15 @@ def advance3(n_steps, bodies, pairs, law, motion, loading, stepping, wrench):
         acc[SETTLEMENT] = settlement
         acc[TIME] = time + dt
         steps += 1
-        if farthest_move3(motion, bodies.radius) > stepping.half_buffer:
+        if farthest_move3(motion, bodies.radius, moved) > stepping.half_buffer:
             rebuild = True
             break
         if loading.target > 0.0 and acc[SETTLEMENT] >= loading.target:
             break
     force[:, :] = 0.0
     place_vertices3(motion.pos, motion.quat, bodies, world)
-    stored = contact_forces3(bodies, pairs, law, motion, world, force, dt, False)
+    stored = contact_forces3(bodies, pairs, law, motion, world, normal, centre, pair_force, pair_energy, force, dt,
+                             False)
     kinetic = 0.0
     unbalanced = 0.0
     load_norm = 0.0
@@ -545,9 +662,13 @@ def advance3(n_steps, bodies, pairs, law, motion, loading, stepping, wrench):
             wrench[i, d] = force[i, d] if bodies.driven[i] else 0.0
         if bodies.driven[i]:
             continue
-        r = rotation_matrix(motion.quat[i])
-        spin = (r @ bodies.inertia[i] @ r.T) @ motion.omega[i]
-        kinetic += 0.5 * bodies.mass[i] * (motion.vel[i] @ motion.vel[i]) + 0.5 * (motion.omega[i] @ spin)
+        wx, wy, wz = rotate_back(motion.quat[i], motion.omega[i, 0], motion.omega[i, 1], motion.omega[i, 2])
+        inertia = bodies.inertia[i]
+        spin = (wx * (inertia[0, 0] * wx + inertia[0, 1] * wy + inertia[0, 2] * wz)
+                + wy * (inertia[1, 0] * wx + inertia[1, 1] * wy + inertia[1, 2] * wz)
+                + wz * (inertia[2, 0] * wx + inertia[2, 1] * wy + inertia[2, 2] * wz))
+        kinetic += 0.5 * bodies.mass[i] * (motion.vel[i, 0] ** 2 + motion.vel[i, 1] ** 2 + motion.vel[i, 2] ** 2) \
+            + 0.5 * spin
         for d in range(3):
             unbalanced += abs(force[i, d] + loading.load[i, d])
             load_norm += abs(loading.load[i, d])
@@ -560,21 +681,22 @@ def advance3(n_steps, bodies, pairs, law, motion, loading, stepping, wrench):
 def detect_face_pairs3(bodies, world, block_pairs, buffer, max_penetration, min_cos):
     """Face pairs of the candidate block pairs ``(k, 2)``: faces anti-parallel within ``acos(min_cos)`` whose
     projections overlap, with gaps between ``-max_penetration`` and ``buffer``. Returns (pair, 2) faces."""
-    face_offs, face_vertices, first_face = bodies.face_offs, bodies.face_vertices, bodies.block_faces
+    first_face = bodies.block_faces
+    n_face = bodies.face_offs.size - 1
+    normal, centre = np.empty((n_face, 3)), np.empty((n_face, 3))
+    face_frames3(world, bodies, normal, centre)
     most = 2 * MAX_FACE_VERTICES
+    w = scratch(most)
     px, py, pz = np.empty(most), np.empty(most), np.empty(most)
     gap, area = np.empty(most), np.empty(most)
-    key = np.empty(most, dtype=np.int64)
     out = []
     for i in range(block_pairs.shape[0]):
         a, b = block_pairs[i, 0], block_pairs[i, 1]
         for fa in range(first_face[a], first_face[a + 1]):
-            na_, _ = face_normal_centre(world, face_offs, face_vertices, fa)
             for fb in range(first_face[b], first_face[b + 1]):
-                nb_, _ = face_normal_centre(world, face_offs, face_vertices, fb)
-                if na_ @ nb_ > -min_cos:
+                if normal[fa] @ normal[fb] > -min_cos:
                     continue
-                count, _ = face_pair_points(world, bodies, fa, fb, px, py, pz, gap, area, key)
+                count, _, _, _ = face_pair_points(world, bodies, normal, centre, fa, fb, w, px, py, pz, gap, area)
                 if count == 0:
                     continue
                 least = gap[:count].min()

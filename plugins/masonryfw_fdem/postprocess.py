@@ -21,6 +21,17 @@ def block_displacement(scene: Scene, pos: np.ndarray) -> np.ndarray:
     return u * np.array([scene.scales.length, scene.scales.length, 1.0])
 
 
+def block_displacement3(scene, snapshot: np.ndarray) -> np.ndarray:
+    """``(block, 6)`` [m, rad]: centroid displacements and rotation vectors (axis times angle) of a 3D state's
+    snapshot (centroids, then unit quaternions)."""
+    pos, quat = snapshot[:, :3], snapshot[:, 3:]
+    quat = quat * np.where(quat[:, :1] < 0.0, -1.0, 1.0)  # the shorter way round
+    sine = np.linalg.norm(quat[:, 1:], axis=1)
+    angle = 2.0 * np.arctan2(sine, quat[:, 0])
+    axis = quat[:, 1:] / np.where(sine > 0, sine, 1.0)[:, None]
+    return np.c_[(pos - scene.pos0) * scene.scales.length, axis * angle[:, None]]
+
+
 def interface_forces(scene: Scene, faces: np.ndarray, props: np.ndarray, normal: np.ndarray, shear: np.ndarray,
                      pos: np.ndarray):
     """Contact forces of the face pairs mapped onto the model's interface ends [N].

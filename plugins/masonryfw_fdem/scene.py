@@ -59,6 +59,29 @@ class Scene:
     tension_per_length: np.ndarray  # ft * thickness, non-dimensional
     default_friction: float
 
+    DOFS = 3  # a block's force and moment components
+    VERTICAL = 1  # the up component
+
+    @property
+    def base_pressure(self) -> float:
+        """The masonry's weight over its contact length with the supports."""
+        return 1.0 / self.support_length
+
+    def masonry_height(self) -> float:
+        """Top of the highest minus bottom of the lowest free block (non-dimensional)."""
+        y = self.pos0[:, 1][np.repeat(np.arange(self.driven.size), np.diff(self.offs))] + self.ly
+        free_nodes = ~np.repeat(self.driven, np.diff(self.offs))
+        return float(np.ptp(y[free_nodes]))
+
+    def critical_time_step(self, kn: float) -> float:
+        """2 / omega_max, omega^2 bounded per free block by the stiffness of springs all round its perimeter:
+        kn P / m in translation, kn P R^2 / I in rotation."""
+        free = ~self.driven
+        translation = kn * self.perimeter[free] / self.mass[free, 0]
+        rotation = kn * self.perimeter[free] * self.radius[free] ** 2 / self.mass[free, 2]
+        omega = np.sqrt(max(translation.max(initial=0.0), rotation.max(initial=0.0)))
+        return 2.0 / omega if omega > 0 else np.inf
+
 
 def build_scene(model: xr.Dataset) -> Scene:
     """The non-dimensional arrays of ``model``; raises ModelError on what the method cannot take."""

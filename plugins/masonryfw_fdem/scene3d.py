@@ -1,19 +1,151 @@
-"""Rigid polyhedra as the 3D kernels take them (:mod:`.kernels3d`; the 2D scene is :mod:`.scene`): the blocks'
-shapes, masses and inertia from their polyhedra, the first state, and the face pairs found at a state with the
-contact histories carried over from the pairs before.
+"""Rigid polyhedra as the 3D kernels take them (:mod:`.kernels3d`; the 2D scene is :mod:`.scene`): a 3D model
+made non-dimensional (:func:`build_scene3`), the blocks' shapes, masses and inertia from their polyhedra, the
+first state, and the face pairs found at a state with the contact histories carried over from the pairs before.
 
-The kernels work in the units they are given; a scene made from a model is non-dimensional as in 2D
-(lengths over the model's size, forces over its weight, time over ``sqrt(length / g)``).
+Units as in 2D: lengths over the model's size, forces over the masonry's weight, time over ``sqrt(length / g)``;
+masses are weight shares, so gravity has unit acceleration. Cohesion and tensile strength are per area
+(``c length^2 / W``), the contact stiffness per area and per length of penetration.
 """
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
+import xarray as xr
 
 import masonryfw as mf
 import masonryfw.plugin_api as mfp
 
 from . import kernels
 from .kernels3d import MAX_FACE_VERTICES, Bodies3, Motion3, Pairs3, detect_face_pairs3, place_vertices3
+from .scene import GRAVITY, Scales, Scene, build_scene
+
+
+@dataclass
+class Scene3:
+    """A 3D model's blocks and joints, non-dimensional (module docstring), the 2D :class:`.scene.Scene`'s
+    counterpart."""
+
+    DOFS = 6  # a block's force and moment components
+    VERTICAL = 2  # the up component
+
+    scales: Scales
+    model: xr.Dataset  # the checked model the scene was built from
+    bodies: Bodies3
+    dead: np.ndarray  # (block, 6) dead load on free blocks (force, moment about the centroid)
+    live: np.ndarray  # (block, 6)
+    unit_height: float  # median height of the masonry blocks
+    support_area: float  # area of the masonry's contact with the supports
+    joints: mfp.PairIndex  # the model's interfaces, found by their two blocks
+    friction: np.ndarray  # (interface,)
+    cohesion: np.ndarray  # (interface,) per area
+    tension: np.ndarray  # (interface,) per area
+    default_friction: float
+
+    @property
+    def pos0(self) -> np.ndarray:
+        return self.bodies.pos0
+
+    @property
+    def radius(self) -> np.ndarray:
+        return self.bodies.radius
+
+    @property
+    def driven(self) -> np.ndarray:
+        return self.bodies.driven
+
+    @property
+    def moving(self) -> np.ndarray:
+        return self.bodies.moving
+
+    @property
+    def direction(self) -> np.ndarray:
+        """(block, 6) every moving support's motion per unit (non-dimensional) settlement, 0 for the others."""
+        return self.bodies.direction
+
+    @property
+    def base_pressure(self) -> float:
+        """The masonry's weight over its contact area with the supports."""
+        return 1.0 / self.support_area
+
+    def masonry_height(self) -> float:
+        """Top of the highest minus bottom of the lowest free block's vertex."""
+        owner = np.repeat(np.arange(self.driven.size), np.diff(self.bodies.vertex_offs))
+        z = (self.bodies.pos0[owner, 2] + self.bodies.vertices[:, 2])[~self.driven[owner]]
+        return float(np.ptp(z))
+
+    def critical_time_step(self, kn: float) -> float:
+        """2 / omega_max, omega^2 bounded per free block by springs over its whole surface: ``kn S / m`` in
+        translation, ``kn S R^2 / I_min`` in rotation (the 2D bound with the surface for the perimeter)."""
+        free = ~self.driven
+        surface = np.bincount(self.bodies.face_block, weights=mfp.face_normals_areas(polyhedra(self))[1],
+                              minlength=free.size)
+        smallest = np.linalg.eigvalsh(self.bodies.inertia[free])[:, 0]
+        translation = kn * surface[free] / self.bodies.mass[free]
+        rotation = kn * surface[free] * self.radius[free] ** 2 / smallest
+        omega = np.sqrt(max(translation.max(initial=0.0), rotation.max(initial=0.0)))
+        return 2.0 / omega if omega > 0 else np.inf
+
+
+def polyhedra(scene: Scene3) -> mfp.Polyhedra:
+    """The scene's blocks at rest as polyhedra (non-dimensional)."""
+    poly = mfp.polyhedra_of(scene.model)
+    return poly._replace(vertices=poly.vertices / scene.scales.length)
+
+
+def build_scene3(model: xr.Dataset) -> Scene3:
+    """The non-dimensional :class:`Scene3` of a checked 3D ``model``; raises ModelError on what the method cannot
+    take (masonry without weight)."""
+    role = model.block_role.values.astype(np.int64)
+    driven = mfp.support_blocks(role)
+    moving = mfp.moving_blocks(role)
+    poly = mfp.polyhedra_of(model)
+    weight = model.block_unit_weight.values * model.block_volume.values
+    total = float(weight[~driven].sum())
+    if not total > 0:
+        raise mf.ModelError("block_unit_weight: the masonry blocks weigh nothing; fdem needs their masses")
+    weightless = np.flatnonzero(~driven & ~(weight > 0))
+    if weightless.size:
+        raise mf.ModelError(f"block(s) {mfp.listed(weightless)}: block_unit_weight * volume is not positive; a free "
+                            "block needs a mass in fdem")
+    length = float(np.linalg.norm(np.ptp(poly.vertices, axis=0))) or 1.0  # the bounding box's diagonal
+    scales = Scales(length=length, force=total, time=float(np.sqrt(length / GRAVITY)))
+    unit_weight = model.block_unit_weight.values * length**3 / total
+    direction = model.settlement_direction.values.astype(float).copy()
+    direction[:, 3:] *= length
+    direction[~moving] = 0.0
+    bodies = bodies_of(poly._replace(vertices=poly.vertices / length), unit_weight, driven, moving, direction)
+    load_scale = np.array([total] * 3 + [total * length] * 3)
+    dead = np.where(driven[:, None], 0.0, mfp.block_loads(model, "dead") / load_scale)
+    live = np.where(driven[:, None], 0.0, mfp.block_loads(model, "live") / load_scale)
+    z = poly.vertices[:, 2] / length
+    height = np.maximum.reduceat(z, bodies.vertex_offs[:-1]) - np.minimum.reduceat(z, bodies.vertex_offs[:-1])
+    sides = model.interface_blocks.values.astype(np.int64)
+    on_support = driven[sides].any(axis=1) & ~driven[sides].all(axis=1)
+    area = model.interface_area.values / length**2
+    support_area = float(area[on_support].sum())
+    if not support_area > 0:
+        raise mf.ModelError("fdem: no masonry rests on a support (no interface between a support and the masonry)")
+    per_area = length**2 / total
+    friction = model.interface_friction.values.astype(float)
+    return Scene3(scales, model, bodies, dead, live, float(np.median(height[~driven])), support_area,
+                  mfp.pair_index(sides, role.size), friction, model.interface_cohesion.values * per_area,
+                  model.interface_tensile_strength.values * per_area,
+                  float(np.median(friction)) if friction.size else 0.0)
+
+
+def face_properties3(scene: Scene3, faces: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(pair, 3) friction, cohesion and tensile strength per area of each face pair, and whether it starts bonded:
+    a pair between blocks that share a model interface takes its properties, others the model's median friction
+    and no strength (the 2D rule, :func:`.scene.face_properties`)."""
+    block = scene.bodies.face_block[faces] if faces.size else np.zeros((0, 2), dtype=np.int64)
+    joint = mfp.find_pairs(scene.joints, block)
+    hit = joint >= 0
+    at = np.maximum(joint, 0)
+    props = np.c_[np.where(hit, scene.friction[at] if scene.friction.size else 0.0, scene.default_friction),
+                  np.where(hit, scene.cohesion[at] if scene.cohesion.size else 0.0, 0.0),
+                  np.where(hit, scene.tension[at] if scene.tension.size else 0.0, 0.0)]
+    return props, (props[:, 1] > 0) | (props[:, 2] > 0)
 
 
 def bodies_of(poly: mfp.Polyhedra, unit_weight: np.ndarray, driven: np.ndarray, moving: np.ndarray,
@@ -78,7 +210,8 @@ def new_pairs(bodies: Bodies3, faces: np.ndarray, props: np.ndarray, bonded_star
     keeps its points' histories, a new one starts with its points bonded where ``bonded_start`` says."""
     counts = np.diff(bodies.face_offs)
     most = int((counts[faces[:, 0]] + counts[faces[:, 1]]).max(initial=3))
-    keys = np.full((faces.shape[0], most), -1, dtype=np.int64)
+    held = np.full((faces.shape[0], most), -1, dtype=np.int64)
+    points = np.zeros((faces.shape[0], most, 3))
     shear = np.zeros((faces.shape[0], most, 3))
     bonded = np.repeat(np.asarray(bonded_start, dtype=np.int64)[:, None], most, axis=1)
     if old is not None and old.faces.size and faces.size:
@@ -89,8 +222,15 @@ def new_pairs(bodies: Bodies3, faces: np.ndarray, props: np.ndarray, bonded_star
         at = np.clip(np.searchsorted(before[order], now), 0, before.size - 1)
         kept = before[order][at] == now
         source = order[at[kept]]
-        width = min(most, old.keys.shape[1])
-        keys[kept, :width] = old.keys[source, :width]
-        shear[kept, :width] = old.shear[source, :width]
-        bonded[kept, :width] = old.bonded[source, :width]
-    return Pairs3(faces, np.asarray(props, dtype=float), keys, shear, bonded, np.zeros((faces.shape[0], most)))
+        width = min(most, old.held.shape[1])
+        for mine, theirs in ((held, old.held), (points, old.points), (shear, old.shear), (bonded, old.bonded)):
+            mine[kept, :width] = theirs[source, :width]
+    return Pairs3(faces, np.asarray(props, dtype=float), held, points, shear, bonded,
+                  np.zeros((faces.shape[0], most)))
+
+
+def scene_of(model: xr.Dataset) -> Scene | Scene3:
+    """The scene of ``model``, made once (the estimate's, then the solve's): blocks in the plane, or polyhedra."""
+    if mfp.space(model) == 3:
+        return mfp.made_once(model, "fdem scene 3d", build_scene3)
+    return mfp.made_once(model, "fdem scene", build_scene)

@@ -27,7 +27,6 @@ import numba
 import numpy as np
 
 import masonryfw as mf
-import masonryfw.plugin_api as mfp
 
 from . import kernels
 from .controls import Controls
@@ -67,8 +66,9 @@ class History:
 
     weights: np.ndarray
     records: list = field(default_factory=list)
-    snapshots: list = field(default_factory=list)  # (settlement, positions)
-    opening: Callable[[np.ndarray], mf.Cracks] | None = None
+    snapshots: list = field(default_factory=list)  # (settlement, the state's snapshot)
+    opening: Callable[..., mf.Cracks] | None = None
+    vertical: int = 1  # the up component of a wrench (2 in 3D)
 
     COLUMNS = ("phase", "time", "settlement", "reaction", "kinetic", "stored", "work_gravity",
                "work_support", "dissipated_damping", "dissipated_friction", "released", "unbalanced", "load_factor")
@@ -80,8 +80,8 @@ class History:
                chunk.report.kinetic, chunk.report.stored, acc[kernels.WORK_GRAVITY], acc[kernels.WORK_SUPPORT],
                acc[kernels.DISSIPATED_DAMPING], acc[kernels.DISSIPATED_FRICTION], acc[kernels.RELEASED],
                chunk.report.unbalanced, load_factor)
-        cracks = self.opening(state.pos) if self.opening is not None else None
-        self.records.append(Record(row, -wrench[:, 1], cracks))
+        cracks = self.opening(state.snapshot()) if self.opening is not None else None
+        self.records.append(Record(row, -wrench[:, self.vertical], cracks))
 
     def table(self) -> dict[str, np.ndarray]:
         data = np.asarray([r.row for r in self.records], dtype=float).reshape(-1, len(self.COLUMNS))
@@ -151,6 +151,18 @@ class State:
         self.pos_detect = self.pos.copy()
         self.rebuilds += 1
 
+    def snapshot(self) -> np.ndarray:
+        """What the blocks' displacements are made of (:func:`.postprocess.block_displacement`): the positions."""
+        return self.pos.copy()
+
+    def motions_from(self, scene: Scene, reference: np.ndarray) -> np.ndarray:
+        """``(block,)``: every free block's motion from ``reference`` positions (:func:`block_motions`)."""
+        return block_motions(scene, self.pos, reference)
+
+    def speeds(self, scene: Scene) -> np.ndarray:
+        """``(block,)``: every free block's speed, centroid plus spin times radius (0 for the driven ones)."""
+        return np.where(scene.driven, 0.0, np.hypot(*self.vel[:, :2].T) + np.abs(self.vel[:, 2]) * scene.radius)
+
 
 def contact_law(controls: Controls) -> kernels.ContactLaw:
     """The contact constants as the kernels take them."""
@@ -208,7 +220,7 @@ def chunk(scene: Scene, controls: Controls, state: State, n_steps: int, rate: fl
     A kernel call runs at most ``controls.call_steps`` steps: Python takes Ctrl-C only between calls (a record
     of a huge run held 200 million steps, and Ctrl-C waited for minutes). A call's end changes no state, so
     the steps are the same however they are split."""
-    wrench = np.zeros((scene.driven.size, 3))
+    wrench = np.zeros((scene.driven.size, scene.DOFS))
     left = n_steps
     while True:
         threads, steps = controls.threads.next_call(min(left, controls.call_steps))
@@ -249,7 +261,7 @@ def gravity_phase(scene, controls, state, history, progress) -> None:
         out = chunk(scene, controls, state, n, 0.0, 0.0)
         state.gravity_steps += state.steps - before
         history.add(GRAVITY_PHASE, state, out)
-        state.gravity_motion = block_motions(scene, state.pos, scene.pos0)
+        state.gravity_motion = state.motions_from(scene, scene.pos0)
         if state.gravity_motion.max(initial=0.0) > STAND_SHARE * scene.unit_height:
             state.fell = True
             state.stop_reason = "did not stand under its own weight"
@@ -314,7 +326,7 @@ def settlement_phase(scene, controls, state, history, progress) -> None:
         settled = state.acc[kernels.SETTLEMENT]
         while pending and settled >= pending[0]:
             pending.pop(0)
-            history.snapshots.append((settled, state.pos.copy()))  # the first record past the request
+            history.snapshots.append((settled, state.snapshot()))  # the first record past the request
         progress(0.05 + 0.95 * min(1.0, settled / controls.target),
                  f"fdem: settlement {settled / controls.target:.0%} of target, "
                  f"reaction {history.records[-1].row[3] / reference:.3f} R0" if reference > 0 else
@@ -339,7 +351,7 @@ def largest_motion(scene: Scene, pos: np.ndarray, reference: np.ndarray) -> floa
 
 def fastest_blocks(scene: Scene, state: State, count: int = 3) -> str:
     """The ``count`` free blocks moving fastest, with where they are [m] and their speed [m/s], for a message."""
-    speed = np.where(scene.driven, 0.0, np.hypot(*state.vel[:, :2].T) + np.abs(state.vel[:, 2]) * scene.radius)
+    speed = state.speeds(scene)
     length, time = scene.scales.length, scene.scales.time
     return ", ".join(f"block {b} at ({state.pos[b, 0] * length:.4g}, {state.pos[b, 1] * length:.4g}) m, "
                      f"{speed[b] * length / time:.3g} m/s" for b in np.argsort(-speed)[:count])
@@ -414,15 +426,15 @@ def _bisect(scene, controls, state, history, progress):
     return lower, upper, unstable
 
 
-def run(scene: Scene, controls: Controls, state: State, load: np.ndarray, progress,
-        opening: Callable[[np.ndarray], mf.Cracks] | None = None) -> History:
-    """Gravity, then settlement, from ``state`` (rigid or deformable); returns the history
-    (``opening``: :attr:`History.opening`).
+def run(scene, controls: Controls, state: State, load: np.ndarray, progress,
+        opening: Callable[..., mf.Cracks] | None = None) -> History:
+    """Gravity, then settlement, from ``state`` (rigid or deformable, 2D or 3D); returns the history
+    (``opening``: :attr:`History.opening`, of the state's :meth:`State.snapshot`).
 
     A KeyboardInterrupt keeps what was computed (``state.interrupted``, the state
     reached evaluated as a last record); one before the first record propagates.
     """
-    history = History(mfp.settlement_weights(scene.model) * [1.0, 1.0, scene.scales.length], opening=opening)
+    history = History(scene.direction, opening=opening, vertical=scene.VERTICAL)
     state.set_loads(scene, load)
     try:
         gravity_phase(scene, controls, state, history, progress)

@@ -19,8 +19,10 @@ import masonryfw.plugin_api as mfp
 from . import postprocess
 from .compilation import Compilations
 from .controls import make_controls
-from .scene import Scene, build_scene
+from .scene import Scene
+from .scene3d import Scene3, scene_of
 from .simulation import SETTLEMENT_PHASE, History, State, initial_state, run
+from .simulation3d import initial_state3
 
 LOG = logging.getLogger("masonryfw.fdem")
 #: Load-factor search (scaled time, sqrt(length / g)): the ramp to a trial multiplier, the longest hold.
@@ -45,11 +47,14 @@ def solve(model: xr.Dataset, options: Mapping[str, Any], progress=mfp.no_progres
 
 
 def _solve(model: xr.Dataset, options: Mapping[str, Any], progress) -> xr.Dataset:
-    scene = mfp.made_once(model, "fdem scene", build_scene)  # the one the estimate made
+    scene = scene_of(model)  # the one the estimate made
     mfp.refuse_rigid_settlement(model, "fdem")
     controls = make_controls(scene, options)
     load = scene.dead + (options["load_factor"] or 0.0) * scene.live
-    if options["mode"] == "deformable":
+    if isinstance(scene, Scene3):
+        refuse_in_3d(options, controls)
+        state = initial_state3(scene, controls)
+    elif options["mode"] == "deformable":
         from . import deformable, deformable_simulation
 
         deformable.check_supported(scene)
@@ -64,7 +69,8 @@ def _solve(model: xr.Dataset, options: Mapping[str, Any], progress) -> xr.Datase
     progress(0.0, f"fdem: dt = {controls.dt * scene.scales.time:.3g} s "
                   f"(dt_crit = {controls.dt_critical * scene.scales.time:.3g} s)")
     history = run(scene, controls, state, load, progress, opening_meter(scene))
-    result = result_dataset(scene, state, history)
+    result = result_dataset3(scene, state, history) if isinstance(scene, Scene3) else \
+        result_dataset(scene, state, history)
     result.attrs.update(
         stop_reason=state.stop_reason,
         interrupted=int(state.interrupted),
@@ -98,11 +104,23 @@ def _solve(model: xr.Dataset, options: Mapping[str, Any], progress) -> xr.Datase
     return result
 
 
-def opening_meter(scene: Scene):
-    """The widest crack in the masonry and the widest base gap of block positions (``mf.widest_crack``,
+def refuse_in_3d(options: Mapping[str, Any], controls) -> None:
+    """What fdem does not do in 3D yet, refused before the run: the CST mode and the load-factor search."""
+    if options["mode"] == "deformable":
+        raise mf.SolveError("fdem: mode = 'deformable' solves 2D models; a 3D model's blocks are rigid "
+                            "(mode = 'rigid')")
+    if controls.search:
+        raise mf.SolveError("fdem: the load-factor search (no moving support, a live load) solves 2D models; give "
+                            "a 3D model a moving support, or --option load_factor=<multiplier>")
+
+
+def opening_meter(scene: Scene | Scene3):
+    """The widest crack in the masonry and the widest base gap of a state's snapshot (``mf.widest_crack``,
     finite rotations)."""
-    def widest(pos: np.ndarray) -> mf.Cracks:
-        return mf.widest_crack(scene.model, postprocess.block_displacement(scene, pos), "finite")
+    displacement = postprocess.block_displacement3 if isinstance(scene, Scene3) else postprocess.block_displacement
+
+    def widest(snapshot: np.ndarray) -> mf.Cracks:
+        return mf.widest_crack(scene.model, displacement(scene, snapshot), "finite")
     return widest
 
 
@@ -213,4 +231,24 @@ def result_dataset(scene: Scene, state: State, history: History) -> xr.Dataset:
                                                {"units": "m", "long_name": "block centroid displacement at the snapshot"})
         data["snapshot_block_rotation"] = (("snapshot", "block"), motion[..., 2],
                                            {"units": "rad", "long_name": "block rotation at the snapshot"})
+    return xr.Dataset(data, attrs={"rotations": "finite", "flow_rule": "nonassociative"})
+
+
+def result_dataset3(scene: Scene3, state, history: History) -> xr.Dataset:
+    """The primary result variables of a 3D run: final displacements (a rotation as its rotation vector), the
+    history."""
+    motion = postprocess.block_displacement3(scene, state.snapshot())
+    data = {
+        "block_displacement": (("block", "axis"), motion[:, :3], mfp.variable_attrs("block_displacement", "result3d")),
+        "block_rotation": (("block", "axis"), motion[:, 3:], mfp.variable_attrs("block_rotation", "result3d")),
+        **history_variables(scene, history),
+    }
+    if history.snapshots:
+        motions = np.stack([postprocess.block_displacement3(scene, p) for _, p in history.snapshots])
+        data["snapshot_settlement"] = ("snapshot", np.array([s for s, _ in history.snapshots]) * scene.scales.length,
+                                       {"units": "m", "long_name": "settlement at the snapshot (first record past the requested one)"})
+        data["snapshot_block_displacement"] = (("snapshot", "block", "axis"), motions[..., :3],
+                                               {"units": "m", "long_name": "block centroid displacement at the snapshot"})
+        data["snapshot_block_rotation"] = (("snapshot", "block", "axis"), motions[..., 3:],
+                                           {"units": "rad", "long_name": "block rotation vector at the snapshot"})
     return xr.Dataset(data, attrs={"rotations": "finite", "flow_rule": "nonassociative"})

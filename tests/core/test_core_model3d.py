@@ -95,7 +95,7 @@ def test_la_solves_the_3d_model_to_the_planar_answer(in_3d):
 
 def test_what_handles_2d_only_refuses_a_3d_model_before_it_starts(in_3d):
     model, _ = in_3d
-    for solver in ("fdem", "jmm", "jmm-limit", "la-incremental"):
+    for solver in ("jmm", "jmm-limit", "la-incremental"):
         with pytest.raises(mf.SolveError, match=f"solver {solver} solves 2D models; 'Test 12C \\(3D twin\\)' is 3D"):
             mf.solve(model, solver)
     result = mf.solve(model, "la")
@@ -107,7 +107,7 @@ def test_what_handles_2d_only_refuses_a_3d_model_before_it_starts(in_3d):
 
 def test_the_command_line_says_so_without_a_traceback(in_3d, tmp_path):
     path = mf.save(in_3d[0], tmp_path / "wall3d.nc")
-    refused(cli(["solve", path, "--plugin", "fdem", "-o", tmp_path / "f.nc"], tmp_path), "solver fdem solves 2D models")
+    refused(cli(["solve", path, "--plugin", "jmm", "-o", tmp_path / "f.nc"], tmp_path), "solver jmm solves 2D models")
     cracks = tmp_path / "cracks.csv"
     cracks.write_text("crack,x,y\nc1,0.5,0.1\nc1,0.6,0.3\n")
     refused(cli(["diagnose", path, "--cracks", cracks, "-o", tmp_path / "d.nc"], tmp_path),

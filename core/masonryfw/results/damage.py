@@ -175,12 +175,13 @@ def category_variables(model: xr.Dataset, settlement: np.ndarray, width: np.ndar
 
 def damage_variables(model: xr.Dataset, produced: xr.Dataset) -> dict[str, tuple]:
     """The damage variables the core derives from a solver's history: the category of every
-    ``step_crack_width_max`` and the distortion of the imposed profile at every ``step_settlement``."""
+    ``step_crack_width_max`` and the distortion of the imposed profile at every ``step_settlement`` (a wall's
+    profile: in 3D the widest crack's category alone, the building's walls have a profile each)."""
     derived: dict[str, tuple] = {}
     if "step_crack_width_max" in produced:
         derived["step_damage_category"] = ("step", damage_category(produced.step_crack_width_max.values),
                                            variable_attrs("step_damage_category"))
-    if "step_settlement" in produced:
+    if "step_settlement" in produced and space(model) == 2:
         ratio, angle = distortion(*support_profile(model))
         settlement = np.asarray(produced.step_settlement.values, dtype=float)
         derived["step_deflection_ratio"] = ("step", ratio * settlement, variable_attrs("step_deflection_ratio"))

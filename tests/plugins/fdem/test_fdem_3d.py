@@ -1,0 +1,61 @@
+"""fdem on 3D models against fdem on the plane (a second formulation: polygons with three dofs against polyhedra
+with six): a wall's 3D twin settles as the wall does. And what fdem does not do in 3D yet is refused before the
+work, by name."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import masonryfw as mf
+import masonryfw.plugin_api as mfp
+
+
+@pytest.fixture(scope="module")
+def settled():
+    planar = mf.open_model("test-12c")
+    twin = mf.checked_model(mfp.twin(planar))
+    return planar, twin, mf.solve(planar, "fdem"), mf.solve(twin, "fdem")
+
+
+def settlement_records(result):
+    at = result.step_phase.values == 1
+    return result.step_settlement.values[at], result.step_reaction.values[at]
+
+
+def test_the_3d_twin_of_test_12c_settles_with_the_planar_reaction_history(settled):
+    """Reaction against settlement within 2 % of R0 of the planar run's all the way, the same minimum to 1 %."""
+    _, _, planar, twin = settled
+    (s2, r2), (s3, r3) = settlement_records(planar), settlement_records(twin)
+    r0 = r2[0]
+    grid = np.linspace(0.0, min(s2[-1], s3[-1]), 60)
+    assert np.abs(np.interp(grid, s3, r3) - np.interp(grid, s2, r2)).max() < 0.02 * r0
+    assert r3.min() == pytest.approx(r2.min(), abs=0.01 * r0)
+    assert twin.attrs["stood"] == 1 and twin.attrs["stop_reason"] in ("target settlement", "reaction plateau")
+
+
+def test_the_3d_twin_cracks_where_the_wall_cracks_as_wide(settled):
+    """The same cracked joints (F1 >= 0.9, by block pair), the widest crack within 5 %, no motion out of the plane
+    beyond 1e-6 of the motion in it."""
+    planar_model, twin_model, planar, twin = settled
+    pairs = {tuple(sorted(p)) for p in planar_model.interface_blocks.values[mf.cracked_joints(planar)].tolist()}
+    found = {tuple(sorted(p)) for p in twin_model.interface_blocks.values[mf.cracked_joints(twin)].tolist()}
+    f1 = 2 * len(pairs & found) / (len(pairs) + len(found))
+    assert f1 >= 0.9, (sorted(pairs - found), sorted(found - pairs))
+    assert twin.step_crack_width_max.values[-1] == pytest.approx(planar.step_crack_width_max.values[-1], rel=0.05)
+    motion = twin.block_displacement.values
+    assert np.abs(motion[:, 1]).max() <= 1e-6 * np.abs(motion[:, [0, 2]]).max()
+    assert np.abs(twin.block_rotation.values[:, [0, 2]]).max() <= 1e-6 * np.abs(twin.block_rotation.values[:, 1]).max()
+    assert twin.step_damage_category.values[-1] == planar.step_damage_category.values[-1]
+    assert not mf.check(twin, "result")
+
+
+def test_what_fdem_does_not_do_in_3d_is_refused_by_name(settled):
+    _, twin, _, _ = settled
+    with pytest.raises(mf.SolveError, match="mode = 'deformable' solves 2D models"):
+        mf.solve(twin, "fdem", {"mode": "deformable"})
+    held = twin.assign(block_role=twin.block_role.copy(data=np.where(
+        mfp.moving_blocks(twin.block_role.values), mfp.ROLE["fixed_support"], twin.block_role.values)))
+    tilted = held.assign(live_load=held.dead_load.copy(data=np.c_[-held.dead_load.values[:, 2],
+                                                                    np.zeros((held.sizes["block"], 2))]))
+    with pytest.raises(mf.SolveError, match="the load-factor search .* solves 2D models"):
+        mf.solve(mf.checked_model(tilted.assign(settlement_direction=tilted.settlement_direction * 0)), "fdem")
