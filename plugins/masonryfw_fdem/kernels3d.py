@@ -152,12 +152,8 @@ def rotate(q, vx, vy, vz):
 
 @jit
 def rotate_back(q, vx, vy, vz):
-    """The vector ``v`` turned by the inverse of the unit quaternion ``q``."""
-    w, x, y, z = q[0], -q[1], -q[2], -q[3]
-    tx = 2.0 * (y * vz - z * vy)
-    ty = 2.0 * (z * vx - x * vz)
-    tz = 2.0 * (x * vy - y * vx)
-    return (vx + w * tx + y * tz - z * ty, vy + w * ty + z * tx - x * tz, vz + w * tz + x * ty - y * tx)
+    """The vector ``v`` turned by the inverse of the unit quaternion ``q`` (its conjugate)."""
+    return rotate((q[0], -q[1], -q[2], -q[3]), vx, vy, vz)
 
 
 @jit

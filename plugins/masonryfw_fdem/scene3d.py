@@ -80,8 +80,9 @@ class Scene3:
         as the contact points carry it): omega^2 the largest eigenvalue of ``M^-1 K``, the block's 6 x 6
         stiffness ``K = sum a B^T B`` (``B = [I, -[r]x]`` at a vertex r from the centroid) over its mass and
         inertia, doubled (a spring joins two blocks that can move against each other). Bounding translation by
-        ``kn S / m`` and rotation by ``kn S R^2 / I_min`` instead (the 2D bound's form) took 2-3x as many
-        steps on the bundled walls' twins; the bound without the doubling let Test 12C's twin blow up."""
+        ``kn S / m`` and rotation by ``kn S R^2 / I_min`` instead (the 2D bound's form) took 1.5-7x the planar
+        run's steps on the bundled walls' twins (this bound: 1.6-1.75x); without the doubling Test 12C's twin
+        blew up."""
         poly = polyhedra(self)
         _, area, _ = mfp.face_normals_areas(poly)
         vertex = poly.face_vertex_index()

@@ -223,15 +223,27 @@ def result_dataset(scene: Scene, state: State, history: History) -> xr.Dataset:
             "trial_largest_motion": ("trial", motion * scene.scales.length, {
                 "units": "m", "long_name": "largest block motion from the last state at rest"}),
         })
-    if history.snapshots:
-        motion = np.stack([postprocess.block_displacement(scene, p) for _, p in history.snapshots])
-        data["snapshot_settlement"] = ("snapshot", np.array([s for s, _ in history.snapshots]) * scene.scales.length,
-                                       {"units": "m", "long_name": "settlement at the snapshot (first record past the requested one)"})
-        data["snapshot_block_displacement"] = (("snapshot", "block", "axis"), motion[..., :2],
-                                               {"units": "m", "long_name": "block centroid displacement at the snapshot"})
-        data["snapshot_block_rotation"] = (("snapshot", "block"), motion[..., 2],
-                                           {"units": "rad", "long_name": "block rotation at the snapshot"})
+    data.update(snapshot_variables(scene, history, postprocess.block_displacement))
     return xr.Dataset(data, attrs={"rotations": "finite", "flow_rule": "nonassociative"})
+
+
+def snapshot_variables(scene, history: History, displacement) -> dict:
+    """The snapshots' settlements and block motions, ``displacement(scene, snapshot)`` of each: ``(block, 3)``
+    (x, y, rotation) in 2D, ``(block, 6)`` (displacement, rotation vector) in 3D."""
+    if not history.snapshots:
+        return {}
+    motion = np.stack([displacement(scene, p) for _, p in history.snapshots])
+    planar = motion.shape[-1] == 3
+    return {
+        "snapshot_settlement": ("snapshot", np.array([s for s, _ in history.snapshots]) * scene.scales.length,
+                                {"units": "m", "long_name": "settlement at the snapshot (first record past the requested one)"}),
+        "snapshot_block_displacement": (("snapshot", "block", "axis"), motion[..., :2] if planar else motion[..., :3],
+                                        {"units": "m", "long_name": "block centroid displacement at the snapshot"}),
+        "snapshot_block_rotation": ((("snapshot", "block"), motion[..., 2], {
+            "units": "rad", "long_name": "block rotation at the snapshot"}) if planar else
+            (("snapshot", "block", "axis"), motion[..., 3:], {
+                "units": "rad", "long_name": "block rotation vector at the snapshot"})),
+    }
 
 
 def result_dataset3(scene: Scene3, state, history: History) -> xr.Dataset:
@@ -243,12 +255,5 @@ def result_dataset3(scene: Scene3, state, history: History) -> xr.Dataset:
         "block_rotation": (("block", "axis"), motion[:, 3:], mfp.variable_attrs("block_rotation", "result3d")),
         **history_variables(scene, history),
     }
-    if history.snapshots:
-        motions = np.stack([postprocess.block_displacement3(scene, p) for _, p in history.snapshots])
-        data["snapshot_settlement"] = ("snapshot", np.array([s for s, _ in history.snapshots]) * scene.scales.length,
-                                       {"units": "m", "long_name": "settlement at the snapshot (first record past the requested one)"})
-        data["snapshot_block_displacement"] = (("snapshot", "block", "axis"), motions[..., :3],
-                                               {"units": "m", "long_name": "block centroid displacement at the snapshot"})
-        data["snapshot_block_rotation"] = (("snapshot", "block", "axis"), motions[..., 3:],
-                                           {"units": "rad", "long_name": "block rotation vector at the snapshot"})
+    data.update(snapshot_variables(scene, history, postprocess.block_displacement3))
     return xr.Dataset(data, attrs={"rotations": "finite", "flow_rule": "nonassociative"})

@@ -69,7 +69,7 @@ def test_a_solve_from_the_command_line_checks_looks_up_resolves_and_builds_once(
     options twice (for the estimate, then the solve), and fdem built its scene twice: once each now."""
     from masonryfw import cli
     from masonryfw.format import model
-    from masonryfw_fdem import estimate, solver
+    from masonryfw_fdem import scene3d
 
     calls: dict[str, int] = {}
 
@@ -84,8 +84,7 @@ def test_a_solve_from_the_command_line_checks_looks_up_resolves_and_builds_once(
     counted(model, "check")
     counted(api, "lookup")
     counted(api, "resolve_options")
-    counted(estimate, "build_scene")
-    monkeypatch.setattr(solver, "build_scene", estimate.build_scene)  # one counter for both
+    counted(scene3d, "build_scene")  # the estimate and the solve both take their scene from scene3d.scene_of
     with pytest.raises(SystemExit) as end:
         cli.main(["solve", "test-12c", "--plugin", "fdem", "--option", "settlement=0.0002", "--no-progress",
                   "-o", str(tmp_path / "r.nc")])

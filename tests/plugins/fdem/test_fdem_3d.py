@@ -59,3 +59,16 @@ def test_what_fdem_does_not_do_in_3d_is_refused_by_name(settled):
                                                                     np.zeros((held.sizes["block"], 2))]))
     with pytest.raises(mf.SolveError, match="the load-factor search .* solves 2D models"):
         mf.solve(mf.checked_model(tilted.assign(settlement_direction=tilted.settlement_direction * 0)), "fdem")
+
+
+def test_a_3d_run_keeps_its_snapshots_as_rotation_vectors():
+    """Snapshots of a 3D run: the displacement (x, y, z) and the rotation vector of every block at the first
+    record past each requested settlement; the last one, taken at the end, is the final state."""
+    twin = mf.checked_model(mfp.twin(mf.open_model("test-8c")))
+    result = mf.solve(twin, "fdem", {"snapshots": "0.0005,0.002"})
+    assert result.snapshot_block_displacement.shape == (2, twin.sizes["block"], 3)
+    assert result.snapshot_block_rotation.shape == (2, twin.sizes["block"], 3)
+    settled = result.snapshot_settlement.values
+    assert 0.0005 <= settled[0] < settled[1] and settled[1] >= 0.002
+    assert np.abs(result.snapshot_block_rotation.values[:, :, [0, 2]]).max() <= 1e-9 * np.abs(
+        result.snapshot_block_rotation.values[:, :, 1]).max()
