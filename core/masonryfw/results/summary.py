@@ -16,6 +16,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ..format.model3d import interface_points, space
 from ..format.roles import masonry_blocks, moving_blocks
 from ..format.schema import flags
 from ..ground.assessment import assess
@@ -142,6 +143,15 @@ def _history_numbers(result: xr.Dataset) -> list[KeyNumber]:
     ]
 
 
+def joint_midpoint(model: xr.Dataset, interface: int) -> np.ndarray:
+    """The midpoint of an interface: its two ends' mean in 2D (x, y), its polygon's vertices' mean in 3D
+    (x, y, z)."""
+    if space(model) == 3:
+        first = int(model.interface_node_count.values[:interface].sum())
+        return interface_points(model)[first:first + int(model.interface_node_count.values[interface])].mean(axis=0)
+    return np.array([model.interface_x.values[interface].mean(), model.interface_y.values[interface].mean()])
+
+
 def _crack_numbers(result: xr.Dataset) -> list[KeyNumber]:
     """The widest crack over the run, where and when it is, the damage category it gives; the last
     record's crack and category; the widest base gap."""
@@ -155,11 +165,9 @@ def _crack_numbers(result: xr.Dataset) -> list[KeyNumber]:
                                  "settlement at the record of the widest crack"))
     interface = int(result.step_crack_interface.values[widest]) if "step_crack_interface" in result else -1
     if interface >= 0:
-        numbers += [
-            KeyNumber("crack_interface", float(interface), "1", "the joint of the widest crack"),
-            KeyNumber("crack_x", float(result.interface_x.values[interface].mean()), "m", "x of that joint's midpoint"),
-            KeyNumber("crack_y", float(result.interface_y.values[interface].mean()), "m", "y of that joint's midpoint"),
-        ]
+        numbers.append(KeyNumber("crack_interface", float(interface), "1", "the joint of the widest crack"))
+        numbers += [KeyNumber(f"crack_{axis}", float(value), "m", f"{axis} of that joint's midpoint")
+                    for axis, value in zip("xyz", joint_midpoint(result, interface))]
     if "step_damage_category" in result:
         category = np.asarray(result.step_damage_category.values)
         numbers += [

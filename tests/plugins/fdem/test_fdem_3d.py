@@ -72,3 +72,15 @@ def test_a_3d_run_keeps_its_snapshots_as_rotation_vectors():
     assert 0.0005 <= settled[0] < settled[1] and settled[1] >= 0.002
     assert np.abs(result.snapshot_block_rotation.values[:, :, [0, 2]]).max() <= 1e-9 * np.abs(
         result.snapshot_block_rotation.values[:, :, 1]).max()
+
+
+def test_the_3d_key_numbers_place_the_widest_crack_where_the_plane_does(settled):
+    """The widest crack's joint midpoint: (x, y) on the plane, (x, 0, z = y) on its twin (the 3D polygon's
+    vertices' mean)."""
+    _, _, planar, twin = settled
+    flat = {n.name: n.value for n in mf.key_numbers(planar)}
+    solid = {n.name: n.value for n in mf.key_numbers(twin)}
+    assert solid["crack_x"] == pytest.approx(flat["crack_x"], abs=1e-9)
+    assert solid["crack_z"] == pytest.approx(flat["crack_y"], abs=1e-9)
+    assert solid["crack_y"] == pytest.approx(0.0, abs=1e-12)
+    assert solid["damage_category"] == flat["damage_category"]
