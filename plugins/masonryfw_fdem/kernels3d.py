@@ -174,15 +174,6 @@ def turn(q, rx, ry, rz):
 
 
 @jit
-def rotation_matrix(q):
-    """The rotation matrix of the unit quaternion ``q``."""
-    w, x, y, z = q[0], q[1], q[2], q[3]
-    return np.array([[1.0 - 2.0 * (y * y + z * z), 2.0 * (x * y - w * z), 2.0 * (x * z + w * y)],
-                     [2.0 * (x * y + w * z), 1.0 - 2.0 * (x * x + z * z), 2.0 * (y * z - w * x)],
-                     [2.0 * (x * z - w * y), 2.0 * (y * z + w * x), 1.0 - 2.0 * (x * x + y * y)]])
-
-
-@jit
 def rotation_angle(q, p):
     """The angle of the rotation from ``p`` to ``q``."""
     dot = abs(q[0] * p[0] + q[1] * p[1] + q[2] * p[2] + q[3] * p[3])

@@ -176,6 +176,7 @@ def bodies_of(poly: mfp.Polyhedra, unit_weight: np.ndarray, driven: np.ndarray, 
         face = int(np.argmax(poly.face_node_count > MAX_FACE_VERTICES))
         raise mf.SolveError(f"fdem: block {int(poly.face_block()[face])} has a face of "
                              f"{int(poly.face_node_count[face])} vertices (at most {MAX_FACE_VERTICES})")
+    refuse_non_convex_faces(poly)
     unit_weight = np.broadcast_to(np.asarray(unit_weight, dtype=float), volume.shape)
     mass = unit_weight * volume
     moments = unit_weight[:, None, None] * mfp.second_moments(poly)
@@ -192,6 +193,22 @@ def bodies_of(poly: mfp.Polyhedra, unit_weight: np.ndarray, driven: np.ndarray, 
                    poly.face_vertex_index().astype(np.int64), poly.face_block().astype(np.int64), mass, inertia,
                    inv_inertia, np.asarray(driven, dtype=bool), np.asarray(moving, dtype=bool),
                    np.asarray(direction, dtype=float))
+
+
+def refuse_non_convex_faces(poly: mfp.Polyhedra) -> None:
+    """Refuse a face that turns against its normal at a vertex: the face pairs' clipping takes convex faces (the
+    format allows non-convex ones; la takes them, fdem in 3D does not yet)."""
+    normal, area, _ = mfp.face_normals_areas(poly)
+    index = poly.face_vertex_index()
+    following = mfp.next_node(poly.face_node_count)
+    edge = poly.vertices[index[following]] - poly.vertices[index]
+    turn = np.einsum("ij,ij->i", np.cross(edge, edge[following]), np.repeat(normal, poly.face_node_count, axis=0))
+    size = np.repeat(area, poly.face_node_count)
+    bad = np.flatnonzero(turn < -1e-9 * size)
+    if bad.size:
+        face = int(np.repeat(np.arange(poly.face_node_count.size), poly.face_node_count)[bad[0]])
+        raise mf.ModelError(f"block {int(poly.face_block()[face])}: face {face} is not convex; fdem in 3D takes "
+                            "convex faces (split the face, or solve with la)")
 
 
 def at_rest(bodies: Bodies3) -> Motion3:

@@ -7,6 +7,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+import masonryfw as mf
 import masonryfw.plugin_api as mfp
 from masonryfw_fdem import kernels3d as k3
 from masonryfw_fdem import scene3d as s3
@@ -43,6 +44,14 @@ def run(bodies, load, friction, steps, dt=1e-3, damping=0.0, dashpot=0.2, ramp=0
         motion.pos_detect[:] = motion.pos
         motion.quat_detect[:] = motion.quat
     return motion, pairs, wrench
+
+
+def rotation_of(q):
+    """The rotation matrix of a unit quaternion (w, x, y, z), written out here as the reference."""
+    w, x, y, z = q
+    return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+                     [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+                     [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])
 
 
 def weight_load(bodies, tilt=0.0, sideways=0.0):
@@ -114,7 +123,7 @@ def test_a_free_symmetric_top_keeps_its_angular_momentum_and_precesses_at_l_over
     steps, dt = 20000, 1e-4
     k3.advance3(steps, bodies, pairs, k3.ContactLaw3(KN, KN, 0.0, 0.0), motion,
                 k3.Loading3(np.zeros((1, 6)), 0.0, 0.0, 0.0, 0.0, 0.0), k3.Stepping3(dt, 0.0, 1e9), np.zeros((1, 6)))
-    r = k3.rotation_matrix(motion.quat[0])
+    r = rotation_of(motion.quat[0])
     after = r @ bodies.inertia[0] @ r.T @ motion.omega[0]
     assert np.linalg.norm(after - momentum) < 1e-3 * np.linalg.norm(momentum)
     axis, along = r[:, 2], momentum / np.linalg.norm(momentum)
@@ -123,3 +132,15 @@ def test_a_free_symmetric_top_keeps_its_angular_momentum_and_precesses_at_l_over
     turned = np.arctan2(np.cross(across0, across) @ along, across0 @ across)
     expected = np.linalg.norm(momentum) / bodies.inertia[0][0, 0] * steps * dt
     assert np.mod(turned, 2 * np.pi) == pytest.approx(np.mod(expected, 2 * np.pi), abs=2e-3)
+
+
+def test_a_block_with_a_non_convex_face_is_refused_by_name():
+    """The clipping takes convex faces: an L-shaped prism (its two L faces non-convex) is refused naming the block,
+    a box beside it is not."""
+    x = np.array([0.0, 2.0, 2.0, 1.0, 1.0, 0.0, 3.0, 4.0, 4.0, 3.0])
+    y = np.array([0.0, 0.0, 1.0, 1.0, 2.0, 2.0, 0.0, 0.0, 1.0, 1.0])
+    poly = mfp.prisms(x, y, np.array([6, 4]), np.array([0.5, 0.5]))
+    with pytest.raises(mf.ModelError, match="block 0: face .* is not convex"):
+        s3.bodies_of(poly, np.ones(2), np.zeros(2, bool), np.zeros(2, bool), np.zeros((2, 6)))
+    box = mfp.boxes(np.array([[3.0, 0.0, -0.25]]), np.array([[4.0, 1.0, 0.25]]))
+    assert s3.bodies_of(box, np.ones(1), np.zeros(1, bool), np.zeros(1, bool), np.zeros((1, 6))).mass[0] == 0.5
