@@ -35,6 +35,7 @@ from .results.summary import (
     load_word,
     result_label,
     stages_text,
+    walls_text,
 )
 from .runtime.errors import Interrupted, MasonryError, ModelError, PluginError, SolveError, SpecError
 from .runtime.inputs import InputError
@@ -55,7 +56,7 @@ __all__ = [
     # What results mean
     "CRACK_THRESHOLD", "at_threshold", "cracked_joints", "dead_reaction", "settlement_reaction",
     "KeyNumber", "key_numbers", "headline_text", "load_word", "damage_text", "result_label", "stages_text",
-    "capacity_text",
+    "capacity_text", "walls_text",
     "DAMAGE_LIMITS", "Cracks", "damage_category", "widest_crack",
     # Files
     "open_dataset", "save", "save_figure",

@@ -274,6 +274,9 @@ def solve(model: str, solver: str, output: str | None, options: dict[str, str], 
     stages = mf.stages_text(result)
     if stages:
         click.echo(f"stages {stages}")
+    walls = mf.walls_text(result)
+    if walls:
+        click.echo(walls)
 
 
 #: A solver option that spaces its records (la-incremental's steps grow while its mechanism holds): capacity asks
@@ -301,8 +304,16 @@ def capacity(model: str, solver: str, category: int | None, settlement: float | 
     the LTSM's (stage 2) and the greenfield screen's (stage 1) over the model's settlement profile. A
     tunnel's S_max is proportional to its volume loss and the trough keeps its shape, so one run to a larger
     settlement answers every smaller volume loss. The result file keeps them (``category_settlement``, ...).
-    A solver that stops at a reaction plateau (fdem) runs to the end.
+    A solver that stops at a reaction plateau (fdem) runs to the end. MODEL may be an incremental solver's
+    result instead (``masonryfw solve``'s to a tunnel's S_max): its history is read, nothing is run again.
     """
+    if _is_result(model):
+        given = [name for name, value in (("--settlement", settlement), ("--volume-loss", volume_loss),
+                                          ("--option", options), ("-o", output)) if value]
+        if given:
+            raise mf.InputError(f"{model} is a result: it is read, not run again ({', '.join(given)} would run it); "
+                                "give its model to run a new one")
+        return _capacity_text_of(mf.open_checked(model), model, category)
     if settlement is not None and volume_loss is not None:
         raise mf.InputError("give --settlement or --volume-loss, not both")
     if volume_loss is not None:
@@ -321,7 +332,19 @@ def capacity(model: str, solver: str, category: int | None, settlement: float | 
     if RECORDS in declared and RECORDS not in options and declared[RECORDS].default < CAPACITY_RECORDS:
         options = {**options, RECORDS: str(CAPACITY_RECORDS)}  # each category's settlement known to a hundredth
     result, out, _ = _solved(model, solver, output, options, progress, force)
-    mfp.refuse_not_standing([result], f"capacity (the result is written to {out})")
+    _capacity_text_of(result, out, category, f"capacity (the result is written to {out})")
+
+
+def _is_result(path: str) -> bool:
+    """Whether ``path`` is a result file (not a spec, a model or a bundled case's name)."""
+    file = Path(path)
+    return file.is_file() and not mfp.is_spec(file) and mf.open_dataset(file).attrs.get("masonryfw_format") == "result"
+
+
+def _capacity_text_of(result, out, category: int | None, what: str = "capacity") -> None:
+    """Print where each damage category is first reached in ``result`` (written to, or read from, ``out``)."""
+    mfp.refuse_not_standing([result], what)
+    solver = result.attrs.get("solver", "the run")
     text = mf.capacity_text(result, category)
     if not text:
         raise mf.SolveError(f"{solver}: its result has no crack-width history to find the damage categories in; "

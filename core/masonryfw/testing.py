@@ -157,13 +157,19 @@ def corner_building(bond: str = "running", angle: float = 90.0) -> xr.Dataset:
 
 
 def permuted(model: xr.Dataset, block_order: np.ndarray, interface_order: np.ndarray) -> xr.Dataset:
-    """The same model with its blocks and interfaces listed in another order (a checked model)."""
+    """The same model with its blocks and interfaces listed in another order (a checked model; in 3D each
+    interface keeps its polygon)."""
     counts = model.block_node_count.values.astype(np.int64)
     start = np.concatenate(([0], np.cumsum(counts)))
     nodes = np.concatenate([np.arange(start[b], start[b + 1]) for b in block_order])
     new_index = np.empty_like(block_order)
     new_index[block_order] = np.arange(block_order.size)
-    ds = model.isel(block=block_order, node=nodes, interface=interface_order)
+    ragged = {"node": nodes}
+    if "interface_node_count" in model:  # 3D: the interfaces' polygons follow their interfaces
+        count = model.interface_node_count.values.astype(np.int64)
+        first = np.concatenate(([0], np.cumsum(count)))
+        ragged["interface_node"] = np.concatenate([np.arange(first[i], first[i + 1]) for i in interface_order])
+    ds = model.isel(block=block_order, interface=interface_order, **ragged)
     ds = ds.assign(interface_blocks=(("interface", "side"), new_index[ds.interface_blocks.values].astype(np.int32),
                                      ds.interface_blocks.attrs))
     return checked_model(ds)

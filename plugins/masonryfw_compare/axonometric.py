@@ -23,6 +23,7 @@ VIEW = (22.0, -58.0)
 #: The largest vertex motion of a mechanism is drawn as this share of the model's size by default.
 DRAWN_MOTION_SHARE = 0.05
 CRACK_COLOUR = "k"
+WIDEST_RING = "#0050d0"
 
 
 def axes_3d(ax):
@@ -44,9 +45,8 @@ def moved_points(geo: xr.Dataset, u: np.ndarray, amplification: float) -> np.nda
     """The blocks' vertices moved by ``amplification`` times the mechanism ``u`` (block, 6), linearised."""
     owner = np.repeat(np.arange(geo.sizes["block"]), geo.block_node_count.values)
     points = np.c_[geo.node_x.values, geo.node_y.values, geo.node_z.values]
-    centre = np.c_[geo.block_centroid_x.values, geo.block_centroid_y.values, geo.block_centroid_z.values][owner]
-    motion = u[owner, :3] + np.cross(u[owner, 3:], points - centre)
-    return points + amplification * motion
+    centre = np.c_[geo.block_centroid_x.values, geo.block_centroid_y.values, geo.block_centroid_z.values]
+    return points + amplification * mfp.carried_motion(u, centre, points, owner)
 
 
 def default_amplification(geo: xr.Dataset, u: np.ndarray) -> float:
@@ -159,9 +159,103 @@ def cracked_outlines(geo: xr.Dataset, u: np.ndarray, amplification: float, crack
     """The polygon of every cracked interface, closed, carried by its side-0 block's amplified motion."""
     count = geo.interface_node_count.values.astype(np.int64)
     points = mfp.interface_points(geo)
-    owner = np.repeat(np.arange(count.size), count)
-    side0 = geo.interface_blocks.values[owner, 0].astype(np.int64)
-    centre = np.c_[geo.block_centroid_x.values, geo.block_centroid_y.values, geo.block_centroid_z.values][side0]
-    moved = points + amplification * (u[side0, :3] + np.cross(u[side0, 3:], points - centre))
+    side0 = geo.interface_blocks.values[np.repeat(np.arange(count.size), count), 0].astype(np.int64)
+    centre = np.c_[geo.block_centroid_x.values, geo.block_centroid_y.values, geo.block_centroid_z.values]
+    moved = points + amplification * mfp.carried_motion(u, centre, points, side0)
     polygons = np.split(moved, np.cumsum(count)[:-1])
     return [np.vstack([p, p[:1]]) for p, crack in zip(polygons, cracked) if crack]
+
+
+#: Crack colours by damage category 1 to 5 (a joint opening under category 1's 0.1 mm is not drawn).
+CATEGORY_COLOURS = ("#fdd49e", "#fc8d59", "#e34a33", "#b30000", "#4a0000")
+MASONRY_FACE = (0.93, 0.93, 0.93, 0.25)  # light and see-through: the cracks of the far walls show through
+
+
+def draw_cracks_3d(ds: xr.Dataset, ax, threshold: float, state_colours: Mapping[str, str]) -> None:
+    """The building as built, see-through, and its joints in the masonry over it: of a result with crack widths
+    (an incremental solver) every joint that opens at the last record by a damage category's width (0.1 mm and
+    more) filled in that category's colour, each wall's widest crack ringed and listed with its width and
+    category (``step_wall_crack_width_max``); of a mechanism (limit analysis: a shape, not a size) the cracked
+    joints at ``threshold`` by how they move (``state_colours``: open, slide, both). The walls named."""
+    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+
+    ax = axes_3d(ax)
+    ax.computed_zorder = False  # the cracks over the see-through blocks
+    geo = mfp.derive_geometry(ds)
+    points = np.c_[geo.node_x.values, geo.node_y.values, geo.node_z.values]
+    polygons, block = faces(geo, points)
+    support = mfp.support_blocks(geo.block_role.values)
+    ax.add_collection3d(Poly3DCollection([p for p, b in zip(polygons, block) if not support[b]],
+                                         facecolors=[MASONRY_FACE], edgecolors=(0.5, 0.5, 0.5, 0.25),
+                                         linewidths=0.1, zorder=1))
+    count = geo.interface_node_count.values.astype(np.int64)
+    joints = np.split(mfp.interface_points(geo), np.cumsum(count)[:-1])
+    widths = "step_crack_width_max" in ds and ds.step_crack_width_max.size > 0
+    groups = category_groups(ds) if widths else state_groups(ds, threshold, state_colours)
+    handles = []
+    for z, (label, colour, chosen) in enumerate(groups):
+        if chosen.size:
+            ax.add_collection3d(Poly3DCollection([joints[j] for j in chosen], facecolors=colour, edgecolors=colour,
+                                                 linewidths=1.2, zorder=3 + z))
+        handles.append(Patch(facecolor=colour, edgecolor=colour, label=f"{label} ({chosen.size})"))
+    if widths:
+        handles += ring_widest_per_wall(ds, ax, joints)
+    title = ("joints opening at the last record, by the\ndamage category of their width (Burland et al. 1977)"
+             if widths else f"cracked joints (threshold {threshold:g}): a mechanism's\nshape, not its size (no widths)")
+    legend_beside(ax, TICKS_3D, handles=handles, fontsize="small", frameon=False, title=title, title_fontsize="small")
+    finish_3d(ax, ds, points)
+
+
+def category_groups(ds: xr.Dataset) -> list[tuple[str, str, np.ndarray]]:
+    """``(label, colour, joints)`` of damage categories 1 to 5 by the width each joint opens at the last record."""
+    category = mf.damage_category(joint_openings(ds))
+    names = {value: name.replace("_", " ") for name, value in mfp.flags("step_damage_category").items()}
+    groups = []
+    for k, colour in enumerate(CATEGORY_COLOURS, start=1):
+        lower = f"{mf.DAMAGE_LIMITS[k - 1] * 1e3:.3g}"
+        widths = f"{lower} - {mf.DAMAGE_LIMITS[k] * 1e3:.3g} mm" if k < len(mf.DAMAGE_LIMITS) else f"over {lower} mm"
+        groups.append((f"{k} {names[k]}: {widths}", colour, np.flatnonzero(category == k)))
+    return groups
+
+
+def state_groups(ds: xr.Dataset, threshold: float, colours: Mapping[str, str]) -> list[tuple[str, str, np.ndarray]]:
+    """``(label, colour, joints)`` of the joints in the masonry cracked at ``threshold``, by their state."""
+    derived = mf.at_threshold(ds, threshold)
+    state = derived.interface_state.values
+    masonry = mfp.masonry_blocks(derived.block_role.values)[derived.interface_blocks.values.astype(np.int64)]
+    flag = mfp.flags("interface_state")
+    return [(meaning.replace("_", " + "), colour, np.flatnonzero((state == flag[meaning]) & masonry.all(axis=1)))
+            for meaning, colour in colours.items()]
+
+
+def joint_openings(ds: xr.Dataset) -> np.ndarray:
+    """Every joint's widest opening at its vertices [m] at the last record, 0 for a joint with the ground (a base
+    gap is no crack in the masonry)."""
+    derived = mf.at_threshold(ds)  # the relative motion at the vertices (no threshold in it)
+    count = derived.interface_node_count.values.astype(np.int64)
+    opening = np.maximum.reduceat(np.maximum(derived.interface_opening.values, 0.0), np.r_[0, np.cumsum(count)[:-1]])
+    masonry = mfp.masonry_blocks(derived.block_role.values)[derived.interface_blocks.values.astype(np.int64)]
+    return np.where(masonry.all(axis=1), opening, 0.0)
+
+
+def ring_widest_per_wall(ds: xr.Dataset, ax, joints: list[np.ndarray]) -> list:
+    """Each wall's widest crack at the last record ringed, the widest of them in :data:`WIDEST_RING`; their legend
+    lines (wall, width, category, course and place along the wall), in the walls' order."""
+    if "step_wall_crack_width_max" not in ds or not ds.step_settlement.size:
+        return []
+    width = ds.step_wall_crack_width_max.values[-1]
+    joint = ds.step_wall_crack_interface.values[-1].astype(np.int64)
+    worst = int(np.argmax(width))
+    opened = [w for w in range(width.size) if joint[w] >= 0]
+    for w in sorted(opened, key=lambda w: w == worst):  # the worst ring drawn last, over a ring it shares
+        ax.scatter(*joints[joint[w]].mean(axis=0), s=160, facecolors="none", linewidths=1.8, zorder=9,
+                   edgecolors=WIDEST_RING if w == worst else "k", depthshade=False)
+    handles = []
+    for w in opened:
+        place = mfp.crack_place(ds, int(joint[w]), w)
+        where = f", course {place.course}, {place.along:.2f} m along" if place else ""
+        handles.append(Line2D([], [], marker="o", markersize=9, markerfacecolor="none", linestyle="none",
+                              markeredgecolor=WIDEST_RING if w == worst else "k", markeredgewidth=1.6,
+                              label=f"{ds.wall_name.values[w]}: {width[w] * 1e3:.3g} mm, category "
+                                    f"{int(mf.damage_category(width[w]))}{where}"))
+    return handles

@@ -283,6 +283,8 @@ def draw_cracks(datasets: Sequence[xr.Dataset], ax, options: Mapping[str, Any]) 
     ds = single_result(datasets, "cracks")
     require_variables(ds, ["interface_opening", "interface_slip"], "cracks",
              "the relative motion at the joints (a result with block displacements: la, fdem)")
+    if mfp.space(ds) == 3:
+        return axonometric.draw_cracks_3d(ds, ax, options["threshold"], STATE_COLOURS)
     geo = mfp.derive_geometry(ds)
     state = mf.at_threshold(ds, options["threshold"]).interface_state.values
     draw_blocks(ax, geo, geo.node_x.values, geo.node_y.values, np.array(["0.93"] * geo.sizes["block"], dtype=object))

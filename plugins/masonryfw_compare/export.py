@@ -9,11 +9,14 @@ geometry and a multiblock index that opens them together:
 | ``wall_joints.vtu`` | one line per interface | cell: ``interface_index``, ``interface_kind``, ``interface_state``, ``crack_indicator``; point (the two ends): ``interface_opening``, ``interface_slip``, ``interface_normal_force``, ``interface_shear_force`` |
 | ``wall_mesh.vtu`` | continuum mesh faces (``mesh_face_nodes``) | cell: ``face_index`` |
 | ``wall_qp.vtu`` | one vertex per quadrature point | point: ``qp_failure`` (0 elastic, 1 tensile, 2 shear, 3 both) |
-| ``wall.vtm`` | VTK multiblock index of the files above | |
+| ``wall_series_000.vtu``, ... | a result with snapshots (fdem in 3D keeps 20 by default): the blocks at each | as ``wall.vtu``, at the snapshot |
+| ``wall_series.pvd`` | ParaView collection of the snapshots, each at its settlement [m] as the time: it plays the settlement | |
+| ``wall.vtm`` | VTK multiblock index of the final state's files | |
 
 A 3D result (``masonryfw_space = 3``) writes its blocks as the polygons of their faces (cell data per face:
 ``face_index``, ``block_index``, ``block_role``, ``macro_block``, ``centroid_displacement`` (ux, uy, uz),
-``rotation`` (rx, ry, rz); point: ``displacement``) and its interfaces as their polygons (cell:
+``rotation`` (rx, ry, rz); point: ``displacement``, by the finite rotation of an incremental solver's result)
+and its interfaces as their polygons (cell:
 ``interface_index``, ``interface_kind``, ``interface_state``, ``crack_indicator``, ``interface_normal_force``;
 point: ``interface_opening``, ``interface_slip``, ``interface_point_force``).
 
@@ -123,8 +126,9 @@ def blocks_mesh_3d(ds: xr.Dataset):
         cell_data["centroid_displacement"] = _split(u[block, :3], order)
         cell_data["rotation"] = _split(u[block, 3:], order)
         owner = np.repeat(np.arange(geo.sizes["block"]), geo.block_node_count.values)
-        centre = np.c_[geo.block_centroid_x.values, geo.block_centroid_y.values, geo.block_centroid_z.values][owner]
-        point_data["displacement"] = u[owner, :3] + np.cross(u[owner, 3:], poly.vertices - centre)
+        centre = np.c_[geo.block_centroid_x.values, geo.block_centroid_y.values, geo.block_centroid_z.values]
+        point_data["displacement"] = mfp.carried_motion(u, centre, poly.vertices, owner,
+                                                        str(ds.attrs.get("rotations", "small")))
     return meshio.Mesh(poly.vertices, cells, point_data=point_data, cell_data=cell_data)
 
 
@@ -208,13 +212,36 @@ PIECES = (
 
 
 def export_paths(ds: xr.Dataset, path: str | os.PathLike) -> list[Path]:
-    """The files :func:`export_vtk` writes for ``ds`` at ``path`` (a ``.vtu`` name), the ``.vtm`` index last."""
+    """The files :func:`export_vtk` writes for ``ds`` at ``path`` (a ``.vtu`` name), the ``.vtm`` index of the
+    final state last; before it, of a result with snapshots, their blocks and the ``.pvd`` collection of them."""
     path = Path(path)
     if path.suffix.lower() != ".vtu":
         raise mf.MasonryError(f"VTK export file {str(path)!r}: the name must end in .vtu")
     stem = path.with_suffix("")
     pieces = [Path(f"{stem}{suffix}.vtu") for _, suffix, present, _ in PIECES if present(ds)]
-    return pieces + [path.with_suffix(".vtm")]
+    return pieces + series_paths(ds, stem) + [path.with_suffix(".vtm")]
+
+
+def series_paths(ds: xr.Dataset, stem: Path) -> list[Path]:
+    """The time series' files: each snapshot's blocks (``<stem>_series_000.vtu``, ...) and their ``.pvd``
+    collection last; none for a result without snapshots."""
+    count = ds.sizes.get("snapshot", 0)
+    return [Path(f"{stem}_series_{k:03d}.vtu") for k in range(count)] + ([Path(f"{stem}_series.pvd")] if count else [])
+
+
+def snapshot_state(ds: xr.Dataset, k: int) -> xr.Dataset:
+    """``ds`` moved to its snapshot ``k``: its blocks' displacements and rotations those of the snapshot (the final
+    state's macro-blocks left out: they are the last record's)."""
+    state = ds.drop_vars(["macro_block"] if "macro_block" in ds else [])
+    return state.assign(block_displacement=ds.block_displacement.copy(data=ds.snapshot_block_displacement.values[k]),
+                        block_rotation=ds.block_rotation.copy(data=ds.snapshot_block_rotation.values[k]))
+
+
+def _collection(entries: list[tuple[float, Path]]) -> str:
+    """A ParaView ``.pvd`` collection: each file at its time, here the settlement [m] of its snapshot."""
+    rows = "\n".join(f'    <DataSet timestep="{time!r}" group="" part="0" file="{path.name}"/>' for time, path in entries)
+    return ('<?xml version="1.0"?>\n<VTKFile type="Collection" version="0.1">\n'
+            f"  <Collection>\n{rows}\n  </Collection>\n</VTKFile>\n")
 
 
 def export_vtk(ds: xr.Dataset, path: str | os.PathLike) -> list[Path]:
@@ -228,6 +255,13 @@ def export_vtk(ds: xr.Dataset, path: str | os.PathLike) -> list[Path]:
     present = [(name, build) for name, _, has, build in PIECES if has(ds)]
     pieces = [(name, target) for (name, _), target in zip(present, paths)]
     writes = {target: _vtu_writer(build(ds)) for (_, build), target in zip(present, paths)}
+    series = series_paths(ds, Path(path).with_suffix(""))
+    build = blocks_mesh_3d if mfp.space(ds) == 3 else blocks_mesh
+    for k, target in enumerate(series[:-1]):
+        writes[target] = _vtu_writer(build(snapshot_state(ds, k)))
+    if series:
+        entries = list(zip(ds.snapshot_settlement.values.tolist(), series[:-1]))
+        writes[series[-1]] = lambda temporary: temporary.write_text(_collection(entries))
     writes[paths[-1]] = lambda temporary: temporary.write_text(_multiblock(pieces))
     return mfp.write_atomically(writes, path)  # the set or nothing: ParaView opens the index, which names the rest
 

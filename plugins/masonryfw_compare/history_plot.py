@@ -2,6 +2,7 @@
 together, with its table (the CSV of ``plot --table``)."""
 from __future__ import annotations
 
+import itertools
 from collections import Counter
 from collections.abc import Mapping, Sequence
 from pathlib import Path
@@ -260,11 +261,15 @@ def _fit_y_to_shown(ax, curves: Sequence[tuple[np.ndarray, np.ndarray]]) -> None
         ax.set_ylim(min(0.0, min(float(np.min(y)) for y in ys)), 1.05 * max(float(np.max(y)) for y in ys))
 
 
+#: Line styles of a building's walls in the damage history (the building's widest crack is the solid line).
+WALL_STYLES = ("--", ":", "-.", (0, (5, 1, 1, 1, 1, 1)), (0, (1, 3)))
+
+
 def _draw_damage(ax, incremental, labels, colours) -> None:
     """The widest crack of every result against the settlement on one crack-width axis whose damage
     categories are bands (their limits from ``mf.DAMAGE_LIMITS``, named at the right): the category a curve
     is in is the band it crosses, with no second axis to misread. Linear up to 0.1 mm (category 0, where a
-    crack may be 0), logarithmic above."""
+    crack may be 0), logarithmic above. One building's result: each wall's widest crack too."""
     for ds in incremental:
         require_variables(ds, ["step_damage_category", "step_crack_width_max"], "history --option quantity=damage",
                  "a result with crack widths (fdem or jmm)")
@@ -281,6 +286,10 @@ def _draw_damage(ax, incremental, labels, colours) -> None:
     for ds, label, colour in zip(incremental, labels, colours):
         s = 1e3 * ds.step_settlement.values
         ax.plot(s, 1e3 * ds.step_crack_width_max.values, color=colour, lw=1.3, label=label)
+        if len(incremental) == 1 and "step_wall_crack_width_max" in ds:  # a building's: each wall's widest crack
+            for w, (name, style) in enumerate(zip(ds.wall_name.values, itertools.cycle(WALL_STYLES))):
+                ax.plot(s, 1e3 * ds.step_wall_crack_width_max.values[:, w], color=colour, lw=0.9, ls=style,
+                        alpha=0.8, label=f"wall {name}")
     ax.set_ylim(0.0, top)
     ax.set_yticks(limits_mm, [f"{v:g}" for v in limits_mm])
     ax.minorticks_off()

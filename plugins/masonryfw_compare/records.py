@@ -58,7 +58,7 @@ PLOTTERS = {
         _plotter("cracks", "joints that open, slide or both, in colours; the widest crack marked with the damage "
                  "category", (THRESHOLD_OPTION,
                               mfp.Option("widths", bool, False, "draw each cracked joint as wide as its opening "
-                                         "(amplified; its width in mm in the legend)"))),
+                                         "(amplified; its width in mm in the legend)")), spaces=(2, 3)),
         _plotter("forces", "contact forces (at collapse, or at the last record) as thrust segments",
                  (mfp.Option("scale", float, 1.0, "largest segment, in median interface lengths", above=0.0),)),
         _plotter("plastic", "plastic quadrature points over the mesh (continuum results)",
@@ -71,7 +71,7 @@ PLOTTERS = {
                   mfp.Option("xscale", str, "linear", "settlement axis; log shows the first fraction of a millimetre "
                             "(where jmm's history lives) next to fdem's centimetres", ("linear", "log")),
                   mfp.Option("settlement_max", float, None, "zoom: the settlement axis ends here [mm]", above=0.0)),
-                 table=True, module="history_plot"),
+                 table=True, module="history_plot", spaces=(2, 3)),
         _plotter("compare", "two or more results side by side with their scores",
                  (AMPLIFICATION_OPTION, THRESHOLD_OPTION), side_by_side=True, module="compare_plot"),
         _plotter("ltsm", "the engineers' stage 2 over a settlement profile: the trough under the wall (a building's "

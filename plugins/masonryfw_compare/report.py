@@ -140,7 +140,9 @@ def _result_figures(ds: xr.Dataset, label: str) -> list[str]:
     captions = {
         "mechanism": f"the mechanism ({_mechanism_source(ds)}, amplified); the dominant macro-blocks numbered by "
                      "size, cracked joints heavy on the blocks' faces.",
-        "cracks": "joints that open, slide or both.",
+        "cracks": ("the joints in the masonry that open at the last record, filled in the colour of their width's "
+                   "damage category, each wall's widest ringed and listed (the building as built, see-through)."
+                   if mfp.space(ds) == 3 and "step_crack_width_max" in ds else "joints that open, slide or both."),
         "forces": f"joint resultants {_forces_state(ds)}; colour: the share of the friction used.",
         "plastic": "plastic quadrature points of the continuum.",
         "ltsm": ("the engineers' stages 1 and 2 beside the model: the building's plan over the greenfield "
@@ -282,7 +284,9 @@ def report_html(paths: Sequence[str], command: str, progress: Callable[[float, s
     parts += _history_section(datasets)
     for i, (label, ds) in enumerate(zip(labels, datasets)):
         step(0.2 + 0.5 * i / len(datasets), f"figures of {label}")
-        parts += [f"<h2>{html.escape(label)}</h2>", *_result_figures(ds, label)]
+        walls = mf.walls_text(ds)
+        parts += [f"<h2>{html.escape(label)}</h2>", *([f'<pre class="walls">{html.escape(walls)}</pre>'] if walls else []),
+                  *_result_figures(ds, label)]
     step(0.7, "diagnoses")
     for path, ds in diagnoses:
         parts += _diagnosis_section(path, ds)

@@ -80,6 +80,7 @@ OPTIONS = (
               "blocks, else the count that runs fastest on the machine as it is, measured as the run goes (a "
               "busy machine makes more threads slower); the trajectory does not depend on it, bit for bit",
               at_least=1),
-    mfp.Option("snapshots", float, (), "settlements [m] at which block positions are stored (comma-separated)",
+    mfp.Option("snapshots", float, (), "settlements [m] at which block positions are stored (comma-separated); "
+              "none given, a 3D run stores 20 evenly up to its settlement (the VTK export's time series)",
               many=True, at_least=0.0),
 )

@@ -176,6 +176,7 @@ def history_variables(scene: Scene, history: History) -> dict:
         "step_crack_interface": ("step", np.array([c.interface for c in cracks], dtype=np.int32),
                                  mfp.variable_attrs("step_crack_interface")),
         "step_base_gap_max": ("step", np.array([c.base_gap for c in cracks]), mfp.variable_attrs("step_base_gap_max")),
+        **wall_crack_variables(cracks),
     } if scene.moving.any() else {
         "step_load_factor": var(rows["load_factor"], "1", "multiplier of the live load (tried) at the record"),
     }
@@ -199,6 +200,17 @@ def history_variables(scene: Scene, history: History) -> dict:
         "step_energy_error": var(error, "1", "(work in - kinetic - dissipated - stored) / largest work so far"),
         "step_unbalanced_ratio": var(rows["unbalanced"], "1", "unbalanced force / applied load"),
     }
+
+
+def wall_crack_variables(cracks: list[mf.Cracks]) -> dict:
+    """A building's history of each wall's widest crack and its joint (``mf.Cracks.wall_width``), else nothing."""
+    if not cracks or not cracks[0].wall_width:
+        return {}
+    sw = ("step", "wall")
+    return {"step_wall_crack_width_max": (sw, np.array([c.wall_width for c in cracks]),
+                                          mfp.variable_attrs("step_wall_crack_width_max", "result3d")),
+            "step_wall_crack_interface": (sw, np.array([c.wall_interface for c in cracks], dtype=np.int32),
+                                          mfp.variable_attrs("step_wall_crack_interface", "result3d"))}
 
 
 def result_dataset(scene: Scene, state: State, history: History) -> xr.Dataset:

@@ -99,8 +99,8 @@ def test_what_handles_2d_only_refuses_a_3d_model_before_it_starts(in_3d):
         with pytest.raises(mf.SolveError, match=f"solver {solver} solves 2D models; 'Test 12C \\(3D twin\\)' is 3D"):
             mf.solve(model, solver)
     result = mf.solve(model, "la")
-    with pytest.raises(mf.ModelError, match="the cracks plot handles 2D models and results"):
-        mf.render([result], "cracks")
+    with pytest.raises(mf.ModelError, match="the forces plot handles 2D models and results"):
+        mf.render([result], "forces")
     with pytest.raises(mf.SolveError, match="nonassociative is not supported in 3D"):
         mf.solve(model, "la", {"flow": "nonassociative"})
 

@@ -102,7 +102,7 @@ def test_the_trough_of_the_tour_builds_under_the_tour_wall(tmp_path):
 
 
 def test_the_buildings_step_of_the_tour_runs_as_written(tmp_path):
-    step = README[README.index("**6. Buildings in 3D.**"):README.index("## Where to read more")]
+    step = README[README.index("**6. Buildings in 3D.**"):README.index("**7. Damage in buildings.**")]
     commands = [part.split() for line in step.splitlines() if line.startswith("    masonryfw ")
                 for part in line.strip().split("#")[0].split(" && ")]
     assert [c[1] for c in commands] == ["build", "check", "info", "solve", "plot", "plot", "export", "report"]
@@ -112,7 +112,9 @@ def test_the_buildings_step_of_the_tour_runs_as_written(tmp_path):
         assert done.returncode == 0, (words, done.stderr)
     assert (tmp_path / "house.png").stat().st_size > 10_000 and (tmp_path / "stages.png").stat().st_size > 10_000
     assert (tmp_path / "house.vtm").exists() and (tmp_path / "house_joints.vtu").exists()
-    assert (tmp_path / "house.html").read_text().count("<img ") == 3  # the model, the mechanism, the stages
+    text = (tmp_path / "house.html").read_text()
+    assert text.count("<img ") == 4  # the model, the mechanism, the cracks, the stages
+    assert text.count('<pre class="walls">') == 1  # the house's stages wall by wall at its S_max
 
 
 def test_the_hand_over_step_ends_with_a_report_and_runs_as_written(tmp_path):
@@ -200,3 +202,21 @@ def test_the_how_far_step_of_the_tour_runs_as_written(tmp_path):
     assert "reached the target 0.06 m before collapse" in outputs[0]
     assert (tmp_path / "how-far.png").stat().st_size > 20_000
     assert outputs[3].splitlines()[2].startswith("category 1 (very slight): first reached at")
+
+
+@pytest.mark.slow  # 5 minutes: fdem settles the 1,126-block house to its S_max
+def test_the_damage_in_buildings_step_of_the_tour_runs_as_written(tmp_path):
+    step = README[README.index("**7. Damage in buildings.**"):README.index("## Where to read more")]
+    commands = [line.strip().split("#")[0].split() for line in step.splitlines() if line.startswith("    masonryfw ")]
+    assert [c[1] for c in commands] == ["solve", "capacity", "plot", "plot"]
+    outputs = []
+    for words in commands:
+        done = subprocess.run([sys.executable, "-m", "masonryfw", *words[1:], *(["--no-progress"] if words[1] == "solve"
+                                                                              else [])],
+                              cwd=tmp_path, capture_output=True, text=True, timeout=1200)
+        assert done.returncode == 0, (words, done.stderr)
+        outputs.append(done.stdout)
+    walls = [w["name"] for w in json.loads(mf.open_model("house-tunnel").attrs["building_walls"])]
+    assert "wall by wall at S = " in outputs[0] and all(f"\n{name} " in outputs[0] for name in walls)
+    assert "wall by wall, the volume loss V_L at which each category is first reached" in outputs[1]
+    assert (tmp_path / "cracks.png").stat().st_size > 10_000 and (tmp_path / "damage.png").stat().st_size > 10_000

@@ -35,6 +35,7 @@ import shapely
 import xarray as xr
 
 from ..format.roles import ROLE
+from ..format.schema import variable_attrs
 from ..geometry import polyhedra
 from ..ground.ground_plan import SETTLEMENT_3D_KEYS, GroundInPlan, profile_in_plan
 from ..ground.profiles import refuse_fine_segments, with_profile
@@ -675,6 +676,8 @@ def _dataset(walls, laid, n_masonry, poly, material, ground_plan, depth, attrs, 
     ends = starts[:, None, :] + s[..., None] * along[:, None, :]
     motion = segment_motion(ground_plan, ends, along, across, depth)
     z0 = np.asarray(laid.z0)
-    return model_on_ground(poly, np.array(laid.role[:n_masonry]), weight, motion, material, attrs, tol,
-                           "segment of every wall", lambda b: f"wall {walls[laid.wall[b]].name!r}'s block {b} "
-                                                          f"({z0[b]:.4g} m up)")
+    model = model_on_ground(poly, np.array(laid.role[:n_masonry]), weight, motion, material, attrs, tol,
+                            "segment of every wall", lambda b: f"wall {walls[laid.wall[b]].name!r}'s block {b} "
+                                                           f"({z0[b]:.4g} m up)")
+    model["block_wall"] = ("block", np.array(laid.wall, dtype=np.int32), variable_attrs("block_wall", "model3d"))
+    return model

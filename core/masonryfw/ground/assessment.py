@@ -210,14 +210,25 @@ def assess(model: xr.Dataset, settlement: float) -> Assessment | None:
 
 
 def assess_building(model: xr.Dataset, profile: Profile, settlement: float) -> Assessment:
-    """Stages 1 and 2 of every wall of a building (its ``building_walls``) over the greenfield profile in plan
-    (``settlement_axis``): each wall's line cut from the greenfield surface (:func:`wall_profile`; with a
-    tunnel's face, a :class:`SurfaceCut`), its own length and height; the building's largest slope, settlement
-    and strain are its worst wall's."""
+    """Stages 1 and 2 of a building: its largest slope, settlement and strain are its worst wall's
+    (:func:`assess_walls`)."""
+    walls = assess_walls(model, settlement, profile)
+    return Assessment(settlement, max((w.slope for w in walls.values()), default=0.0),
+                      max((w.greenfield_settlement for w in walls.values()), default=0.0),
+                      tuple(part for w in walls.values() for part in w.parts))
+
+
+def assess_walls(model: xr.Dataset, settlement: float, profile: Profile | None = None) -> dict[str, Assessment]:
+    """Stages 1 and 2 of every wall of a building (its ``building_walls``, in their order, by name) over the
+    greenfield profile in plan (``settlement_axis``): each wall's line cut from the greenfield surface
+    (:func:`wall_profile`; with a tunnel's face, a :class:`SurfaceCut`), its own length and height; empty for
+    a model that is no building or has no profile."""
+    profile = model_profile(model) if profile is None else profile
     ground = ground_in_plan(model)
-    assert ground is not None  # a building is built over a profile in plan
+    if profile is None or ground is None or "building_walls" not in model.attrs:
+        return {}
     point, direction = ground.point, ground.across
-    slopes, settled, parts = [0.0], [0.0], []
+    walls = {}
     for wall in json.loads(model.attrs["building_walls"]):
         start, end = np.array(wall["start"]), np.array(wall["end"])
         along = (end - start) / np.linalg.norm(end - start)
@@ -225,13 +236,13 @@ def assess_building(model: xr.Dataset, profile: Profile, settlement: float) -> A
         cut: Profile | SurfaceCut | None = SurfaceCut(ground, start, along) if ground.face is not None else \
             wall_profile(profile, float((start - point) @ direction), float(along @ direction))
         if cut is None:  # the wall runs along the trough's axis: its ground settles uniformly
-            settled.append(float(profile.rate(np.array([(start - point) @ direction]))[0]))
+            uniform = float(profile.rate(np.array([(start - point) @ direction]))[0])
+            walls[wall["name"]] = Assessment(settlement, 0.0, abs(settlement) * uniform, ())
             continue
         slope, most = greenfield_screen(cut, x_a, x_b)
-        slopes.append(slope)
-        settled.append(most)
-        parts += [replace(part, wall=wall["name"]) for part in ltsm_parts(cut, x_a, x_b, wall["height"])]
-    return Assessment(settlement, abs(settlement) * max(slopes), abs(settlement) * max(settled), tuple(parts))
+        parts = tuple(replace(part, wall=wall["name"]) for part in ltsm_parts(cut, x_a, x_b, wall["height"]))
+        walls[wall["name"]] = Assessment(settlement, abs(settlement) * slope, abs(settlement) * most, parts)
+    return walls
 
 
 #: A wall within this cosine of the trough's axis has a uniform greenfield settlement along it.
@@ -278,8 +289,11 @@ def ltsm_thresholds(model: xr.Dataset) -> np.ndarray | None:
     """Stage 2 backwards: the settlement parameter t [m] at which the LTSM strain first reaches each limit of
     :data:`LTSM_LIMITS` (categories 1 to 4; inf where the strain stays zero), None without a profile."""
     unit = assess(model, 1.0)
-    if unit is None:
-        return None
+    return None if unit is None else unit_ltsm_thresholds(unit)
+
+
+def unit_ltsm_thresholds(unit: Assessment) -> np.ndarray:
+    """:func:`ltsm_thresholds` of one assessment at t = 1 (a wall's, a building's)."""
     with np.errstate(divide="ignore"):
         return np.array(LTSM_LIMITS) / unit.strain if unit.strain > 0 else np.full(len(LTSM_LIMITS), np.inf)
 
@@ -288,8 +302,11 @@ def screen_threshold(model: xr.Dataset) -> float | None:
     """Stage 1 backwards: the smallest t [m] at which the wall is no longer screened out (the greenfield slope
     reaches 1/500 or the settlement 10 mm under it), None without a profile."""
     unit = assess(model, 1.0)
-    if unit is None:
-        return None
+    return None if unit is None else unit_screen_threshold(unit)
+
+
+def unit_screen_threshold(unit: Assessment) -> float:
+    """:func:`screen_threshold` of one assessment at t = 1 (a wall's, a building's)."""
     bounds = [limit / value for limit, value in ((SCREEN_SLOPE, unit.slope),
                                                  (SCREEN_SETTLEMENT, unit.greenfield_settlement)) if value > 0]
     return min(bounds, default=math.inf)

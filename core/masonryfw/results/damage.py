@@ -39,6 +39,7 @@ categories and the distortion of the imposed settlement profile.
 """
 from __future__ import annotations
 
+import json
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -47,7 +48,15 @@ import numpy as np
 from ..format.model3d import space
 from ..format.roles import masonry_blocks, support_blocks
 from ..format.schema import variable_attrs
-from ..ground.assessment import ltsm_thresholds, ltsm_variables, screen_threshold, volume_loss_per_settlement
+from ..ground.assessment import (
+    assess_walls,
+    ltsm_thresholds,
+    ltsm_variables,
+    screen_threshold,
+    unit_ltsm_thresholds,
+    unit_screen_threshold,
+    volume_loss_per_settlement,
+)
 from ..runtime.errors import SolveError
 from .semantics import relative_motion
 from .semantics3d import padded, vertex_motion
@@ -62,7 +71,10 @@ DERIVED_STEP_VARIABLES = ("step_damage_category", "step_deflection_ratio", "step
                           "step_ltsm_strain", "step_ltsm_category", "category", "category_settlement",
                           "category_settlement_resolution", "category_ltsm_settlement", "screen_settlement",
                           "category_volume_loss",
-                          "category_ltsm_volume_loss", "screen_volume_loss")
+                          "category_ltsm_volume_loss", "screen_volume_loss", "wall_name", "step_wall_damage_category",
+                          "wall_category_settlement", "wall_category_settlement_resolution",
+                          "wall_category_ltsm_settlement", "wall_screen_settlement", "wall_category_volume_loss",
+                          "wall_category_ltsm_volume_loss", "wall_screen_volume_loss")
 
 
 def damage_category(width) -> np.ndarray:
@@ -77,6 +89,8 @@ class Cracks:
     width: float  # widest opening of a joint between two masonry blocks [m]
     interface: int  # that joint, -1 when none opens
     base_gap: float  # widest opening of a joint between the wall and a support [m]
+    wall_width: tuple[float, ...] = ()  # a building's: each wall's widest crack [m] (:func:`wall_cracks`)
+    wall_interface: tuple[int, ...] = ()  # and its joint, -1 where none of the wall opens
 
 
 def widest_crack(model: xr.Dataset, u: np.ndarray, rotations: str = "finite") -> Cracks:
@@ -91,9 +105,32 @@ def widest_crack(model: xr.Dataset, u: np.ndarray, rotations: str = "finite") ->
     masonry = masonry_blocks(model.block_role.values)[model.interface_blocks.values.astype(np.int64)]
     inside, base = masonry.all(axis=1), masonry.any(axis=1) & ~masonry.all(axis=1)
     crack = np.where(inside, opening, 0.0)
+    width, widest = _widest(crack)
+    wall_width, wall_interface = wall_cracks(model, crack)
+    return Cracks(width, widest, float(opening[base].max(initial=0.0)), wall_width, wall_interface)
+
+
+def _widest(crack: np.ndarray) -> tuple[float, int]:
+    """The largest of the joints' ``crack`` widths and its joint (-1 when none opens)."""
     widest = int(np.argmax(crack)) if crack.size else -1
     width = float(crack[widest]) if widest >= 0 else 0.0
-    return Cracks(width, widest if width > 0 else -1, float(opening[base].max(initial=0.0)))
+    return width, widest if width > 0 else -1
+
+
+def wall_cracks(model: xr.Dataset, crack: np.ndarray) -> tuple[tuple[float, ...], tuple[int, ...]]:
+    """Each wall's widest crack of a building (``block_wall``) and its joint, from every joint's ``crack`` width:
+    a wall's joints are those with a block laid in it on either side (a joint between two walls, at a corner or
+    a junction, cracks both); nothing for a model without walls."""
+    if "block_wall" not in model:
+        return (), ()
+    sides = model.block_wall.values[model.interface_blocks.values.astype(np.int64)]
+    found = [_widest(np.where((sides == w).any(axis=1), crack, 0.0)) for w in range(wall_count(model))]
+    return tuple(width for width, _ in found), tuple(joint for _, joint in found)
+
+
+def wall_count(model: xr.Dataset) -> int:
+    """How many walls a building has (``building_walls``), 0 for any other model."""
+    return len(json.loads(model.attrs["building_walls"])) if "building_walls" in model.attrs else 0
 
 
 def support_profile(model: xr.Dataset) -> tuple[np.ndarray, np.ndarray]:
@@ -150,47 +187,78 @@ def category_variables(model: xr.Dataset, settlement: np.ndarray, width: np.ndar
     """Where the run first reaches damage categories 1 to 5 (stage 3), beside stage 2 and stage 1 and, of a
     tunnel, their volume losses (module docstring)."""
     categories = np.arange(1, len(DAMAGE_LIMITS) + 1, dtype=np.int8)
-    reached, spacing = np.array([first_exceeding(settlement, width, limit) for limit in DAMAGE_LIMITS]).T
-    derived: dict[str, tuple] = {
-        "category": ("category", categories, variable_attrs("category")),
-        "category_settlement": ("category", reached, variable_attrs("category_settlement")),
-        "category_settlement_resolution": ("category", spacing, variable_attrs("category_settlement_resolution")),
-    }
-    ltsm = ltsm_thresholds(model)
-    screen = screen_threshold(model)
+    ltsm, screen = ltsm_thresholds(model), screen_threshold(model)
+    return {"category": ("category", categories, variable_attrs("category")),
+            **_stage_variables(model, "", (), _first_reached(settlement, width),
+                               None if ltsm is None else np.r_[ltsm, np.nan], screen)}
+
+
+def wall_category_variables(model: xr.Dataset, settlement: np.ndarray, wall_width: np.ndarray) -> dict[str, tuple]:
+    """:func:`category_variables` wall by wall of a building, from each wall's widest crack ``wall_width``
+    (step, wall) and each wall's stages 1 and 2 (:func:`masonryfw.ground.assessment.assess_walls`); the walls'
+    names and each record's category per wall."""
+    names = [wall["name"] for wall in json.loads(model.attrs["building_walls"])]
+    stages = assess_walls(model, 1.0)
+    reached = np.stack([_first_reached(settlement, wall_width[:, w]) for w in range(len(names))], axis=1)
+    ltsm = np.array([np.r_[unit_ltsm_thresholds(stages[name]), np.nan] for name in names]) if stages else None
+    screen = np.array([unit_screen_threshold(stages[name]) for name in names]) if stages else None
+    return {"wall_name": ("wall", np.array(names, dtype=str), variable_attrs("wall_name", "result3d")),
+            "step_wall_damage_category": (("step", "wall"), damage_category(wall_width),
+                                          variable_attrs("step_wall_damage_category", "result3d")),
+            **_stage_variables(model, "wall_", ("wall",), reached, ltsm, screen)}
+
+
+def _first_reached(settlement: np.ndarray, width: np.ndarray) -> np.ndarray:
+    """(2, category): the settlement at which ``width`` first exceeds each category's lower width and the
+    spacing of the records around it (:func:`first_exceeding`)."""
+    return np.array([first_exceeding(settlement, width, limit) for limit in DAMAGE_LIMITS]).T
+
+
+def _stage_variables(model: xr.Dataset, prefix: str, lead: tuple[str, ...], reached: np.ndarray,
+                     ltsm: np.ndarray | None, screen: np.ndarray | float | None) -> dict[str, tuple]:
+    """The three stages' thresholds as variables named ``prefix + name`` over ``lead + (category,)``: stage 3's
+    ``reached`` (settlement, spacing), stage 2's ``ltsm`` and stage 1's ``screen`` where the model has a
+    profile, and of a tunnel the volume loss of each."""
+    kind = "result3d" if prefix else "result"
+    per_category = (*lead, "category")
+    values: dict[str, tuple] = {"category_settlement": (per_category, reached[0]),
+                                "category_settlement_resolution": (per_category, reached[1])}
     if ltsm is not None:
-        derived["category_ltsm_settlement"] = ("category", np.r_[ltsm, np.nan],
-                                               variable_attrs("category_ltsm_settlement"))
+        values["category_ltsm_settlement"] = (per_category, ltsm)
     if screen is not None:
-        derived["screen_settlement"] = ((), screen, variable_attrs("screen_settlement"))
+        values["screen_settlement"] = (lead, screen)
     per_metre = volume_loss_per_settlement(model)
     if per_metre is not None:
         for name in ("category_settlement", "category_ltsm_settlement", "screen_settlement"):
-            if name in derived:
-                dims, values, _ = derived[name]
-                loss = name.replace("settlement", "volume_loss")
-                derived[loss] = (dims, per_metre * np.asarray(values), variable_attrs(loss))
-    return derived
+            if name in values:
+                dims, settled = values[name]
+                values[name.replace("settlement", "volume_loss")] = (dims, per_metre * np.asarray(settled))
+    return {prefix + name: (dims, value, variable_attrs(prefix + name, kind)) for name, (dims, value) in values.items()}
 
 
 def damage_variables(model: xr.Dataset, produced: xr.Dataset) -> dict[str, tuple]:
     """The damage variables the core derives from a solver's history: the category of every
-    ``step_crack_width_max`` and the distortion of the imposed profile at every ``step_settlement`` (a wall's
-    profile: in 3D the widest crack's category alone, the building's walls have a profile each)."""
+    ``step_crack_width_max``, where each category is first reached beside stages 1 and 2 and, of a 2D wall, the
+    distortion of the imposed profile at every ``step_settlement``; of a building, each wall's (its
+    ``step_wall_crack_width_max``)."""
     derived: dict[str, tuple] = {}
     if "step_crack_width_max" in produced:
         derived["step_damage_category"] = ("step", damage_category(produced.step_crack_width_max.values),
                                            variable_attrs("step_damage_category"))
-    if "step_settlement" in produced and space(model) == 2:
+    if "step_settlement" not in produced:
+        return derived
+    settlement = np.asarray(produced.step_settlement.values, dtype=float)
+    if space(model) == 2:
         ratio, angle = distortion(*support_profile(model))
-        settlement = np.asarray(produced.step_settlement.values, dtype=float)
         derived["step_deflection_ratio"] = ("step", ratio * settlement, variable_attrs("step_deflection_ratio"))
         derived["step_angular_distortion"] = ("step", angle * settlement, variable_attrs("step_angular_distortion"))
-        derived.update(ltsm_variables(model, settlement))
-        if "step_crack_width_max" in produced:
-            derived.update(category_variables(model, settlement, np.asarray(produced.step_crack_width_max.values)))
+    derived.update(ltsm_variables(model, settlement))
+    if "step_crack_width_max" in produced:
+        derived.update(category_variables(model, settlement, np.asarray(produced.step_crack_width_max.values)))
+    if "step_wall_crack_width_max" in produced:
+        derived.update(wall_category_variables(model, settlement,
+                                               np.asarray(produced.step_wall_crack_width_max.values)))
     return derived
-
 
 
 def standing_text(result: xr.Dataset) -> str | None:

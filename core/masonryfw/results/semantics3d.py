@@ -50,20 +50,25 @@ def vertex_motion(model: xr.Dataset, u: np.ndarray, rotations: str = "small") ->
     owner = np.repeat(np.arange(count.size), count)
     sides = model.interface_blocks.values.astype(np.int64)[owner]
     centroid = np.c_[model.block_centroid_x.values, model.block_centroid_y.values, model.block_centroid_z.values]
-    u = np.asarray(u, dtype=float)
-    turning = rotation_matrices(u[:, 3:]) if rotations == "finite" else None
-    moved = []
-    for k in (0, 1):
-        arm = points - centroid[sides[:, k]]
-        if turning is None:
-            moved.append(u[sides[:, k], :3] + np.cross(u[sides[:, k], 3:], arm))
-        else:
-            moved.append(u[sides[:, k], :3] + np.einsum("pij,pj->pi", turning[sides[:, k]], arm) - arm)
-    relative = moved[1] - moved[0]
+    relative = carried_motion(u, centroid, points, sides[:, 1], rotations) - \
+        carried_motion(u, centroid, points, sides[:, 0], rotations)
     n = normal[owner]
     opening = np.einsum("pd,pd->p", relative, n)
     slip = np.linalg.norm(relative - opening[:, None] * n, axis=1)
     return opening, slip
+
+
+def carried_motion(u: np.ndarray, centroid: np.ndarray, points: np.ndarray, owner: np.ndarray,
+                   rotations: str = "small") -> np.ndarray:
+    """``(point, 3)``: the motion of ``points`` carried rigidly by their blocks ``owner`` under block motions ``u``
+    ``(block, 6)`` about the blocks' ``centroid`` ``(block, 3)``: ``u_c + r x (p - c)`` of a mechanism
+    (``rotations = "small"``), ``u_c + (R(r) - I)(p - c)`` of a displacement whose rotation vector is r
+    (``"finite"``)."""
+    u = np.asarray(u, dtype=float)
+    arm = points - centroid[owner]
+    if rotations == "finite":
+        return u[owner, :3] + np.einsum("pij,pj->pi", rotation_matrices(u[:, 3:])[owner], arm) - arm
+    return u[owner, :3] + np.cross(u[owner, 3:], arm)
 
 
 def padded(values: np.ndarray, count: np.ndarray) -> np.ndarray:

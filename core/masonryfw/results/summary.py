@@ -19,7 +19,8 @@ import numpy as np
 from ..format.model3d import interface_points, space
 from ..format.roles import masonry_blocks, moving_blocks
 from ..format.schema import flags
-from ..ground.assessment import assess
+from ..geometry.polygons import block_bounds
+from ..ground.assessment import assess, assess_walls
 from .damage import standing_text
 from .semantics import CRACK_THRESHOLD, at_threshold, dead_reaction, model_scales
 
@@ -152,6 +153,37 @@ def joint_midpoint(model: xr.Dataset, interface: int) -> np.ndarray:
     return np.array([model.interface_x.values[interface].mean(), model.interface_y.values[interface].mean()])
 
 
+@dataclass(frozen=True)
+class CrackPlace:
+    """Where a joint of a building is: its wall (index and name), course and place along the wall."""
+
+    wall: int
+    name: str
+    course: int  # 0 the bottom course; a bed joint is under the course it names
+    along: float  # the midpoint's distance along the wall's base line from its start [m]
+
+
+def crack_place(model: xr.Dataset, interface: int, wall: int | None = None) -> CrackPlace | None:
+    """Where ``interface`` of a building is in ``wall`` (by default the wall of its side-0 block): the course
+    whose bed levels its midpoint lies at or above, and its distance along the base line; None for a model
+    without walls or a joint of no wall."""
+    if "block_wall" not in model:
+        return None
+    sides = model.block_wall.values[model.interface_blocks.values[interface]]
+    wall = int(sides[0]) if wall is None else wall
+    if wall < 0 or wall not in sides:
+        return None
+    spec = json.loads(model.attrs["building_walls"])[wall]
+    start, end = np.array(spec["start"]), np.array(spec["end"])
+    mid = joint_midpoint(model, interface)
+    laid = (model.block_wall.values == wall) & masonry_blocks(model.block_role.values)
+    _, _, bottom, _ = block_bounds(model.node_x.values, model.node_z.values, model.block_node_count.values)
+    bottoms = np.unique(np.round(bottom[laid], 9))
+    course = max(int(np.searchsorted(bottoms, round(float(mid[2]), 9), side="right")) - 1, 0)
+    along = float((mid[:2] - start) @ (end - start) / np.linalg.norm(end - start))
+    return CrackPlace(wall, spec["name"], course, along)
+
+
 def _crack_numbers(result: xr.Dataset) -> list[KeyNumber]:
     """The widest crack over the run, where and when it is, the damage category it gives; the last
     record's crack and category; the widest base gap."""
@@ -168,6 +200,15 @@ def _crack_numbers(result: xr.Dataset) -> list[KeyNumber]:
         numbers.append(KeyNumber("crack_interface", float(interface), "1", "the joint of the widest crack"))
         numbers += [KeyNumber(f"crack_{axis}", float(value), "m", f"{axis} of that joint's midpoint")
                     for axis, value in zip("xyz", joint_midpoint(result, interface))]
+        place = crack_place(result, interface, int(np.argmax(result.step_wall_crack_width_max.values[widest]))
+                            if "step_wall_crack_width_max" in result else None)
+        if place is not None:
+            numbers += [KeyNumber("crack_wall", float(place.wall), "1",
+                                  f"the wall of the widest crack (its index in building_walls: {place.name!r})"),
+                        KeyNumber("crack_course", float(place.course), "1",
+                                  "the course of that joint in its wall (0 the bottom course)"),
+                        KeyNumber("crack_along", place.along, "m", "where that joint's midpoint is along the wall's "
+                                                                   "base line, from its start")]
     if "step_damage_category" in result:
         category = np.asarray(result.step_damage_category.values)
         numbers += [
@@ -182,14 +223,20 @@ def _crack_numbers(result: xr.Dataset) -> list[KeyNumber]:
     return numbers
 
 
-def _assessment_numbers(result: xr.Dataset) -> list[KeyNumber]:
-    """The engineers' stages 1 and 2 (:mod:`masonryfw.ground.assessment`) at the last record's settlement, or at the
-    model's ``settlement_target`` for a result without a history (limit analysis)."""
+def assessed_settlement(result: xr.Dataset) -> float | None:
+    """The settlement parameter stages 1 and 2 are assessed at: the last record's, or the model's
+    ``settlement_target`` for a result without a history (limit analysis); None without either."""
     if "step_settlement" in result and result.step_settlement.size:
-        settlement = float(result.step_settlement.values[-1])
-    elif "settlement_target" in result:
-        settlement = float(result.settlement_target.values)
-    else:
+        return float(result.step_settlement.values[-1])
+    if "settlement_target" in result:
+        return float(result.settlement_target.values)
+    return None
+
+
+def _assessment_numbers(result: xr.Dataset) -> list[KeyNumber]:
+    """The engineers' stages 1 and 2 (:mod:`masonryfw.ground.assessment`) at the :func:`assessed_settlement`."""
+    settlement = assessed_settlement(result)
+    if settlement is None:
         return []
     stages = assess(result, settlement)
     if stages is None:
@@ -335,6 +382,51 @@ def stages_text(result: xr.Dataset) -> str:
             f"stage 2 (LTSM) {_stage_2(numbers)}; stage 3 ({result_label(result)}) {own}")
 
 
+def wall_rows(result: xr.Dataset) -> list[Row]:
+    """A building's walls, one row each: stage 1 and stage 2 at the :func:`assessed_settlement`
+    (:func:`masonryfw.ground.assessment.assess_walls`) and, of a history with each wall's cracks, stage 3: the
+    wall's largest damage category over the run and its widest crack (course, place along the wall, settlement);
+    empty for a model that is no building."""
+    settlement = assessed_settlement(result)
+    walls = assess_walls(result, settlement) if settlement is not None else {}
+    if not walls:
+        return []
+    rows = []
+    for w, (name, stages) in enumerate(walls.items()):
+        stage_1 = {"greenfield_slope": stages.slope, "greenfield_settlement": stages.greenfield_settlement,
+                   "screened_out": stages.screened_out}
+        cells = [_stage_1(stage_1), _stage_2({"ltsm_category": stages.category, "ltsm_strain": stages.strain})]
+        values: list[float | None] = [float(stages.screened_out), float(stages.category)]
+        if "step_wall_crack_width_max" in result:
+            width = np.asarray(result.step_wall_crack_width_max.values[:, w], dtype=float)
+            k = int(np.argmax(width))
+            category = int(result.step_wall_damage_category.values[k, w])
+            joint = int(result.step_wall_crack_interface.values[k, w])
+            place = crack_place(result, joint, w) if joint >= 0 else None
+            where = f" (course {place.course}, {_place(place.along)} m along" if place else " ("
+            cells.append(f"{_damage_name(category)}: {_mm(float(width[k]))}{where}; settlement "
+                         f"{_mm(float(result.step_settlement.values[k]))})")
+            values += [float(category), float(width[k])]
+        rows.append(Row(name, tuple(cells), "", tuple(values)))
+    return rows
+
+
+def walls_text(result: xr.Dataset) -> str:
+    """:func:`wall_rows` as a table under the stages' heads, the worst wall of stage 3 named last (empty for a
+    model that is no building)."""
+    rows = wall_rows(result)
+    if not rows:
+        return ""
+    header = ["wall", "stage 1: greenfield", "stage 2: LTSM"]
+    if len(rows[0].cells) > 2:
+        header.append(f"stage 3: {result_label(result)}, widest crack over the run")
+    lines = [f"wall by wall at S = {_mm(assessed_settlement(result) or 0.0)}:", text_table(header, rows, note=False)]
+    if len(rows[0].cells) > 2:
+        worst = max(rows, key=lambda row: (row.values[2], row.values[3]))
+        lines.append(f"worst wall: {worst.label} ({_damage_name(worst.values[2] or 0)})")
+    return "\n".join(lines)
+
+
 def _short_of_target(result: xr.Dataset) -> str:
     """``, reached, short of the model's 15 mm (step limit)`` for a run that stopped before the model's
     ``settlement_target`` (a tunnel's S_max): its stages are at the settlement reached, not at the target."""
@@ -401,6 +493,9 @@ def capacity_text(result: xr.Dataset, category: int | None = None) -> str:
         loss = float(result.screen_volume_loss.values) if "screen_volume_loss" in result else None
         lines.append(f"stage 1: the greenfield screen (slope 1/500 or 10 mm under the wall) fails at "
                      f"{_at(result, float(result.screen_settlement.values), loss)}")
+    walls = wall_capacity_text(result)
+    if walls:
+        lines.append(walls)
     if category is not None:
         k = int(category) - 1
         if not 0 <= k < model.size:
@@ -412,6 +507,38 @@ def capacity_text(result: xr.Dataset, category: int | None = None) -> str:
                  f"{' or --volume-loss' if tunnel else ''})")
         lines.insert(0, f"category {category} ({names.get(int(category), '')}): {found}")
     return "\n".join(lines)
+
+
+def wall_capacity_text(result: xr.Dataset) -> str:
+    """A building's :func:`capacity_text` wall by wall: for each wall and category where the run first reached
+    it (stage 3) and where the wall's LTSM does (stage 2), and where the wall's greenfield screen fails (stage 1);
+    as a tunnel's volume loss, else as the settlement. Empty for a result without each wall's cracks."""
+    if "wall_category_settlement" not in result:
+        return ""
+    tunnel = "wall_category_volume_loss" in result
+    kind = "volume_loss" if tunnel else "settlement"
+
+    def at(value: float) -> str:
+        if not np.isfinite(value):
+            return "-"
+        if value == 0:
+            return "own weight"
+        return f"{value:.3g} %" if tunnel else _mm(value)
+
+    stage_3 = np.asarray(result[f"wall_category_{kind}"].values, dtype=float)
+    stage_2 = np.asarray(result[f"wall_category_ltsm_{kind}"].values, dtype=float) \
+        if f"wall_category_ltsm_{kind}" in result else np.full_like(stage_3, np.nan)
+    stage_1 = np.asarray(result[f"wall_screen_{kind}"].values, dtype=float) \
+        if f"wall_screen_{kind}" in result else np.full(stage_3.shape[0], np.nan)
+    categories = result.category.values.astype(int)
+    rows = [Row(str(name), (at(stage_1[w]), *(f"{at(stage_3[w, k])} / {'(4)' if n == 5 else at(stage_2[w, k])}"
+                                                for k, n in enumerate(categories))), "", ())
+            for w, name in enumerate(result.wall_name.values)]
+    what = "volume loss V_L" if tunnel else "settlement"
+    return "\n".join([f"wall by wall, the {what} at which each category is first reached: stage 3 "
+                      f"({result_label(result)}) / stage 2 (LTSM; it lumps 5 with 4); '-' not reached, 'own weight' before any settlement",
+                      text_table(("wall", "stage 1 fails", *(_damage_name(n) for n in categories)), rows,
+                                 note=False)])
 
 
 def _slope(radians: float) -> str:

@@ -68,7 +68,20 @@ def test_the_drawing_moves_blocks_relative_to_the_largest_macro_block(corner):
     np.testing.assert_allclose(actual - drawn, rigid, atol=1e-9 * np.abs(actual).max())
 
 
-@pytest.mark.parametrize("kind", ["cracks", "forces", "history"])
+def test_the_cracks_of_a_3d_mechanism_are_its_cracked_joints_in_the_masonry_by_state(corner):
+    """Limit analysis gives a shape, not a size: the cracks plot fills the joints cracked at the threshold (a joint
+    with the ground is none), by state, and says there are no widths."""
+    _, result = corner
+    ax = only_axes(mf.render([result], "cracks"))
+    derived = mf.at_threshold(result)
+    masonry = mfp.masonry_blocks(result.block_role.values)[result.interface_blocks.values].all(axis=1)
+    cracked = (derived.interface_state.values > 0) & masonry
+    filled = [c for c in ax.collections if isinstance(c, Poly3DCollection)][1:]  # the blocks first
+    assert sum(len(c.get_paths()) for c in filled) == int(cracked.sum()) > 0
+    assert "no widths" in ax.get_legend().get_title().get_text()
+
+
+@pytest.mark.parametrize("kind", ["forces"])
 def test_the_kinds_that_draw_2d_only_say_so(corner, kind):
     with pytest.raises(mf.ModelError, match=f"the {kind} plot handles 2D models and results"):
         mf.render([corner[1]], kind)
@@ -151,7 +164,8 @@ def test_a_3d_result_against_itself_scores_perfectly_and_against_another_model_i
 
 
 def test_the_report_of_two_3d_results(corner, tmp_path):
-    """The building in axonometry, its spec, the key numbers, each mechanism, and the agreement table of the cone
+    """The building in axonometry, its spec, the key numbers, each mechanism and cracked joints, and the
+    agreement table of the cone
     against the 8-sided pyramid, labelled with the method each ran."""
     from masonryfw_compare.report import report_html
 
@@ -159,7 +173,8 @@ def test_the_report_of_two_3d_results(corner, tmp_path):
     paths = [str(mf.save(cone, tmp_path / "cone.nc")),
              str(mf.save(mf.solve(model, "la", {"pyramid_sides": 8}), tmp_path / "pyramid.nc"))]
     text = report_html(paths, "masonryfw report cone.nc pyramid.nc")
-    assert "<h2>The building</h2>" in text and text.count("<img ") == 3
+    assert "<h2>The building</h2>" in text and text.count("<img ") == 5  # the building; each mechanism and cracks
+    assert '<pre class="walls">' not in text  # a trough without a target settlement: no stages to assess
     assert "A: la (cone, clarabel)" in text and "B: la (pyramid of 8 sides, ipm)" in text
     assert "<h2>Agreement</h2>" in text and 'id="agreement"' in text
 
