@@ -88,8 +88,9 @@ def draw_ltsm(datasets: Sequence[xr.Dataset], ax, options: Mapping[str, Any]) ->
 
 def _draw_plan(ax, ds: xr.Dataset, walls: list[dict], stages, settlement: float) -> dict:
     """A building's plan over the greenfield settlement at ``settlement`` (contours), the trough's axis (and a
-    tunnel's face), each wall coloured by its LTSM category and labelled with its strain; returns the worst
-    wall."""
+    tunnel's face), each wall coloured by its LTSM category and labelled with its strain and, of a run with each
+    wall's cracks, a second line inside it in the colour of the wall's category in the run; returns the worst
+    wall (by the LTSM)."""
     ground = mfp.ground_in_plan(ds)
     ends = np.array([[w["start"], w["end"]] for w in walls]).reshape(-1, 2)
     low, high = ends.min(axis=0), ends.max(axis=0)
@@ -113,7 +114,9 @@ def _draw_plan(ax, ds: xr.Dataset, walls: list[dict], stages, settlement: float)
     strain = {w["name"]: max((settlement * p.strain for p in stages.parts if p.wall == w["name"]), default=0.0)
               for w in walls}
     centre = ends.mean(axis=0)
-    for wall in walls:
+    stage_3 = stage_3_categories(ds)
+    inset = 0.05 * float((high - low).max())
+    for w, wall in enumerate(walls):
         category = int(mfp.ltsm_category(strain[wall["name"]]))
         line = np.array([wall["start"], wall["end"]])
         ax.plot(*line.T, color=DAMAGE_COLOURS[category], lw=6, solid_capstyle="butt")
@@ -122,9 +125,16 @@ def _draw_plan(ax, ds: xr.Dataset, walls: list[dict], stages, settlement: float)
         outward *= np.sign(outward @ (line.mean(axis=0) - centre)) or 1.0
         angle = np.degrees(np.arctan2(along[1], along[0]))
         angle = (angle + 90.0) % 180.0 - 90.0  # upright text
-        ax.annotate(f"{wall['name']}: {100 * strain[wall['name']]:.3g} %, cat. {category}",
-                    line.mean(axis=0) + 0.25 * margin * outward, fontsize="small", ha="center", va="center",
+        label = f"{wall['name']}: {100 * strain[wall['name']]:.3g} %, cat. {category}"
+        if stage_3 is not None:  # beside it, inside the building: the wall's own category in the run
+            inner = line - inset * outward + inset * np.array([along, -along])
+            ax.plot(*inner.T, color=DAMAGE_COLOURS[int(stage_3[w])], lw=6, solid_capstyle="butt")
+            label += f"; {ds.attrs.get('solver', 'run')}: cat. {int(stage_3[w])}"
+        ax.annotate(label, line.mean(axis=0) + 0.25 * margin * outward, fontsize="small", ha="center", va="center",
                     rotation=angle, bbox={"boxstyle": "round,pad=0.2", "fc": "white", "alpha": 0.8, "lw": 0})
+    if stage_3 is not None:
+        ax.plot([], [], color="0.5", lw=6, label="each wall: stage 2 (LTSM) on its line,\nstage 3 "
+                                                 f"({ds.attrs.get('solver', 'run')}) inside it")
     ax.set_aspect("equal")
     ax.set_xlim(x.min(), x.max())
     ax.set_ylim(y.min(), y.max())
@@ -132,6 +142,13 @@ def _draw_plan(ax, ds: xr.Dataset, walls: list[dict], stages, settlement: float)
     ax.set_ylabel("y [m]")
     ax.legend(loc="upper left", bbox_to_anchor=(1.25, 1.0), fontsize="small", frameon=False)
     return max(walls, key=lambda w: strain[w["name"]])
+
+
+def stage_3_categories(ds: xr.Dataset) -> np.ndarray | None:
+    """Each wall's largest damage category over the run (``step_wall_damage_category``), None without them."""
+    if "step_wall_damage_category" not in ds or not ds.step_settlement.size:
+        return None
+    return np.asarray(ds.step_wall_damage_category.values).max(axis=0)
 
 
 def _draw_trough(ax, profile, stages, settlement: float, x_a: float, x_b: float, height: float) -> None:

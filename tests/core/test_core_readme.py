@@ -208,7 +208,7 @@ def test_the_how_far_step_of_the_tour_runs_as_written(tmp_path):
 def test_the_damage_in_buildings_step_of_the_tour_runs_as_written(tmp_path):
     step = README[README.index("**7. Damage in buildings.**"):README.index("## Where to read more")]
     commands = [line.strip().split("#")[0].split() for line in step.splitlines() if line.startswith("    masonryfw ")]
-    assert [c[1] for c in commands] == ["solve", "capacity", "plot", "plot"]
+    assert [c[1] for c in commands] == ["solve", "capacity", "plot", "plot", "export"]
     outputs = []
     for words in commands:
         done = subprocess.run([sys.executable, "-m", "masonryfw", *words[1:], *(["--no-progress"] if words[1] == "solve"
@@ -220,3 +220,4 @@ def test_the_damage_in_buildings_step_of_the_tour_runs_as_written(tmp_path):
     assert "wall by wall at S = " in outputs[0] and all(f"\n{name} " in outputs[0] for name in walls)
     assert "wall by wall, the volume loss V_L at which each category is first reached" in outputs[1]
     assert (tmp_path / "cracks.png").stat().st_size > 10_000 and (tmp_path / "damage.png").stat().st_size > 10_000
+    assert (tmp_path / "settling_series.pvd").read_text().count("<DataSet ") == 20

@@ -156,3 +156,18 @@ def test_the_export_plays_the_settlement_as_a_time_series_of_rigid_blocks(capaci
         before = np.linalg.norm(last.points[edges[:, 0]] - last.points[edges[:, 1]], axis=1)
         after = np.linalg.norm(moved[edges[:, 0]] - moved[edges[:, 1]], axis=1)
         assert np.abs(after - before).max() < 1e-12 * size
+
+
+def test_the_ltsm_plan_draws_each_walls_stage_3_inside_its_stage_2(capacity):
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.colors import to_hex
+
+    from masonryfw_compare.figure_parts import DAMAGE_COLOURS
+
+    _, result, _ = capacity
+    figure = mf.render([result], "ltsm")
+    FigureCanvasAgg(figure).draw()
+    lines = [line for line in figure.axes[1].get_lines() if line.get_linewidth() == 6 and len(line.get_xdata())]
+    assert len(lines) == 2 * result.sizes["wall"]  # each wall: its LTSM line, then its run's line inside it
+    ran = result.step_wall_damage_category.values.max(axis=0)
+    assert [to_hex(line.get_color()) for line in lines[1::2]] == [DAMAGE_COLOURS[int(c)] for c in ran]

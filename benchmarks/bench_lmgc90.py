@@ -1,0 +1,116 @@
+"""fdem-3D and la-3D against LMGC90 (a second physics: non-smooth contact dynamics of rigid polyhedra, Coulomb
+friction without dilatancy, through ``compas_lmgc90`` on PyPI) on the corner building of ``masonryfw.testing``
+(two walls toothed at a corner, a door, 134 blocks over a Gaussian trough) to 10 mm: the settlement reaction
+against the settlement, its minimum, the walls' final widest cracks (fdem), which blocks follow the ground.
+
+LMGC90 runs in its own environment (it pulls compas_viewer and Qt): ``--lmgc-python`` names that Python, e.g.
+``python3 -m venv /tmp/lmgc && /tmp/lmgc/bin/pip install compas_lmgc90``; its driver is
+``benchmarks/lmgc90/run_lmgc90.py``. Rewrites the section "lmgc90" of docs/benchmarks.md.
+"""
+from __future__ import annotations
+
+import json
+import subprocess
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+from _report import command_line, write_section
+
+import masonryfw as mf
+import masonryfw.plugin_api as mfp
+import masonryfw.testing as mt
+
+SETTLEMENT = 0.01  # m
+DRIVER = Path(__file__).resolve().parent / "lmgc90" / "run_lmgc90.py"
+
+
+def blocks_json(model) -> dict:
+    """The model's blocks (vertices, faces by vertex), roles, support motions, centroids, weight, friction."""
+    counts = model.block_node_count.values.astype(int)
+    face_counts = model.block_face_count.values.astype(int)
+    nodes = np.c_[model.node_x.values, model.node_y.values, model.node_z.values]
+    face_sizes, face_nodes = model.face_node_count.values.astype(int), model.face_nodes.values.astype(int)
+    faces = np.split(face_nodes, np.cumsum(face_sizes)[:-1])
+    blocks = [{"vertices": part.tolist(), "faces": [f.tolist() for f in block_faces]}
+              for part, block_faces in zip(np.split(nodes, np.cumsum(counts)[:-1]),
+                                           np.split(np.array(faces, dtype=object), np.cumsum(face_counts)[:-1]))]
+    return {"blocks": blocks, "role": model.block_role.values.tolist(),
+            "direction": model.settlement_direction.values.tolist(),
+            "centroid": np.c_[model.block_centroid_x.values, model.block_centroid_y.values,
+                              model.block_centroid_z.values].tolist(),
+            "unit_weight": float(model.block_unit_weight.values.max()),
+            "friction": float(model.interface_friction.values.max())}
+
+
+def following(motion_z: np.ndarray, masonry: np.ndarray) -> np.ndarray:
+    """The masonry blocks that went down by more than half the settlement: those following the ground."""
+    return masonry & (motion_z < -0.5 * SETTLEMENT)
+
+
+def main() -> None:
+    parser = command_line(__doc__)
+    parser.add_argument("--lmgc-python", required=True, help="the Python that has compas_lmgc90")
+    parser.add_argument("--times", type=float, nargs="+", default=[2.0, 4.0],
+                        help="LMGC90's time to reach the settlement [s] (each a run)")
+    args = parser.parse_args()
+    model = mt.corner_building()
+    masonry = mfp.masonry_blocks(model.block_role.values)
+    with tempfile.TemporaryDirectory() as folder:
+        spec = Path(folder) / "model.json"
+        spec.write_text(json.dumps(blocks_json(model)))
+        lmgc = {}
+        for seconds in args.times:
+            out = Path(folder) / f"lmgc-{seconds}.json"
+            subprocess.run([args.lmgc_python, str(DRIVER), str(spec), str(out), "--settlement", repr(SETTLEMENT),
+                            "--time", repr(seconds)], check=True)
+            lmgc[seconds] = json.loads(out.read_text())
+    fdem = {}
+    for ratio in (1e-4, 5e-5):
+        start = time.perf_counter()
+        fdem[ratio] = (mf.solve(model, "fdem", {"settlement": repr(SETTLEMENT), "penetration_ratio": repr(ratio)}),
+                       time.perf_counter() - start)
+    la = mf.solve(model, "la")
+    r0 = float({n.name: n.value for n in mf.key_numbers(fdem[1e-4][0])}["dead_reaction"])
+    collapse = float({n.name: n.value for n in mf.key_numbers(la)}["collapse_reaction"])
+    grid = np.linspace(0.0, SETTLEMENT, 41)[1:]
+    later = grid >= 1e-3
+    reference = np.array(lmgc[args.times[0]]["rows"])
+    reference_curve = np.interp(grid, reference[:, 1], reference[:, 2])
+    ground = following(np.array(lmgc[args.times[0]]["displacement"])[:, 2], masonry)
+    body = ["Reactions as shares of fdem's R0 "
+            f"({r0 / 1e3:.4g} kN); the differences against LMGC90's first run over the settlement (all of it, "
+            "and from 1 mm on); Jaccard of the blocks following the ground (down by more than half the "
+            "settlement).", "",
+            "| run | s | reaction at 0.5, 1, 2, 5, 10 mm / R0 | minimum / R0 | max diff / R0 (from 1 mm) | "
+            "following the ground | Jaccard |", "|---|---|---|---|---|---|---|"]
+    at = np.array([0.5e-3, 1e-3, 2e-3, 5e-3, 10e-3])
+
+    def row(label, seconds, s, r, moved_z):
+        curve = np.interp(grid, s, r)
+        diff = np.abs(curve - reference_curve)
+        mine = following(moved_z, masonry)
+        jaccard = (mine & ground).sum() / max((mine | ground).sum(), 1)
+        body.append(f"| {label} | {seconds:.0f} | {', '.join(f'{v / r0:.4f}' for v in np.interp(at, s, r))} | "
+                    f"{r[s > 0].min() / r0:.4f} | {diff.max() / r0:.4f} ({diff[later].max() / r0:.4f}) | "
+                    f"{int(mine.sum())} | {jaccard:.2f} |")
+
+    for seconds, run in lmgc.items():
+        rows = np.array(run["rows"])
+        row(f"LMGC90, {SETTLEMENT / seconds * 1e3:.2g} mm/s, {run['steps']} steps", run["seconds"], rows[:, 1],
+            rows[:, 2], np.array(run["displacement"])[:, 2])
+    for ratio, (result, seconds) in fdem.items():
+        settling = result.step_phase.values == 1
+        widths = ", ".join(f"{w * 1e3:.3g}" for w in result.step_wall_crack_width_max.values[-1])
+        row(f"fdem, penetration ratio {ratio:g} (walls' widest cracks {widths} mm)", seconds,
+            result.step_settlement.values[settling], result.step_reaction.values[settling],
+            result.block_displacement.values[:, 2])
+    body += ["", f"la (associative, the cone): alpha {float(la.collapse_multiplier):.4f}, collapse reaction "
+             f"(1 - alpha) R0 = {collapse / r0:.4f} of fdem's R0."]
+    print("\n".join(body))
+    write_section("lmgc90", "fdem-3D and la-3D against LMGC90 on the corner building", "\n".join(body))
+
+
+if __name__ == "__main__":
+    main()
