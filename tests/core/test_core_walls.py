@@ -3,6 +3,8 @@ rigidly away from the other opens every joint between them by the motion, and no
 and 2, and the building's stages as its worst wall's."""
 from __future__ import annotations
 
+import json
+
 import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
@@ -78,18 +80,23 @@ def test_a_building_moved_as_one_body_cracks_no_wall(corner):
     assert max(cracks.wall_width) < 1e-14 and cracks.width < 1e-14
 
 
-def test_the_buildings_stages_are_its_worst_walls(corner):
-    """Stage 1's slope and settlement, stage 2's strain: the building's the largest of its walls'; a wall's stage 2
-    is the LTSM of its own parts."""
-    building = mfp.assess(corner, 0.01)
-    walls = mfp.assess_walls(corner, 0.01)
+def test_each_walls_stage_1_is_the_greenfield_surface_sampled_along_it(corner):
+    """Stage 1 of each wall, against the greenfield surface in plan evaluated at 20,001 points along the wall's
+    ground extent (not the wall's cut profile that the assessment uses): its largest slope and settlement; the
+    building's are the largest of its walls'."""
+    ground = mfp.ground_in_plan(corner)
+    walls = mfp.assess_walls(corner, 1.0)
     assert list(walls) == ["a", "b"]
+    for wall in json.loads(corner.attrs["building_walls"]):
+        start, end = np.array(wall["start"]), np.array(wall["end"])
+        s = np.linspace(*wall["ground"], 20001)
+        rate, _ = ground.greenfield(start + s[:, None] * (end - start) / np.linalg.norm(end - start))
+        assert walls[wall["name"]].slope == pytest.approx(np.abs(np.gradient(rate, s)).max(), rel=1e-3)
+        assert walls[wall["name"]].greenfield_settlement == pytest.approx(rate.max(), rel=1e-6)
+        assert {p.wall for p in walls[wall["name"]].parts} == {wall["name"]}
+    building = mfp.assess(corner, 1.0)
     assert building.slope == max(w.slope for w in walls.values())
-    assert building.greenfield_settlement == max(w.greenfield_settlement for w in walls.values())
     assert building.strain == pytest.approx(max(w.strain for w in walls.values()), rel=1e-12)
-    for name, wall in walls.items():
-        assert wall.parts and {p.wall for p in wall.parts} == {name}
-        assert wall.category == int(mfp.ltsm_category(wall.strain))
 
 
 def test_a_crack_is_placed_in_its_wall_by_course_and_along_the_base_line(corner):
