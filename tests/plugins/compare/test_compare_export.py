@@ -94,3 +94,24 @@ def test_the_export_command_writes_the_files(results, tmp_path):
     assert meshio.read(tmp_path / "out" / "f.vtu").points.shape == (104, 3)
     with pytest.raises(mf.MasonryError, match="must end in .vtu"):
         export_vtk(results["fdem"], tmp_path / "f.vtk")
+
+
+def test_a_planar_run_with_snapshots_exports_them_as_a_time_series(tmp_path):
+    """fdem on Test 8C with two snapshots: each written as the blocks at that snapshot (a vertex of a block moves
+    by the snapshot's rigid motion of that block, finite rotation), listed in a .pvd at its settlement."""
+    result = mf.solve(mf.open_model("test-8c"), "fdem", {"snapshots": "0.001,0.002"})
+    written = export_vtk(result, tmp_path / "wall.vtu")
+    assert [p.name for p in written][-4:] == ["wall_series_000.vtu", "wall_series_001.vtu", "wall_series.pvd",
+                                              "wall.vtm"]
+    times = [float(d.get("timestep")) for d in ET.parse(tmp_path / "wall_series.pvd").getroot().iter("DataSet")]
+    assert times == result.snapshot_settlement.values.tolist()
+    second = meshio.read(tmp_path / "wall_series_001.vtu")
+    order = _cell_array(second, "block_index")
+    block = int(order[0])  # the first cell's block and its first vertex
+    vertex = second.cells[0].data[0][0]
+    c = np.array([result.block_centroid_x.values[block], result.block_centroid_y.values[block]])
+    u = result.snapshot_block_displacement.values[1, block]
+    turn = result.snapshot_block_rotation.values[1, block]
+    rotation = np.array([[np.cos(turn), -np.sin(turn)], [np.sin(turn), np.cos(turn)]])
+    expected = u + (rotation - np.eye(2)) @ (second.points[vertex, :2] - c)
+    np.testing.assert_allclose(second.point_data["displacement"][vertex, :2], expected, atol=1e-12)
