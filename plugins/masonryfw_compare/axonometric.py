@@ -27,7 +27,10 @@ WIDEST_RING = "#0050d0"
 
 
 def axes_3d(ax):
-    """A 3D axes in the place of ``ax`` (the figure :func:`masonryfw.render` made is a 2D one)."""
+    """A 3D axes in the place of ``ax`` (the figure :func:`masonryfw.render` made is a 2D one); ``ax`` itself if it
+    is one (a panel of the compare plot)."""
+    if ax.name == "3d":
+        return ax
     figure, where = ax.figure, ax.get_subplotspec()
     ax.remove()
     return figure.add_subplot(where, projection="3d")

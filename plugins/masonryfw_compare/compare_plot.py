@@ -13,7 +13,8 @@ from matplotlib.collections import LineCollection
 import masonryfw as mf
 import masonryfw.plugin_api as mfp
 
-from .block_plots import draw_mechanism, draw_plastic, mechanism_amplification
+from .axonometric import draw_cracks_3d
+from .block_plots import STATE_COLOURS, draw_mechanism, draw_plastic, mechanism_amplification
 from .figure_parts import TITLE_WIDTH, draw_blocks, finish_axes, segment_array
 
 
@@ -42,6 +43,18 @@ def draw_indicator(ds: xr.Dataset, ax, threshold: float) -> None:
     finish_axes(ax, ds)
 
 
+def draw_in_3d(ds: xr.Dataset, panel, kind: str, options: Mapping[str, Any]) -> None:
+    """A 3D result's panel in axonometry: its mechanism (the plot's amplification, or the 3D default), or its cracked
+    joints by state (a continuum's plastic points have no 3D drawing)."""
+    if kind == "mechanism":
+        draw_mechanism([ds], panel, options)
+    elif kind == "indicator":
+        draw_cracks_3d(ds, panel, options["threshold"], STATE_COLOURS)
+    else:
+        raise mf.MasonryError("the compare plot draws a 3D result's mechanism or cracks: this one has neither "
+                              "block_displacement nor crack_indicator")
+
+
 def score_caption(comparison: xr.Dataset) -> str:
     """Short caption of the main scores of a comparison (only those computed)."""
     parts = [
@@ -52,22 +65,25 @@ def score_caption(comparison: xr.Dataset) -> str:
     return ", ".join(f"{label} {value:.2f}" for label, value in parts) or "no common score"
 
 
-def panel_axes(ax, count: int) -> list:
-    """``count`` side-by-side Axes in the place of ``ax`` (which stays as an invisible frame)."""
+def panel_axes(ax, count: int, projection: str | None = None) -> list:
+    """``count`` side-by-side Axes in the place of ``ax`` (which stays as an invisible frame), 3D ones for
+    ``projection="3d"``."""
     figure = ax.figure
     spec = ax.get_subplotspec()
     ax.set_axis_off()
     if spec is not None:
         grid = spec.subgridspec(1, count)
-        return [figure.add_subplot(grid[0, i]) for i in range(count)]
+        return [figure.add_subplot(grid[0, i], projection=projection) for i in range(count)]
     left, bottom, width, height = ax.get_position().bounds
-    return [figure.add_axes((left + i * width / count, bottom, width / count, height)) for i in range(count)]
+    return [figure.add_axes((left + i * width / count, bottom, width / count, height), projection=projection)
+            for i in range(count)]
 
 
 def draw_compare(datasets: Sequence[xr.Dataset], ax, options: Mapping[str, Any]) -> None:
     """Results side by side, the first titled with the wall; each later panel's title carries its scores
     against the first. The panels keep their drawings and drop their legends (the single-result kinds
-    explain them); a mechanism's amplification goes under its panel."""
+    explain them); a mechanism's amplification goes under its panel (3D: in axonometry, the amplification and
+    the motion's reference, its legend's title, under the panel's title)."""
     if len(datasets) < 2:
         raise mf.MasonryError(f"the compare plot needs two or more results of one model, got {len(datasets)}")
     kinds = [panel_kind(ds) for ds in datasets]
@@ -75,8 +91,12 @@ def draw_compare(datasets: Sequence[xr.Dataset], ax, options: Mapping[str, Any])
         score_caption(mf.compare(datasets[0], ds, "crack", {"threshold": options["threshold"]})) for ds in datasets[1:]
     ]
     wall = str(datasets[0].attrs.get("title", ""))
-    for k, (panel, ds, kind, caption) in enumerate(zip(panel_axes(ax, len(datasets)), datasets, kinds, captions)):
-        if kind == "mechanism":
+    in_3d = mfp.space(datasets[0]) == 3
+    panels = panel_axes(ax, len(datasets), "3d" if in_3d else None)
+    for k, (panel, ds, kind, caption) in enumerate(zip(panels, datasets, kinds, captions)):
+        if in_3d:
+            draw_in_3d(ds, panel, kind, options)
+        elif kind == "mechanism":
             amplification = mechanism_amplification(ds, options)
             draw_mechanism([ds], panel, {**options, "amplification": amplification})
             panel.set_xlabel(f"x [m]; displacements x {amplification:.3g}")
@@ -84,11 +104,13 @@ def draw_compare(datasets: Sequence[xr.Dataset], ax, options: Mapping[str, Any])
             draw_plastic([ds], panel, {"marker_size": 4.0})
         else:
             draw_indicator(ds, panel, options["threshold"])
-        if panel.get_legend() is not None:
-            panel.get_legend().remove()
+        legend, legend_title = panel.get_legend(), ""
+        if legend is not None:
+            legend_title = legend.get_title().get_text().replace("\n", " ") if in_3d else ""
+            legend.remove()
         alpha = f", alpha = {ds.collapse_multiplier.item():.4g}" if "collapse_multiplier" in ds else ""
         heading = f"{wall}\n" if k == 0 and wall else ""
         width = max(20, int(TITLE_WIDTH * ax.figure.get_size_inches()[0] / 7.0 / len(datasets)))  # a panel's share
-        lines = [f"{mf.result_label(ds)}{alpha}", caption]
+        lines = [f"{mf.result_label(ds)}{alpha}", caption] + ([legend_title] if legend_title else [])
         panel.set_title(heading + "\n".join(textwrap.fill(line, width) for line in lines), fontsize="medium")
 

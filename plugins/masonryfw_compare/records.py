@@ -73,7 +73,7 @@ PLOTTERS = {
                   mfp.Option("settlement_max", float, None, "zoom: the settlement axis ends here [mm]", above=0.0)),
                  table=True, module="history_plot", spaces=(2, 3)),
         _plotter("compare", "two or more results side by side with their scores",
-                 (AMPLIFICATION_OPTION, THRESHOLD_OPTION), side_by_side=True, module="compare_plot"),
+                 (AMPLIFICATION_OPTION, THRESHOLD_OPTION), side_by_side=True, module="compare_plot", spaces=(2, 3)),
         _plotter("ltsm", "the engineers' stage 2 over a settlement profile: the trough under the wall (a building's "
                  "plan, its walls by category) and the LTSM interaction chart (deflection ratio against horizontal "
                  "strain, the category zones, the (worst) wall's sagging and hogging parts)", module="ltsm_plot",

@@ -186,12 +186,12 @@ def _agreement_section(datasets: Sequence[xr.Dataset], letters: Sequence[str]) -
     pairs = list(itertools.combinations(range(len(datasets)), 2))
     comparisons = [mf.compare(datasets[i], datasets[j], "crack") for i, j in pairs]
     columns = [f"{letters[i]}-{letters[j]}" for i, j in pairs]
-    side_by_side = [] if mfp.space(datasets[0]) == 3 else [  # the compare kind draws 2D
-        _figure(datasets, "compare", "The results side by side, each later one with its scores against the first.")]
+    side_by_side = _figure(datasets, "compare", "The results side by side, each later one with its scores against the "
+                           "first.")
     return ["<h2>Agreement</h2>",
             "<p>Every pair scored by the <code>crack</code> comparator (the first of a pair is its reference): "
             "do the two results crack the same joints, break into the same pieces, move the same way?</p>",
-            _table(["score", *columns], mfp.score_rows(comparisons), "agreement", columns), *side_by_side]
+            _table(["score", *columns], mfp.score_rows(comparisons), "agreement", columns), side_by_side]
 
 
 def _versions() -> dict[str, str]:

@@ -163,6 +163,25 @@ def test_a_3d_result_against_itself_scores_perfectly_and_against_another_model_i
         mf.compare(result, other)
 
 
+def test_the_compare_plot_of_two_3d_results_draws_each_mechanism_in_axonometry_with_its_scores(corner):
+    """Two panels in axonometry, each the mechanism kind's drawing (its cracked interfaces outlined); the second
+    titled with the crack comparator's scores against the first and each with its motion's amplification."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    model, cone = corner
+    pyramid = mf.solve(model, "la", {"pyramid_sides": 8})
+    figure = mf.render([cone, pyramid], "compare")
+    FigureCanvasAgg(figure).draw()
+    panels = [ax for ax in figure.axes if ax.name == "3d"]
+    assert len(panels) == 2
+    for panel, result in zip(panels, (cone, pyramid)):
+        lines = [c for c in panel.collections if isinstance(c, Line3DCollection)]
+        assert len(lines[0].get_segments()) == int(mf.cracked_joints(result).sum()) > 0
+        assert panel.get_legend() is None and "motion relative to macro-block (1), x " in panel.get_title()
+    scores = mf.compare(cone, pyramid, "crack")
+    assert f"F1 {float(scores.crack_f1):.2f}, ARI {float(scores.macro_block_ari):.2f}" in panels[1].get_title()
+
+
 def test_the_report_of_two_3d_results(corner, tmp_path):
     """The building in axonometry, its spec, the key numbers, each mechanism and cracked joints, and the
     agreement table of the cone
@@ -173,7 +192,7 @@ def test_the_report_of_two_3d_results(corner, tmp_path):
     paths = [str(mf.save(cone, tmp_path / "cone.nc")),
              str(mf.save(mf.solve(model, "la", {"pyramid_sides": 8}), tmp_path / "pyramid.nc"))]
     text = report_html(paths, "masonryfw report cone.nc pyramid.nc")
-    assert "<h2>The building</h2>" in text and text.count("<img ") == 5  # the building; each mechanism and cracks
+    assert "<h2>The building</h2>" in text and text.count("<img ") == 6  # the building; each mechanism and cracks; both
     assert '<pre class="walls">' not in text  # a trough without a target settlement: no stages to assess
     assert "A: la (cone, clarabel)" in text and "B: la (pyramid of 8 sides, ipm)" in text
     assert "<h2>Agreement</h2>" in text and 'id="agreement"' in text
