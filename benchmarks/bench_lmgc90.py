@@ -1,11 +1,12 @@
 """fdem-3D and la-3D against LMGC90 (a second physics: non-smooth contact dynamics of rigid polyhedra, Coulomb
 friction without dilatancy, through ``compas_lmgc90`` on PyPI) on the corner building of ``masonryfw.testing``
-(two walls toothed at a corner, a door, 134 blocks over a Gaussian trough) to 10 mm: the settlement reaction
-against the settlement, its minimum, the walls' final widest cracks (fdem), which blocks follow the ground.
+(two walls toothed at a corner, a door, 134 blocks over a Gaussian trough) to 10 mm, or with ``--model WALL`` on
+a bundled wall's 3D twin (``mfp.twin``) to ``--settlement``: the settlement reaction against the settlement, its
+minimum, the walls' final widest cracks (fdem), which blocks follow the ground.
 
 LMGC90 runs in its own environment (it pulls compas_viewer and Qt): ``--lmgc-python`` names that Python, e.g.
 ``python3 -m venv /tmp/lmgc && /tmp/lmgc/bin/pip install compas_lmgc90``; its driver is
-``benchmarks/lmgc90/run_lmgc90.py``. Rewrites the section "lmgc90" of docs/benchmarks.md.
+``benchmarks/lmgc90/run_lmgc90.py``. Rewrites the section "lmgc90" (a wall: "lmgc90-WALL") of docs/benchmarks.md.
 """
 from __future__ import annotations
 
@@ -22,7 +23,7 @@ import masonryfw as mf
 import masonryfw.plugin_api as mfp
 import masonryfw.testing as mt
 
-SETTLEMENT = 0.01  # m
+SETTLEMENT = 0.01  # m, the corner building's
 DRIVER = Path(__file__).resolve().parent / "lmgc90" / "run_lmgc90.py"
 
 
@@ -44,9 +45,9 @@ def blocks_json(model) -> dict:
             "friction": float(model.interface_friction.values.max())}
 
 
-def following(motion_z: np.ndarray, masonry: np.ndarray) -> np.ndarray:
+def following(motion_z: np.ndarray, masonry: np.ndarray, settlement: float) -> np.ndarray:
     """The masonry blocks that went down by more than half the settlement: those following the ground."""
-    return masonry & (motion_z < -0.5 * SETTLEMENT)
+    return masonry & (motion_z < -0.5 * settlement)
 
 
 def main() -> None:
@@ -54,8 +55,11 @@ def main() -> None:
     parser.add_argument("--lmgc-python", required=True, help="the Python that has compas_lmgc90")
     parser.add_argument("--times", type=float, nargs="+", default=[2.0, 4.0],
                         help="LMGC90's time to reach the settlement [s] (each a run)")
+    parser.add_argument("--model", default="corner", help="corner (the kit's corner building) or a bundled wall")
+    parser.add_argument("--settlement", type=float, default=SETTLEMENT, help="the settlement to reach [m]")
     args = parser.parse_args()
-    model = mt.corner_building()
+    settlement = args.settlement
+    model = mt.corner_building() if args.model == "corner" else mf.checked_model(mfp.twin(mf.open_model(args.model)))
     masonry = mfp.masonry_blocks(model.block_role.values)
     with tempfile.TemporaryDirectory() as folder:
         spec = Path(folder) / "model.json"
@@ -63,22 +67,22 @@ def main() -> None:
         lmgc = {}
         for seconds in args.times:
             out = Path(folder) / f"lmgc-{seconds}.json"
-            subprocess.run([args.lmgc_python, str(DRIVER), str(spec), str(out), "--settlement", repr(SETTLEMENT),
+            subprocess.run([args.lmgc_python, str(DRIVER), str(spec), str(out), "--settlement", repr(settlement),
                             "--time", repr(seconds)], check=True)
             lmgc[seconds] = json.loads(out.read_text())
     fdem = {}
     for ratio in (1e-4, 5e-5):
         start = time.perf_counter()
-        fdem[ratio] = (mf.solve(model, "fdem", {"settlement": repr(SETTLEMENT), "penetration_ratio": repr(ratio)}),
+        fdem[ratio] = (mf.solve(model, "fdem", {"settlement": repr(settlement), "penetration_ratio": repr(ratio)}),
                        time.perf_counter() - start)
     la = mf.solve(model, "la")
     r0 = float({n.name: n.value for n in mf.key_numbers(fdem[1e-4][0])}["dead_reaction"])
     collapse = float({n.name: n.value for n in mf.key_numbers(la)}["collapse_reaction"])
-    grid = np.linspace(0.0, SETTLEMENT, 41)[1:]
+    grid = np.linspace(0.0, settlement, 41)[1:]
     later = grid >= 1e-3
     reference = np.array(lmgc[args.times[0]]["rows"])
     reference_curve = np.interp(grid, reference[:, 1], reference[:, 2])
-    ground = following(np.array(lmgc[args.times[0]]["displacement"])[:, 2], masonry)
+    ground = following(np.array(lmgc[args.times[0]]["displacement"])[:, 2], masonry, settlement)
     body = ["Reactions as shares of fdem's R0 "
             f"({r0 / 1e3:.4g} kN); the differences against LMGC90's first run over the settlement (all of it, "
             "and from 1 mm on); Jaccard of the blocks following the ground (down by more than half the "
@@ -90,7 +94,7 @@ def main() -> None:
     def row(label, seconds, s, r, moved_z):
         curve = np.interp(grid, s, r)
         diff = np.abs(curve - reference_curve)
-        mine = following(moved_z, masonry)
+        mine = following(moved_z, masonry, settlement)
         jaccard = (mine & ground).sum() / max((mine | ground).sum(), 1)
         body.append(f"| {label} | {seconds:.0f} | {', '.join(f'{v / r0:.4f}' for v in np.interp(at, s, r))} | "
                     f"{r[s > 0].min() / r0:.4f} | {diff.max() / r0:.4f} ({diff[later].max() / r0:.4f}) | "
@@ -98,18 +102,24 @@ def main() -> None:
 
     for seconds, run in lmgc.items():
         rows = np.array(run["rows"])
-        row(f"LMGC90, {SETTLEMENT / seconds * 1e3:.2g} mm/s, {run['steps']} steps", run["seconds"], rows[:, 1],
+        row(f"LMGC90, {settlement / seconds * 1e3:.2g} mm/s, {run['steps']} steps", run["seconds"], rows[:, 1],
             rows[:, 2], np.array(run["displacement"])[:, 2])
     for ratio, (result, seconds) in fdem.items():
         settling = result.step_phase.values == 1
-        widths = ", ".join(f"{w * 1e3:.3g}" for w in result.step_wall_crack_width_max.values[-1])
-        row(f"fdem, penetration ratio {ratio:g} (walls' widest cracks {widths} mm)", seconds,
+        widest = result.step_wall_crack_width_max.values[-1] if "step_wall_crack_width_max" in result else \
+            result.step_crack_width_max.values[-1:]
+        widths = ", ".join(f"{w * 1e3:.3g}" for w in widest)
+        row(f"fdem, penetration ratio {ratio:g} (widest cracks {widths} mm)", seconds,
             result.step_settlement.values[settling], result.step_reaction.values[settling],
             result.block_displacement.values[:, 2])
     body += ["", f"la (associative, the cone): alpha {float(la.collapse_multiplier):.4f}, collapse reaction "
              f"(1 - alpha) R0 = {collapse / r0:.4f} of fdem's R0."]
     print("\n".join(body))
-    write_section("lmgc90", "fdem-3D and la-3D against LMGC90 on the corner building", "\n".join(body))
+    if args.model == "corner":
+        write_section("lmgc90", "fdem-3D and la-3D against LMGC90 on the corner building", "\n".join(body))
+    else:
+        write_section(f"lmgc90-{args.model}", f"fdem-3D and la-3D against LMGC90 on {model.attrs.get('title')}",
+                      "\n".join(body))
 
 
 if __name__ == "__main__":

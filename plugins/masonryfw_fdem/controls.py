@@ -9,7 +9,7 @@ from typing import Any
 import numba
 import numpy as np
 
-from .costs import call_steps
+from .costs import call_steps, step_seconds
 from .scene import Scene
 from .scene3d import Scene3
 from .threads import Threads
@@ -38,6 +38,7 @@ class Controls:
     call_steps: int  # the most steps of one kernel call (Ctrl-C is taken between calls)
     threads: Threads  # the threads of each kernel call, chosen as the run goes
     buffer: float
+    reclip: float  # 3D: the relative motion (a share of the smaller block's radius) after which a pair is clipped
     max_penetration: float
     min_cos: float
     sleep_speed: float  # 0: no sleeping
@@ -63,7 +64,6 @@ GRAVITY_TIME = 0.4
 #: ... and in 3D about this many: rigid polyhedra come to rest slower (2026-12-02: 1.66, 2.73 and 3.77 times the
 #: 2D constant's steps on the corner building, the small house of the building tests and the bundled house).
 GRAVITY_TIME_3D = 1.1
-
 
 #: The reaction plateau that stops a run when the target is not the model's own (share of the dead reaction).
 PLATEAU_TOLERANCE = 0.005
@@ -117,9 +117,10 @@ def make_controls(scene: Scene | Scene3, options: Mapping[str, Any]) -> Controls
         rest_tolerance=options["rest_tolerance"],
         max_steps=options["max_steps"],
         record_steps=record_steps,
-        call_steps=call_steps(scene.driven.size, polyhedra=scene.DOFS == 6),
+        call_steps=call_steps(step_seconds(scene.driven.size, scene.friction.size, polyhedra=scene.DOFS == 6)),
         threads=Threads.chosen(options["threads"], scene.driven.size, numba.config.NUMBA_NUM_THREADS),
         buffer=options["buffer_ratio"] * scene.unit_height,
+        reclip=options["reclip_ratio"],
         max_penetration=0.25 * scene.unit_height,
         min_cos=float(np.cos(np.radians(options["max_contact_angle"]))),
         sleep_speed=options["sleep"] * rate,

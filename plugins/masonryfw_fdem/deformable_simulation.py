@@ -12,7 +12,7 @@ import numpy as np
 
 from . import deformable, kernels
 from .controls import Controls
-from .costs import call_steps
+from .costs import call_steps, step_seconds
 from .scene import Scene
 from .simulation import State, bodies, contact_law, detect, stepping
 
@@ -71,7 +71,7 @@ def deformable_controls(mesh: deformable.Mesh, scene: Scene, controls: Controls,
     dt = dt_safety * dt_critical
     record_steps = max(1, int(round(controls.record_steps * controls.dt / dt)))
     return replace(controls, dt=dt, dt_critical=dt_critical, record_steps=record_steps,
-                   call_steps=call_steps(scene.driven.size, deformable=True), ramp_time=max(controls.ramp_time, dt))
+                   call_steps=call_steps(step_seconds(scene.driven.size, scene.friction.size, deformable=True)), ramp_time=max(controls.ramp_time, dt))
 
 
 def initial_state(scene: Scene, controls: Controls, mesh: deformable.Mesh, load: np.ndarray) -> DeformableState:

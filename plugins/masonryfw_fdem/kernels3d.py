@@ -12,8 +12,12 @@ grows with the overlap), and its gap is the distance along ``n`` between the two
 penetration). A point keeps its history (shear spring, bond) from step to step as the two ends of a 2D face pair
 keep theirs: it is the last step's point nearest to it in block A's frame (within a tenth of the pair's overlap
 size, each old point taken once). Names by the edges a vertex lies on would not do: aligned blocks have faces
-whose edges coincide, and round-off then picks either edge from one step to the next. A block that rocks about an edge keeps its points along that edge, a corner on a face the
-point at that corner; faces up to ``acos(min_cos)`` apart still pair, so a rotated block does not pass through.
+whose edges coincide, and round-off then picks either edge from one step to the next. A block that rocks about
+an edge keeps its points along that edge, a corner on a face the point at that corner; faces up to
+``acos(min_cos)`` apart still pair. A block turned further (a pier toppling over its edge) has no face pair with
+what it leans on: its vertices inside the other, convex, block are corner contacts (:func:`corner_forces3`), so
+it does not pass through. A pair's overlap is clipped again only once its blocks have moved against each other by
+``ContactLaw3.reclip`` of the smaller one's radius (:func:`pair_forces3`).
 
 Rotations are integrated exactly: a block's orientation is a unit quaternion, turned each step by the rotation
 of its angular velocity over the step (``exp``), its inertia turned with it (no small-rotation shortcut).
@@ -54,7 +58,9 @@ class Bodies3(NamedTuple):
     the centroid in the rest frame (vertex, 3) block after block (``vertex_offs``), faces block after block
     (``block_faces``) as vertex lists (``face_offs``, ``face_vertices``: global vertex numbers, counter-clockwise
     seen from outside) and their blocks, masses (block,), inertia tensors about the centroid in the rest frame (block, 3, 3) and their
-    inverses, support flags and settlement motions (block, 6: translation, then rotation vector, per unit t)."""
+    inverses, support flags and settlement motions (block, 6: translation, then rotation vector, per unit t); the area a
+    corner contact of each block's vertices takes (:func:`corner_forces3`) and whether the block is convex (only a
+    convex block's inside is the inside of all its faces' planes)."""
 
     pos0: np.ndarray
     radius: np.ndarray
@@ -70,13 +76,19 @@ class Bodies3(NamedTuple):
     driven: np.ndarray
     moving: np.ndarray
     direction: np.ndarray
+    corner_area: np.ndarray
+    convex: np.ndarray
 
 
 class Pairs3(NamedTuple):
     """The face pairs (pair, 2: face of A, face of B), their properties (pair, 3: friction coefficient, cohesion
     and tensile strength per area) and their points' histories (pair, point): whether each slot holds a point
     (1; 0: none; -1 in every slot of a pair that never had one), its place in block A's frame (pair, point, 3),
-    its shear spring force (pair, point, 3), bond and normal force."""
+    its shear spring force (pair, point, 3), bond and normal force; and the overlap as last clipped: its point
+    count (pair; -1: to clip), the points' tributary areas (pair, point) and B's pose in A's frame then (pair, 7:
+    B's centroid, the relative orientation), which :func:`pair_forces3` reuses while B has moved less than
+    :attr:`ContactLaw3.reclip` in A's frame. And the corner contacts (corner, 3: a vertex, its block B, the block A
+    it may enter; :func:`detect_corners3`) with their friction coefficients and shear springs (corner, 3)."""
 
     faces: np.ndarray
     props: np.ndarray
@@ -85,16 +97,27 @@ class Pairs3(NamedTuple):
     shear: np.ndarray
     bonded: np.ndarray
     normal: np.ndarray
+    clipped: np.ndarray
+    area: np.ndarray
+    pose: np.ndarray
+    corners: np.ndarray
+    corner_friction: np.ndarray
+    corner_shear: np.ndarray
 
 
 class ContactLaw3(NamedTuple):
     """Normal and tangential stiffness per area, the smallest overlap area that carries, the normal dashpot as a
-    share of critical."""
+    share of critical, and the motion of a pair's B in A's frame (a share of the smaller block's radius) after
+    which the pair's overlap is clipped again (below it, its points stay where they were in A's frame); a corner
+    contact's vertex must be this much farther from the entered block's other faces than from the face it entered
+    (a vertex at an edge of A is a neighbour's, not a corner entering: :func:`corner_forces3`)."""
 
     kn: float
     kt: float
     min_area: float
     damping: float
+    reclip: float
+    margin: float
 
 
 class Motion3(NamedTuple):
@@ -332,14 +355,57 @@ def face_pair_points(world, bodies, normal, centre, fa, fb, w, px, py, pz, gap, 
         wx = ox + w.cx[k] * t1x + w.cy[k] * t2x
         wy = oy + w.cx[k] * t1y + w.cy[k] * t2y
         wz = oz + w.cx[k] * t1z + w.cy[k] * t2z
-        h_a = (normal[fa, 0] * (centre[fa, 0] - wx) + normal[fa, 1] * (centre[fa, 1] - wy)
-               + normal[fa, 2] * (centre[fa, 2] - wz)) / cos_a
-        h_b = (normal[fb, 0] * (centre[fb, 0] - wx) + normal[fb, 1] * (centre[fb, 1] - wy)
-               + normal[fb, 2] * (centre[fb, 2] - wz)) / cos_b
-        gap[k] = h_b - h_a
-        mid = 0.5 * (h_a + h_b)
-        px[k], py[k], pz[k] = wx + mid * nx, wy + mid * ny, wz + mid * nz
+        gap[k], px[k], py[k], pz[k] = mid_surface(normal, centre, fa, fb, cos_a, cos_b, nx, ny, nz, wx, wy, wz)
     return count, nx, ny, nz
+
+
+@jit
+def mid_surface(normal, centre, fa, fb, cos_a, cos_b, nx, ny, nz, wx, wy, wz):
+    """The gap along the pair's normal ``n`` between the planes of faces ``fa`` and ``fb`` at the point ``w`` (its
+    ``cos`` with each face's normal), and the point moved along ``n`` to midway between them."""
+    h_a = (normal[fa, 0] * (centre[fa, 0] - wx) + normal[fa, 1] * (centre[fa, 1] - wy)
+           + normal[fa, 2] * (centre[fa, 2] - wz)) / cos_a
+    h_b = (normal[fb, 0] * (centre[fb, 0] - wx) + normal[fb, 1] * (centre[fb, 1] - wy)
+           + normal[fb, 2] * (centre[fb, 2] - wz)) / cos_b
+    mid = 0.5 * (h_a + h_b)
+    return h_b - h_a, wx + mid * nx, wy + mid * ny, wz + mid * nz
+
+
+@jit
+def relative_pose(pos, quat, a, b, out):
+    """B's centroid in A's frame and B's orientation relative to A's (``conj(q_a) q_b``), into ``out`` (7)."""
+    out[0], out[1], out[2] = rotate_back(quat[a], pos[b, 0] - pos[a, 0], pos[b, 1] - pos[a, 1], pos[b, 2] - pos[a, 2])
+    a0, a1, a2, a3 = quat[a, 0], -quat[a, 1], -quat[a, 2], -quat[a, 3]
+    b0, b1, b2, b3 = quat[b, 0], quat[b, 1], quat[b, 2], quat[b, 3]
+    out[3] = a0 * b0 - a1 * b1 - a2 * b2 - a3 * b3
+    out[4] = a0 * b1 + a1 * b0 + a2 * b3 - a3 * b2
+    out[5] = a0 * b2 - a1 * b3 + a2 * b0 + a3 * b1
+    out[6] = a0 * b3 + a1 * b2 - a2 * b1 + a3 * b0
+
+
+@jit
+def pose_change(now, then, radius):
+    """How far B's faces have moved in A's frame between the poses ``then`` and ``now`` (:func:`relative_pose`):
+    its centroid's move plus its turn's angle times its ``radius``."""
+    dx, dy, dz = now[0] - then[0], now[1] - then[1], now[2] - then[2]
+    return np.sqrt(dx * dx + dy * dy + dz * dz) + rotation_angle(now[3:], then[3:]) * radius
+
+
+@jit
+def carried_points(world, bodies, normal, centre, fa, fb, pos, quat, a, local, count, px, py, pz, gap):
+    """The contact points of a face pair whose overlap is reused: its ``count`` points ``local`` (A's frame, as
+    last clipped) carried by A, each moved to the mid-surface between the faces' planes as they are now, with
+    its gap along the pair's normal (:func:`face_pair_points`' measure). Returns the normal."""
+    nx, ny, nz = normal[fa, 0] - normal[fb, 0], normal[fa, 1] - normal[fb, 1], normal[fa, 2] - normal[fb, 2]
+    norm = np.sqrt(nx * nx + ny * ny + nz * nz)
+    nx, ny, nz = nx / norm, ny / norm, nz / norm
+    cos_a = normal[fa, 0] * nx + normal[fa, 1] * ny + normal[fa, 2] * nz
+    cos_b = normal[fb, 0] * nx + normal[fb, 1] * ny + normal[fb, 2] * nz
+    for k in range(count):
+        x, y, z = rotate(quat[a], local[k, 0], local[k, 1], local[k, 2])
+        gap[k], px[k], py[k], pz[k] = mid_surface(normal, centre, fa, fb, cos_a, cos_b, nx, ny, nz, pos[a, 0] + x,
+                                                  pos[a, 1] + y, pos[a, 2] + z)
+    return nx, ny, nz
 
 
 # ---------------------------------------------------------------------------------------- contact law
@@ -397,7 +463,9 @@ def pair_forces3(bodies, pairs, law, motion, world, normal, centre, pair_force, 
     """Every face pair's force and moments, in parallel: ``pair_force`` (pair, 9) the force on B and the
     moments on B and on A about their centroids (A takes the opposite force), ``pair_energy`` (pair, 3) its
     stored spring energy, friction and dashpot dissipation."""
-    faces, props, held, points, shear, bonded, normal_force = pairs
+    faces, props, held, points, shear, bonded = pairs.faces, pairs.props, pairs.held, pairs.points, pairs.shear, \
+        pairs.bonded
+    normal_force, clipped, clipped_area, pose = pairs.normal, pairs.clipped, pairs.area, pairs.pose
     pos, vel, omega, quat = motion.pos, motion.vel, motion.omega, motion.quat
     most = held.shape[1]
     n_pair = faces.shape[0]
@@ -409,40 +477,67 @@ def pair_forces3(bodies, pairs, law, motion, world, normal, centre, pair_force, 
         old_points = np.empty((most, 3))
         old_shear = np.empty((most, 3))
         old_bonded = np.empty(most, dtype=np.int64)
+        pose_now = np.empty(7)
         for f in range(chunk * PAIR_BLOCK, min(n_pair, (chunk + 1) * PAIR_BLOCK)):
             fa, fb = faces[f, 0], faces[f, 1]
             a, b = bodies.face_block[fa], bodies.face_block[fb]
-            count, nx, ny, nz = face_pair_points(world, bodies, normal, centre, fa, fb, w, px, py, pz, gap, area)
+            relative_pose(pos, quat, a, b, pose_now)
+            reused = clipped[f] >= 0 and pose_change(pose_now, pose[f], bodies.radius[b]) <= law.reclip * min(
+                bodies.radius[a], bodies.radius[b])
+            if reused:  # the overlap as last clipped, its points carried by A: each keeps its own history
+                count = clipped[f]
+                nx, ny, nz = carried_points(world, bodies, normal, centre, fa, fb, pos, quat, a, points[f], count,
+                                            px, py, pz, gap)
+                for k in range(count):
+                    area[k] = clipped_area[f, k]
+            else:
+                count, nx, ny, nz = face_pair_points(world, bodies, normal, centre, fa, fb, w, px, py, pz, gap,
+                                                     area)
+                total = 0.0
+                for k in range(count):
+                    total += area[k]
+                if total <= law.min_area:
+                    count = 0
+                if update_history:
+                    clipped[f] = count
+                    for k in range(count):
+                        clipped_area[f, k] = area[k]
+                    for d in range(7):
+                        pose[f, d] = pose_now[d]
+            fresh = held[f, 0] == -1
+            if not reused:  # the points as they were, for the new ones to take their histories by place
+                for k in range(most):
+                    old_held[k], old_bonded[k] = held[f, k], bonded[f, k]
+                    for d in range(3):
+                        old_points[k, d], old_shear[k, d] = points[f, k, d], shear[f, k, d]
             total = 0.0
             for k in range(count):
                 total += area[k]
-            if total <= law.min_area:
-                count = 0
-            fresh = held[f, 0] == -1
-            for k in range(most):  # the points as they were
-                old_held[k], old_bonded[k] = held[f, k], bonded[f, k]
-                for d in range(3):
-                    old_points[k, d], old_shear[k, d] = points[f, k, d], shear[f, k, d]
             reach = (MATCH_SHARE * MATCH_SHARE) * total
             m_inv = (0.0 if bodies.driven[a] else 1.0 / bodies.mass[a]) + (0.0 if bodies.driven[b] else
                                                                               1.0 / bodies.mass[b])
             fbx = fby = fbz = mbx = mby = mbz = max_ = may = maz = 0.0
             stored = friction_sum = damping_sum = 0.0
             for k in range(count):
-                lx, ly, lz = rotate_back(quat[a], px[k] - pos[a, 0], py[k] - pos[a, 1], pz[k] - pos[a, 2])
-                fx = fy = fz = 0.0
-                bond = old_bonded[0] if fresh else 0  # a new pair's points start as its joint is
-                nearest, best = -1, reach
-                for j in range(most):
-                    if old_held[j] == 1:
-                        dx, dy, dz = old_points[j, 0] - lx, old_points[j, 1] - ly, old_points[j, 2] - lz
-                        d2 = dx * dx + dy * dy + dz * dz
-                        if d2 < best:
-                            nearest, best = j, d2
-                if nearest >= 0:
-                    old_held[nearest] = 0  # taken
-                    fx, fy, fz = old_shear[nearest, 0], old_shear[nearest, 1], old_shear[nearest, 2]
-                    bond = old_bonded[nearest]
+                if reused:  # each point its own slot's history (read before the slot is written)
+                    lx, ly, lz = points[f, k, 0], points[f, k, 1], points[f, k, 2]
+                    fx, fy, fz = shear[f, k, 0], shear[f, k, 1], shear[f, k, 2]
+                    bond = bonded[f, k]
+                else:
+                    lx, ly, lz = rotate_back(quat[a], px[k] - pos[a, 0], py[k] - pos[a, 1], pz[k] - pos[a, 2])
+                    fx = fy = fz = 0.0
+                    bond = old_bonded[0] if fresh else 0  # a new pair's points start as its joint is
+                    nearest, best = -1, reach
+                    for j in range(most):
+                        if old_held[j] == 1:
+                            dx, dy, dz = old_points[j, 0] - lx, old_points[j, 1] - ly, old_points[j, 2] - lz
+                            d2 = dx * dx + dy * dy + dz * dz
+                            if d2 < best:
+                                nearest, best = j, d2
+                    if nearest >= 0:
+                        old_held[nearest] = 0  # taken
+                        fx, fy, fz = old_shear[nearest, 0], old_shear[nearest, 1], old_shear[nearest, 2]
+                        bond = old_bonded[nearest]
                 size = np.sqrt(fx * fx + fy * fy + fz * fz)  # the spring kept in the turned plane, its length kept
                 along = fx * nx + fy * ny + fz * nz
                 fx, fy, fz = fx - along * nx, fy - along * ny, fz - along * nz
@@ -498,6 +593,78 @@ def pair_forces3(bodies, pairs, law, motion, world, normal, centre, pair_force, 
 
 
 @jit
+def corner_depth(world, bodies, normal, centre, v, a):
+    """How far the vertex ``v`` is outside the convex block ``a``: the largest signed distance of ``v`` from
+    ``a``'s faces' planes (negative: inside), that face, and the next largest (how far the nearest other face is)."""
+    depth, second, face = -np.inf, -np.inf, -1
+    for f in range(bodies.block_faces[a], bodies.block_faces[a + 1]):
+        d = (normal[f, 0] * (world[v, 0] - centre[f, 0]) + normal[f, 1] * (world[v, 1] - centre[f, 1])
+             + normal[f, 2] * (world[v, 2] - centre[f, 2]))
+        if d > depth:
+            depth, second, face = d, depth, f
+        elif d > second:
+            second = d
+    return depth, face, second
+
+
+@jit
+def corner_forces3(bodies, pairs, law, motion, world, normal, centre, force, dt, margin, update_history):
+    """Add the forces of the corner contacts to ``force``: a vertex of B inside the convex block A through one
+    face (the others farther than ``margin``) is pushed out along that face's normal by the contact law at one
+    point (dry: no cohesion, no tension), its area the vertex's share of B's surface (``corner_area``). Returns
+    the stored spring energy; adds the friction and dashpot dissipation when ``update_history``."""
+    pos, vel, omega = motion.pos, motion.vel, motion.omega
+    stored = 0.0
+    for c in range(pairs.corners.shape[0]):
+        v, b, a = pairs.corners[c, 0], pairs.corners[c, 1], pairs.corners[c, 2]
+        depth, face, second = corner_depth(world, bodies, normal, centre, v, a)
+        if depth >= 0.0 or second > depth - margin:
+            if update_history:
+                pairs.corner_shear[c, 0] = pairs.corner_shear[c, 1] = pairs.corner_shear[c, 2] = 0.0
+            continue
+        nx, ny, nz = normal[face, 0], normal[face, 1], normal[face, 2]  # out of A: B is pushed along it
+        px, py, pz = world[v, 0], world[v, 1], world[v, 2]
+        rax, ray, raz = px - pos[a, 0], py - pos[a, 1], pz - pos[a, 2]
+        rbx, rby, rbz = px - pos[b, 0], py - pos[b, 1], pz - pos[b, 2]
+        dvx = (vel[b, 0] + omega[b, 1] * rbz - omega[b, 2] * rby) - (vel[a, 0] + omega[a, 1] * raz - omega[a, 2] * ray)
+        dvy = (vel[b, 1] + omega[b, 2] * rbx - omega[b, 0] * rbz) - (vel[a, 1] + omega[a, 2] * rax - omega[a, 0] * raz)
+        dvz = (vel[b, 2] + omega[b, 0] * rby - omega[b, 1] * rbx) - (vel[a, 2] + omega[a, 0] * ray - omega[a, 1] * rax)
+        opening = dvx * nx + dvy * ny + dvz * nz
+        fx, fy, fz = pairs.corner_shear[c, 0], pairs.corner_shear[c, 1], pairs.corner_shear[c, 2]
+        along = fx * nx + fy * ny + fz * nz  # the spring kept in the contact plane
+        fx, fy, fz = fx - along * nx, fy - along * ny, fz - along * nz
+        area = bodies.corner_area[b]
+        knp, ktp = law.kn * area, law.kt * area
+        m_inv = (0.0 if bodies.driven[a] else 1.0 / bodies.mass[a]) + (0.0 if bodies.driven[b] else
+                                                                          1.0 / bodies.mass[b])
+        dashpot = 2.0 * law.damping * np.sqrt(knp / m_inv) if m_inv > 0.0 else 0.0
+        is_open, fn, fx, fy, fz, _, spring, friction, damping = contact_point(
+            -knp * depth, opening, dvx - opening * nx, dvy - opening * ny, dvz - opening * nz, fx, fy, fz, 0, knp,
+            ktp, dashpot, pairs.corner_friction[c], 0.0, 0.0, dt, update_history)
+        if update_history:
+            pairs.corner_shear[c, 0], pairs.corner_shear[c, 1], pairs.corner_shear[c, 2] = fx, fy, fz
+            motion.acc[DISSIPATED_FRICTION] += friction
+            motion.acc[DISSIPATED_DAMPING] -= damping
+        if is_open:
+            continue
+        stored += spring
+        gx, gy, gz = fn * nx + fx, fn * ny + fy, fn * nz + fz  # on B; A takes the opposite
+        force[b, 0] += gx
+        force[b, 1] += gy
+        force[b, 2] += gz
+        force[b, 3] += rby * gz - rbz * gy
+        force[b, 4] += rbz * gx - rbx * gz
+        force[b, 5] += rbx * gy - rby * gx
+        force[a, 0] -= gx
+        force[a, 1] -= gy
+        force[a, 2] -= gz
+        force[a, 3] -= ray * gz - raz * gy
+        force[a, 4] -= raz * gx - rax * gz
+        force[a, 5] -= rax * gy - ray * gx
+    return stored
+
+
+@jit
 def contact_forces3(bodies, pairs, law, motion, world, normal, centre, pair_force, pair_energy, force, dt,
                     update_history):
     """Add the contact forces and moments (block, 6) of every face pair to ``force`` (:func:`pair_forces3`, then
@@ -517,7 +684,8 @@ def contact_forces3(bodies, pairs, law, motion, world, normal, centre, pair_forc
         if update_history:
             motion.acc[DISSIPATED_FRICTION] += pair_energy[f, 1]
             motion.acc[DISSIPATED_DAMPING] -= pair_energy[f, 2]
-    return stored
+    return stored + corner_forces3(bodies, pairs, law, motion, world, normal, centre, force, dt, law.margin,
+                                   update_history)
 
 
 # ----------------------------------------------------------------------------------------- time steps
@@ -698,3 +866,30 @@ def detect_face_pairs3(bodies, world, block_pairs, buffer, max_penetration, min_
     for i in range(len(out)):
         faces[i, 0], faces[i, 1] = out[i]
     return faces
+
+
+@jit
+def detect_corners3(bodies, world, block_pairs, joined, buffer, max_penetration, margin):
+    """Corner contacts (corner, 3: vertex, its block, the other block) of the candidate block pairs ``(k, 2)`` that
+    have no face pair (``joined[i]`` false): each vertex of one block within ``buffer`` outside the other,
+    convex, block (or inside it by less than ``max_penetration``) through one of its faces (the others farther than
+    ``margin``: :func:`corner_forces3`)."""
+    n_face = bodies.face_offs.size - 1
+    normal, centre = np.empty((n_face, 3)), np.empty((n_face, 3))
+    face_frames3(world, bodies, normal, centre)
+    out = []
+    for i in range(block_pairs.shape[0]):
+        if joined[i]:
+            continue
+        for side in range(2):
+            b, a = block_pairs[i, side], block_pairs[i, 1 - side]
+            if not bodies.convex[a] or (bodies.driven[a] and bodies.driven[b]):
+                continue
+            for v in range(bodies.vertex_offs[b], bodies.vertex_offs[b + 1]):
+                depth, _, second = corner_depth(world, bodies, normal, centre, v, a)
+                if -max_penetration < depth < buffer and second <= depth - margin:
+                    out.append((v, b, a))
+    corners = np.empty((len(out), 3), dtype=np.int64)
+    for i in range(len(out)):
+        corners[i, 0], corners[i, 1], corners[i, 2] = out[i]
+    return corners

@@ -69,6 +69,11 @@ OPTIONS = (
               "when a block has moved half of it", above=0.0),
     mfp.Option("max_contact_angle", float, 40.0, "largest angle [deg] between two faces still in contact",
               above=0.0, below=90.0),
+    mfp.Option("reclip_ratio", float, 1e-4,
+              "3D: a face pair's overlap is clipped again once its blocks have moved against each other by this "
+              "share of the smaller block's radius (its points stay on block A until then; 0 = whenever they "
+              "have moved)",
+              at_least=0.0),
     mfp.Option("sleep", float, 0.0,
               "blocks slower than this share of the settlement velocity for sleep_steps steps sleep "
               "(not integrated) until a contact moving faster wakes them; 0 = no sleeping", at_least=0.0),

@@ -17,7 +17,15 @@ import masonryfw as mf
 import masonryfw.plugin_api as mfp
 
 from . import kernels
-from .kernels3d import MAX_FACE_VERTICES, Bodies3, Motion3, Pairs3, detect_face_pairs3, place_vertices3
+from .kernels3d import (
+    MAX_FACE_VERTICES,
+    Bodies3,
+    Motion3,
+    Pairs3,
+    detect_corners3,
+    detect_face_pairs3,
+    place_vertices3,
+)
 from .scene import GRAVITY, Scales, Scene, build_scene
 
 
@@ -167,6 +175,14 @@ def face_properties3(scene: Scene3, faces: np.ndarray) -> tuple[np.ndarray, np.n
     return props, (props[:, 1] > 0) | (props[:, 2] > 0)
 
 
+def corner_friction3(scene: Scene3, corners: np.ndarray) -> np.ndarray:
+    """(corner,) the friction coefficient of each corner contact: its blocks' model interface's, or the model's
+    median (:func:`face_properties3`'s rule)."""
+    joint = mfp.find_pairs(scene.joints, corners[:, 1:]) if corners.size else np.zeros(0, dtype=np.int64)
+    at = np.maximum(joint, 0)
+    return np.where(joint >= 0, scene.friction[at] if scene.friction.size else 0.0, scene.default_friction)
+
+
 def bodies_of(poly: mfp.Polyhedra, unit_weight: np.ndarray, driven: np.ndarray, moving: np.ndarray,
               direction: np.ndarray) -> Bodies3:
     """The :class:`.kernels3d.Bodies3` of the polyhedra ``poly`` weighing ``unit_weight`` a volume (their mass,
@@ -188,11 +204,31 @@ def bodies_of(poly: mfp.Polyhedra, unit_weight: np.ndarray, driven: np.ndarray, 
     local = poly.vertices - centroid[owner]
     radius = np.zeros(poly.n_block)
     np.maximum.at(radius, owner, np.linalg.norm(local, axis=1))
+    _, face_area, _ = mfp.face_normals_areas(poly)
+    surface = np.bincount(poly.face_block(), weights=face_area, minlength=poly.n_block)
     return Bodies3(centroid, radius, local, mfp.block_offsets(poly.block_node_count),
                    mfp.block_offsets(poly.block_face_count), mfp.block_offsets(poly.face_node_count),
                    poly.face_vertex_index().astype(np.int64), poly.face_block().astype(np.int64), mass, inertia,
                    inv_inertia, np.asarray(driven, dtype=bool), np.asarray(moving, dtype=bool),
-                   np.asarray(direction, dtype=float))
+                   np.asarray(direction, dtype=float), surface / (3.0 * poly.block_node_count), convex_blocks(poly))
+
+
+def convex_blocks(poly: mfp.Polyhedra) -> np.ndarray:
+    """(block,) whether each block lies behind every one of its faces' planes (to 1e-9 of its size): convex."""
+    normal, _, _ = mfp.face_normals_areas(poly)
+    index = poly.face_vertex_index()
+    face_point = poly.vertices[index[mfp.block_offsets(poly.face_node_count)[:-1]]]
+    face_block = poly.face_block()
+    starts = mfp.block_offsets(poly.block_node_count)
+    counts = poly.block_node_count[face_block]
+    face = np.repeat(np.arange(face_block.size), counts)
+    vertex = np.concatenate([np.arange(starts[b], starts[b + 1]) for b in face_block]) if face_block.size else \
+        np.zeros(0, dtype=np.int64)
+    height = np.einsum("ij,ij->i", poly.vertices[vertex] - face_point[face], normal[face])
+    size = np.ptp(poly.vertices, axis=0).max() if poly.vertices.size else 1.0
+    outside = np.zeros(poly.n_block, dtype=bool)
+    np.logical_or.at(outside, face_block[face], height > 1e-9 * size)
+    return ~outside
 
 
 def refuse_non_convex_faces(poly: mfp.Polyhedra) -> None:
@@ -227,23 +263,36 @@ def world_vertices(bodies: Bodies3, motion: Motion3) -> np.ndarray:
     return world
 
 
-def face_pairs(bodies: Bodies3, motion: Motion3, buffer: float, max_penetration: float, min_cos: float
-               ) -> np.ndarray:
-    """(pair, 2) the face pairs at ``motion``: blocks whose boxes come within ``buffer`` (core's broad phase; none
-    between two supports), then faces that face each other (:func:`.kernels3d.detect_face_pairs3`)."""
+def contacts(bodies: Bodies3, motion: Motion3, buffer: float, max_penetration: float, min_cos: float
+             ) -> tuple[np.ndarray, np.ndarray]:
+    """The contacts at ``motion`` of blocks whose boxes come within ``buffer`` (core's broad phase; none between two
+    supports): (pair, 2) the face pairs, faces that face each other (:func:`.kernels3d.detect_face_pairs3`), and
+    (corner, 3) the corner contacts of the blocks that have none (a block turned past ``max_contact_angle``, its
+    corner against a face: :func:`.kernels3d.detect_corners3`)."""
     world = world_vertices(bodies, motion)
     low = np.minimum.reduceat(world, bodies.vertex_offs[:-1], axis=0)
     high = np.maximum.reduceat(world, bodies.vertex_offs[:-1], axis=0)
     a, b = mfp.box_pairs(low, high, buffer)
     keep = ~(bodies.driven[a] & bodies.driven[b])
-    return detect_face_pairs3(bodies, world, np.c_[a[keep], b[keep]].astype(np.int64), buffer, max_penetration,
-                              min_cos)
+    blocks = np.c_[a[keep], b[keep]].astype(np.int64)
+    faces = detect_face_pairs3(bodies, world, blocks, buffer, max_penetration, min_cos)
+    n = bodies.pos0.shape[0]
+    joined = np.isin(np.minimum(blocks[:, 0], blocks[:, 1]) * n + np.maximum(blocks[:, 0], blocks[:, 1]),
+                     pair_keys(bodies.face_block[faces], n))
+    return faces, detect_corners3(bodies, world, blocks, joined, buffer, max_penetration, buffer)
+
+
+def pair_keys(blocks: np.ndarray, n: int) -> np.ndarray:
+    """One number per unordered block pair (k, 2) of ``n`` blocks."""
+    return np.minimum(blocks[:, 0], blocks[:, 1]) * n + np.maximum(blocks[:, 0], blocks[:, 1]) if blocks.size else \
+        np.zeros(0, dtype=np.int64)
 
 
 def new_pairs(bodies: Bodies3, faces: np.ndarray, props: np.ndarray, bonded_start: np.ndarray,
-              old: Pairs3 | None = None) -> Pairs3:
-    """The :class:`.kernels3d.Pairs3` of ``faces`` with their ``props`` (pair, 3); a pair that was in ``old``
-    keeps its points' histories, a new one starts with its points bonded where ``bonded_start`` says."""
+              corners: np.ndarray, corner_friction: np.ndarray, old: Pairs3 | None = None) -> Pairs3:
+    """The :class:`.kernels3d.Pairs3` of ``faces`` with their ``props`` (pair, 3) and of the ``corners`` with
+    their friction coefficients; a pair that was in ``old`` keeps its points' histories, a new one starts with its
+    points bonded where ``bonded_start`` says; a corner contact that was in ``old`` keeps its shear spring."""
     counts = np.diff(bodies.face_offs)
     most = int((counts[faces[:, 0]] + counts[faces[:, 1]]).max(initial=3))
     held = np.full((faces.shape[0], most), -1, dtype=np.int64)
@@ -261,8 +310,18 @@ def new_pairs(bodies: Bodies3, faces: np.ndarray, props: np.ndarray, bonded_star
         width = min(most, old.held.shape[1])
         for mine, theirs in ((held, old.held), (points, old.points), (shear, old.shear), (bonded, old.bonded)):
             mine[kept, :width] = theirs[source, :width]
+    corner_shear = np.zeros((corners.shape[0], 3))
+    if old is not None and old.corners.size and corners.size:
+        key = (corners[:, 0] * bodies.pos0.shape[0] + corners[:, 2])
+        before = old.corners[:, 0] * bodies.pos0.shape[0] + old.corners[:, 2]
+        order = np.argsort(before)
+        at = np.clip(np.searchsorted(before[order], key), 0, before.size - 1)
+        kept = before[order][at] == key
+        corner_shear[kept] = old.corner_shear[order[at[kept]]]
     return Pairs3(faces, np.asarray(props, dtype=float), held, points, shear, bonded,
-                  np.zeros((faces.shape[0], most)))
+                  np.zeros((faces.shape[0], most)), np.full(faces.shape[0], -1, dtype=np.int64),
+                  np.zeros((faces.shape[0], most)), np.zeros((faces.shape[0], 7)), corners.astype(np.int64),
+                  np.asarray(corner_friction, dtype=float), corner_shear)
 
 
 def scene_of(model: xr.Dataset) -> Scene | Scene3:

@@ -9,7 +9,7 @@ import numpy as np
 
 from . import kernels, kernels3d
 from .controls import Controls
-from .scene3d import Scene3, face_pairs, face_properties3, new_pairs
+from .scene3d import Scene3, contacts, corner_friction3, face_properties3, new_pairs
 from .simulation import State
 
 
@@ -62,7 +62,8 @@ def contact_law3(controls: Controls) -> kernels3d.ContactLaw3:
     """The contact constants as the 3D kernels take them: stiffnesses per area, the smallest overlap the square
     of the 2D shortest contact."""
     return kernels3d.ContactLaw3(float(controls.kn), float(controls.kt), float((2.0 * controls.min_half) ** 2),
-                                 float(controls.contact_damping))
+                                 float(controls.contact_damping), float(controls.reclip),
+                                 float(controls.buffer))
 
 
 def stepping3(controls: Controls) -> kernels3d.Stepping3:
@@ -73,9 +74,10 @@ def detect3(scene: Scene3, controls: Controls, motion: kernels3d.Motion3,
             old: kernels3d.Pairs3 | None) -> kernels3d.Pairs3:
     """The face pairs at ``motion`` with their properties; those of ``old`` keep their points' histories, the
     first detection's pairs start bonded where their joint has a strength."""
-    faces = face_pairs(scene.bodies, motion, controls.buffer, controls.max_penetration, controls.min_cos)
+    faces, corners = contacts(scene.bodies, motion, controls.buffer, controls.max_penetration, controls.min_cos)
     props, bonded = face_properties3(scene, faces)
-    return new_pairs(scene.bodies, faces, props, bonded if old is None else np.zeros(len(faces), bool), old)
+    return new_pairs(scene.bodies, faces, props, bonded if old is None else np.zeros(len(faces), bool), corners,
+                     corner_friction3(scene, corners), old)
 
 
 def initial_state3(scene: Scene3, controls: Controls) -> State3:

@@ -1,6 +1,7 @@
 """fdem on a building, wall by wall: ``capacity`` of the kit's corner building prints and keeps each wall's stages
 1, 2 and 3; the building's thresholds are its first wall's; its widest crack the widest of its walls'; another
-block order gives the same walls' categories; the cracks and damage plots draw each wall's."""
+block order gives the same walls' categories; the cracks and damage plots draw each wall's; in mm it is the same
+building."""
 from __future__ import annotations
 
 import numpy as np
@@ -171,3 +172,31 @@ def test_the_ltsm_plan_draws_each_walls_stage_3_inside_its_stage_2(capacity):
     assert len(lines) == 2 * result.sizes["wall"]  # each wall: its LTSM line, then its run's line inside it
     ran = result.step_wall_damage_category.values.max(axis=0)
     assert [to_hex(line.get_color()) for line in lines[1::2]] == [DAMAGE_COLOURS[int(c)] for c in ran]
+
+
+def corner_spec(scale: float, unit: str) -> dict:
+    """The kit's corner building (:func:`masonryfw.testing.corner_building`, its walls at right angles) written in
+    ``unit``, its lengths times ``scale``."""
+    s = scale
+    walls = [{"name": "a", "start": [0.0, 0.0], "end": [1.44 * s, 0.0], "height": 0.96 * s, "thickness": 0.12 * s,
+              "openings": [{"x": 0.48 * s, "y": 0.0, "width": 0.48 * s, "height": 0.6 * s}]},
+             {"name": "b", "start": [1.44 * s, 0.0], "end": [1.44 * s, 1.2 * s], "height": 0.96 * s,
+              "thickness": 0.12 * s}]
+    return {"title": "corner", "length_unit": unit,
+            "building": {"unit": {"length": 0.24 * s, "height": 0.12 * s, "depth": 0.12 * s}, "walls": walls},
+            "material": {"unit_weight": 20000.0, "friction_angle": 30.0},
+            "settlement": {"profile": "gaussian", "width": 0.6 * s, "axis_angle": 30.0, "center_x": 1.4 * s,
+                           "center_y": 0.2 * s}}
+
+
+def test_a_building_in_mm_settles_as_in_m():
+    """The same building written in mm and in m: the same reaction history to 1e-4 of R0 (the non-dimensional
+    problem is one; what differs is the rounding of the units' conversion, measured 7e-6) and the same walls'
+    cracks."""
+    in_m, in_mm = (mf.solve(mf.build(corner_spec(scale, unit)), "fdem", {"settlement": 0.005})
+                   for scale, unit in ((1.0, "m"), (1000.0, "mm")))
+    r0 = float(in_m.step_reaction.values[0])
+    assert np.abs(in_mm.step_reaction.values - in_m.step_reaction.values).max() <= 1e-4 * r0
+    np.testing.assert_allclose(in_mm.step_wall_crack_width_max.values, in_m.step_wall_crack_width_max.values,
+                               rtol=1e-4, atol=1e-9)
+    assert np.array_equal(in_mm.step_wall_damage_category.values, in_m.step_wall_damage_category.values)

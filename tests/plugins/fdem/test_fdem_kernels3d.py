@@ -1,7 +1,7 @@
 """fdem's 3D kernels (rigid polyhedra, face-pair contacts, exact rotations) against closed forms: a block at rest
 on a base (reaction and penetration), sliding down an incline at ``g (sin theta - mu cos theta)`` and held below
-the friction angle, tipping over an edge once the sideways load passes ``b / h`` of its weight, and the
-torque-free precession of a symmetric top. Units are the kernels' own: g = 1, unit weight 1 a volume."""
+the friction angle, tipping over an edge once the sideways load passes ``b / h`` of its weight and landing on its
+side (corner contacts), and the torque-free precession of a symmetric top. Units are the kernels' own: g = 1, unit weight 1 a volume."""
 from __future__ import annotations
 
 import numpy as np
@@ -13,6 +13,7 @@ from masonryfw_fdem import kernels3d as k3
 from masonryfw_fdem import scene3d as s3
 
 KN = 1e4  # normal stiffness per area: a unit cube of weight 1 sinks 1e-4
+RECLIP_SHARE = {o.name: o.default for o in mf.get_solver("fdem").options}["reclip_ratio"]
 BUFFER = 0.05
 MIN_COS = np.cos(np.radians(30.0))
 
@@ -31,14 +32,14 @@ def run(bodies, load, friction, steps, dt=1e-3, damping=0.0, dashpot=0.2, ramp=0
     pairs found again whenever the kernel asks; returns the motion, the last pairs and the wrench on the
     supports."""
     motion = s3.at_rest(bodies)
-    law = k3.ContactLaw3(KN, 0.5 * KN, 1e-12, dashpot)
+    law = k3.ContactLaw3(KN, 0.5 * KN, 1e-12, dashpot, RECLIP_SHARE, BUFFER)
     loading = k3.Loading3(load, ramp, 0.0, 0.0, 0.0, 0.0)
     stepping = k3.Stepping3(dt, damping, 0.5 * BUFFER)
     pairs, wrench, left = None, np.zeros((bodies.pos0.shape[0], 6)), steps
     while left > 0:
-        faces = s3.face_pairs(bodies, motion, BUFFER, 0.2, MIN_COS)
+        faces, corners = s3.contacts(bodies, motion, BUFFER, 0.2, MIN_COS)
         pairs = s3.new_pairs(bodies, faces, np.tile([friction, 0.0, 0.0], (len(faces), 1)), np.zeros(len(faces)),
-                             pairs)
+                             corners, np.full(len(corners), friction), pairs)
         done, rebuild, *_ = k3.advance3(left, bodies, pairs, law, motion, loading, stepping, wrench)
         left -= done
         motion.pos_detect[:] = motion.pos
@@ -70,6 +71,39 @@ def test_a_block_at_rest_presses_its_weight_into_the_base_with_the_closed_form_p
     assert pairs.normal[0][pairs.held[0] == 1] == pytest.approx(np.full(4, 0.25), rel=1e-9)
     assert 0.0 - (motion.pos[1, 2] - 0.5) == pytest.approx(1.0 / KN, rel=1e-6)  # W / (kn A)
     assert np.abs(motion.pos[1, :2]).max() < 1e-12
+
+
+def pair_wrench(bodies, pairs, motion):
+    """Every face pair's force and moments (:func:`.kernels3d.pair_forces3`) at ``motion``, histories kept."""
+    world = s3.world_vertices(bodies, motion)
+    n_face = bodies.face_offs.size - 1
+    normal, centre = np.empty((n_face, 3)), np.empty((n_face, 3))
+    k3.face_frames3(world, bodies, normal, centre)
+    force, energy = np.empty((len(pairs.faces), 9)), np.empty((len(pairs.faces), 3))
+    law = k3.ContactLaw3(KN, 0.5 * KN, 1e-12, 0.0, RECLIP_SHARE, BUFFER)
+    k3.pair_forces3(bodies, pairs, law, motion, world, normal, centre, force, energy, 1e-3, False)
+    return force
+
+
+@pytest.mark.parametrize("turn", [False, True])
+def test_a_pairs_reused_overlap_carries_the_forces_of_a_fresh_clip_to_its_tolerance(turn):
+    """A block at rest slid (or turned about z) by less than ``reclip_ratio`` of its radius against its base: the
+    pair keeps its overlap as clipped at rest, its points on the base; its forces are those of the overlap clipped
+    afresh, the moments within the weight times the move (the points' lever arms moved by that much)."""
+    bodies = block_on_base()
+    motion, pairs, _ = run(bodies, weight_load(bodies), 0.6, 4000, damping=0.8)
+    move = 0.5 * RECLIP_SHARE * bodies.radius.min()
+    if turn:
+        k3.turn(motion.quat[1], 0.0, 0.0, move / bodies.radius[1])
+    else:
+        motion.pos[1, :2] += move / np.sqrt(2.0)
+    assert (pairs.clipped == 4).all()
+    reused = pair_wrench(bodies, pairs, motion)
+    fresh = pair_wrench(bodies, pairs._replace(clipped=np.full_like(pairs.clipped, -1)), motion)
+    weight = bodies.mass[1]
+    assert np.abs(reused[:, :3] - fresh[:, :3]).max() <= 1e-9 * weight
+    assert np.abs(reused[:, 3:] - fresh[:, 3:]).max() <= 1.01 * weight * move
+    assert abs(reused[:, 2].sum() - weight) <= 1e-6 * weight
 
 
 @pytest.mark.parametrize("tilt_deg", [25.0, 35.0])
@@ -111,6 +145,31 @@ def test_a_slender_block_tips_over_its_edge_once_the_sideways_load_passes_b_over
         assert motion.omega[1, 1] > 0.0 and abs(motion.omega[1, 0]) + abs(motion.omega[1, 2]) < 1e-6
 
 
+def lowest_vertex(bodies, motion, block):
+    """The height of ``block``'s lowest vertex at ``motion``."""
+    vertices = bodies.vertices[bodies.vertex_offs[block]:bodies.vertex_offs[block + 1]]
+    return min(k3.rotate(motion.quat[block], *v)[2] for v in vertices) + motion.pos[block, 2]
+
+
+def test_a_toppling_block_lands_on_its_side_and_never_passes_through_the_base():
+    """A block b wide and h high pushed over its edge (sideways 1.2 b / h of its weight, friction 0.9) turns past
+    ``max_contact_angle`` (its base no longer faces the ground: the face pair is gone) on the corner contacts of
+    its edge, then lies on its side: turned 90 degrees, its centroid b / 2 high. Without corner contacts it sank
+    into the base from 40 degrees and fell through it (0.40 below the surface at 64 degrees)."""
+    b, h = 0.5, 1.5
+    bodies = block_on_base((b, 1.0, h))
+    load = weight_load(bodies, sideways=1.2 * b / h)
+    falling, _, _ = run(bodies, load, 0.9, 3500, ramp=0.2)
+    fallen, pairs, _ = run(bodies, load, 0.9, 8000, damping=0.0, ramp=0.2)
+    rest = np.array([1.0, 0.0, 0.0, 0.0])
+    assert 50.0 < np.degrees(k3.rotation_angle(falling.quat[1], rest)) < 85.0  # on its edge, past the contact angle
+    assert lowest_vertex(bodies, falling, 1) > -1e-3
+    assert np.degrees(k3.rotation_angle(fallen.quat[1], rest)) == pytest.approx(90.0, abs=0.5)
+    assert fallen.pos[1, 2] == pytest.approx(b / 2, abs=1e-3)
+    assert lowest_vertex(bodies, fallen, 1) > -1e-3
+    assert len(pairs.faces) == 1 and len(pairs.corners) == 0  # lying on its side: a face pair again
+
+
 def test_a_free_symmetric_top_keeps_its_angular_momentum_and_precesses_at_l_over_i1():
     """No contact, no load: the angular momentum stays (world frame) and the symmetry axis turns about it at
     ``|L| / I1`` (I1 the inertia about a transverse axis)."""
@@ -118,10 +177,11 @@ def test_a_free_symmetric_top_keeps_its_angular_momentum_and_precesses_at_l_over
     bodies = s3.bodies_of(poly, np.array([1.0]), np.array([False]), np.zeros(1, bool), np.zeros((1, 6)))
     motion = s3.at_rest(bodies)
     motion.omega[0] = (0.6, 0.0, 2.0)
-    pairs = s3.new_pairs(bodies, np.zeros((0, 2), dtype=np.int64), np.zeros((0, 3)), np.zeros(0))
+    pairs = s3.new_pairs(bodies, np.zeros((0, 2), dtype=np.int64), np.zeros((0, 3)), np.zeros(0),
+                         np.zeros((0, 3), dtype=np.int64), np.zeros(0))
     momentum = bodies.inertia[0] @ motion.omega[0]
     steps, dt = 20000, 1e-4
-    k3.advance3(steps, bodies, pairs, k3.ContactLaw3(KN, KN, 0.0, 0.0), motion,
+    k3.advance3(steps, bodies, pairs, k3.ContactLaw3(KN, KN, 0.0, 0.0, RECLIP_SHARE, BUFFER), motion,
                 k3.Loading3(np.zeros((1, 6)), 0.0, 0.0, 0.0, 0.0, 0.0), k3.Stepping3(dt, 0.0, 1e9), np.zeros((1, 6)))
     r = rotation_of(motion.quat[0])
     after = r @ bodies.inertia[0] @ r.T @ motion.omega[0]
