@@ -32,6 +32,19 @@ def block_displacement3(scene, snapshot: np.ndarray) -> np.ndarray:
     return np.c_[(pos - scene.pos0) * scene.scales.length, axis * angle[:, None]]
 
 
+def interface_normal_forces3(scene, faces: np.ndarray, normal: np.ndarray) -> np.ndarray:
+    """``(interface,)`` [N]: each model interface's normal force (compression positive), the sum of the normal
+    forces at the points of the face pairs between its two blocks (``normal``: pair, point; a pair between
+    blocks that share no interface, a contact the settlement made, is left out; blocks joined by several
+    interfaces give it to the first)."""
+    out = np.zeros(scene.model.sizes["interface"])
+    if faces.size:
+        joint = mfp.find_pairs(scene.joints, scene.bodies.face_block[faces])
+        kept = joint >= 0
+        np.add.at(out, joint[kept], normal[kept].sum(axis=1) * scene.scales.force)
+    return out
+
+
 def interface_forces(scene: Scene, faces: np.ndarray, props: np.ndarray, normal: np.ndarray, shear: np.ndarray,
                      pos: np.ndarray):
     """Contact forces of the face pairs mapped onto the model's interface ends [N].

@@ -259,12 +259,15 @@ def snapshot_variables(scene, history: History, displacement) -> dict:
 
 
 def result_dataset3(scene: Scene3, state, history: History) -> xr.Dataset:
-    """The primary result variables of a 3D run: final displacements (a rotation as its rotation vector), the
-    history."""
+    """The primary result variables of a 3D run: final displacements (a rotation as its rotation vector), each
+    interface's normal force at the end, the history."""
     motion = postprocess.block_displacement3(scene, state.snapshot())
     data = {
         "block_displacement": (("block", "axis"), motion[:, :3], mfp.variable_attrs("block_displacement", "result3d")),
         "block_rotation": (("block", "axis"), motion[:, 3:], mfp.variable_attrs("block_rotation", "result3d")),
+        "interface_normal_force": ("interface", postprocess.interface_normal_forces3(scene, state.pairs.faces,
+                                                                                    state.pairs.normal),
+                                   mfp.variable_attrs("interface_normal_force", "result3d")),
         **history_variables(scene, history),
     }
     data.update(snapshot_variables(scene, history, postprocess.block_displacement3))

@@ -200,3 +200,19 @@ def test_a_building_in_mm_settles_as_in_m():
     np.testing.assert_allclose(in_mm.step_wall_crack_width_max.values, in_m.step_wall_crack_width_max.values,
                                rtol=1e-4, atol=1e-9)
     assert np.array_equal(in_mm.step_wall_damage_category.values, in_m.step_wall_damage_category.values)
+
+
+def test_the_interfaces_normal_forces_at_the_end_carry_the_buildings_weight(capacity):
+    """Each interface's normal force (the sum over its face pairs' points) is a compression on these dry joints,
+    and those on the ground sum to the masonry's weight (sum of unit weight times volume) within the run's
+    unbalanced force at rest (the last record's unbalanced ratio is under 1 %)."""
+    _, result, _ = capacity
+    model = mt.corner_building()
+    force = result.interface_normal_force.values
+    assert force.shape == (model.sizes["interface"],) and force.min() >= 0.0
+    support = mfp.support_blocks(model.block_role.values)
+    sides = model.interface_blocks.values
+    on_ground = support[sides].any(axis=1) & ~support[sides].all(axis=1)
+    weight = float((model.block_unit_weight.values * model.block_volume.values)[~support].sum())
+    assert force[on_ground].sum() == pytest.approx(weight, rel=0.01)
+    assert force[~on_ground].max() > 0.0  # the joints in the masonry carry too
