@@ -166,21 +166,26 @@ def face_properties3(scene: Scene3, faces: np.ndarray) -> tuple[np.ndarray, np.n
     a pair between blocks that share a model interface takes its properties, others the model's median friction
     and no strength (the 2D rule, :func:`.scene.face_properties`)."""
     block = scene.bodies.face_block[faces] if faces.size else np.zeros((0, 2), dtype=np.int64)
+    props = block_pair_properties(scene, block)
+    return props, (props[:, 1] > 0) | (props[:, 2] > 0)
+
+
+def block_pair_properties(scene: Scene3, block: np.ndarray) -> np.ndarray:
+    """(k, 3) friction, cohesion and tensile strength per area between the (k, 2) blocks: their model
+    interface's, or the model's median friction and no strength."""
     joint = mfp.find_pairs(scene.joints, block)
     hit = joint >= 0
     at = np.maximum(joint, 0)
     props = np.c_[np.where(hit, scene.friction[at] if scene.friction.size else 0.0, scene.default_friction),
                   np.where(hit, scene.cohesion[at] if scene.cohesion.size else 0.0, 0.0),
                   np.where(hit, scene.tension[at] if scene.tension.size else 0.0, 0.0)]
-    return props, (props[:, 1] > 0) | (props[:, 2] > 0)
+    return props
 
 
 def corner_friction3(scene: Scene3, corners: np.ndarray) -> np.ndarray:
     """(corner,) the friction coefficient of each corner contact: its blocks' model interface's, or the model's
     median (:func:`face_properties3`'s rule)."""
-    joint = mfp.find_pairs(scene.joints, corners[:, 1:]) if corners.size else np.zeros(0, dtype=np.int64)
-    at = np.maximum(joint, 0)
-    return np.where(joint >= 0, scene.friction[at] if scene.friction.size else 0.0, scene.default_friction)
+    return block_pair_properties(scene, corners[:, 1:].reshape(-1, 2))[:, 0]
 
 
 def bodies_of(poly: mfp.Polyhedra, unit_weight: np.ndarray, driven: np.ndarray, moving: np.ndarray,
@@ -277,15 +282,16 @@ def contacts(bodies: Bodies3, motion: Motion3, buffer: float, max_penetration: f
     blocks = np.c_[a[keep], b[keep]].astype(np.int64)
     faces = detect_face_pairs3(bodies, world, blocks, buffer, max_penetration, min_cos)
     n = bodies.pos0.shape[0]
-    joined = np.isin(np.minimum(blocks[:, 0], blocks[:, 1]) * n + np.maximum(blocks[:, 0], blocks[:, 1]),
-                     pair_keys(bodies.face_block[faces], n))
+    joined = np.isin(mfp.pair_key(blocks, n), mfp.pair_key(bodies.face_block[faces], n))
     return faces, detect_corners3(bodies, world, blocks, joined, buffer, max_penetration, buffer)
 
 
-def pair_keys(blocks: np.ndarray, n: int) -> np.ndarray:
-    """One number per unordered block pair (k, 2) of ``n`` blocks."""
-    return np.minimum(blocks[:, 0], blocks[:, 1]) * n + np.maximum(blocks[:, 0], blocks[:, 1]) if blocks.size else \
-        np.zeros(0, dtype=np.int64)
+def rows_before(before: np.ndarray, now: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Which of the keys ``now`` were among ``before`` (a mask of ``now``) and their rows there."""
+    order = np.argsort(before)
+    at = np.clip(np.searchsorted(before[order], now), 0, before.size - 1)
+    kept = before[order][at] == now
+    return kept, order[at[kept]]
 
 
 def new_pairs(bodies: Bodies3, faces: np.ndarray, props: np.ndarray, bonded_start: np.ndarray,
@@ -301,23 +307,15 @@ def new_pairs(bodies: Bodies3, faces: np.ndarray, props: np.ndarray, bonded_star
     bonded = np.repeat(np.asarray(bonded_start, dtype=np.int64)[:, None], most, axis=1)
     if old is not None and old.faces.size and faces.size:
         n_face = bodies.face_offs.size - 1
-        before = old.faces[:, 0] * n_face + old.faces[:, 1]
-        order = np.argsort(before)
-        now = faces[:, 0] * n_face + faces[:, 1]
-        at = np.clip(np.searchsorted(before[order], now), 0, before.size - 1)
-        kept = before[order][at] == now
-        source = order[at[kept]]
+        kept, source = rows_before(old.faces[:, 0] * n_face + old.faces[:, 1], faces[:, 0] * n_face + faces[:, 1])
         width = min(most, old.held.shape[1])
         for mine, theirs in ((held, old.held), (points, old.points), (shear, old.shear), (bonded, old.bonded)):
             mine[kept, :width] = theirs[source, :width]
     corner_shear = np.zeros((corners.shape[0], 3))
     if old is not None and old.corners.size and corners.size:
-        key = (corners[:, 0] * bodies.pos0.shape[0] + corners[:, 2])
-        before = old.corners[:, 0] * bodies.pos0.shape[0] + old.corners[:, 2]
-        order = np.argsort(before)
-        at = np.clip(np.searchsorted(before[order], key), 0, before.size - 1)
-        kept = before[order][at] == key
-        corner_shear[kept] = old.corner_shear[order[at[kept]]]
+        n = bodies.pos0.shape[0]
+        kept, source = rows_before(old.corners[:, 0] * n + old.corners[:, 2], corners[:, 0] * n + corners[:, 2])
+        corner_shear[kept] = old.corner_shear[source]
     return Pairs3(faces, np.asarray(props, dtype=float), held, points, shear, bonded,
                   np.zeros((faces.shape[0], most)), np.full(faces.shape[0], -1, dtype=np.int64),
                   np.zeros((faces.shape[0], most)), np.zeros((faces.shape[0], 7)), corners.astype(np.int64),
