@@ -10,7 +10,7 @@ model's 3D twin (a bundled wall's, or a 3D model itself: ``house-tunnel``, ``cor
 building, ``small-house`` for the building tests' house, ``house-5k`` for the bundled house in finer units, 5,430
 blocks) and prints its key numbers and the estimate's seconds
 (and steps) against the solve's: time it whole-process, A against B. ``--twins WALL,WALL`` solves each wall
-in 2D and its twin at the shares of ``--shares`` and prints the largest difference of their reaction
+in 2D and its twin under each ``--variant`` of the 3D options and prints the largest difference of their reaction
 histories over R0, the minima, the widest cracks, the categories and the F1 of the cracked joints.
 """
 from __future__ import annotations
@@ -65,8 +65,9 @@ def cracked_pairs(model, result) -> set[tuple[int, int]]:
     return {tuple(sorted(p)) for p in model.interface_blocks.values[mf.cracked_joints(result)].tolist()}
 
 
-def twin_rows(walls: list[str], shares: list[float]) -> list[str]:
-    rows = ["| wall | share | max diff / R0 | R min / R0 2D, 3D | crack [mm] 2D, 3D | category 2D, 3D | F1 | "
+def twin_rows(walls: list[str], variants: list[dict]) -> list[str]:
+    """Each wall in 2D and its twin under each variant (fdem options): the table's rows."""
+    rows = ["| wall | 3D options | max diff / R0 | R min / R0 2D, 3D | crack [mm] 2D, 3D | category 2D, 3D | F1 | "
             "solve 3D [s] |", "|---|---|---|---|---|---|---|---|"]
     for name in walls:
         planar = mf.open_model(name)
@@ -74,16 +75,16 @@ def twin_rows(walls: list[str], shares: list[float]) -> list[str]:
         flat = mf.solve(planar, "fdem")
         s2, r2 = settlement_records(flat)
         r0 = r2[0]
-        for share in shares:
+        for variant in variants:
             start = time.perf_counter()
-            solid = mf.solve(twin, "fdem", {"reclip_ratio": share})
+            solid = mf.solve(twin, "fdem", variant)
             seconds = time.perf_counter() - start
             s3, r3 = settlement_records(solid)
             grid = np.linspace(0.0, min(s2[-1], s3[-1]), 200)
             diff = np.abs(np.interp(grid, s3, r3) - np.interp(grid, s2, r2)).max() / r0
             a, b = cracked_pairs(planar, flat), cracked_pairs(twin, solid)
             f1 = 2 * len(a & b) / (len(a) + len(b))
-            rows.append(f"| {planar.attrs.get('title', name)} | {share:g} | {diff:.4f} | {r2.min() / r0:.4f}, "
+            rows.append(f"| {planar.attrs.get('title', name)} | {options_text(variant)} | {diff:.4f} | {r2.min() / r0:.4f}, "
                         f"{r3.min() / r0:.4f} | {1e3 * flat.step_crack_width_max.values[-1]:.2f}, "
                         f"{1e3 * solid.step_crack_width_max.values[-1]:.2f} | "
                         f"{int(flat.step_damage_category.values[-1])}, {int(solid.step_damage_category.values[-1])} "
@@ -92,18 +93,37 @@ def twin_rows(walls: list[str], shares: list[float]) -> list[str]:
     return rows
 
 
+def parsed_options(pairs: list[str]) -> dict:
+    """``KEY=VALUE`` strings as fdem options, a number where the value reads as one."""
+    def value(text: str):
+        try:
+            return float(text)
+        except ValueError:
+            return text
+
+    return {key: value(text) for key, text in (pair.split("=", 1) for pair in pairs)}
+
+
+def options_text(options: dict) -> str:
+    return ", ".join(f"{key}={value}" for key, value in options.items()) or "defaults"
+
+
 def main() -> None:
     parser = command_line(__doc__)
     parser.add_argument("model", nargs="?", default="corner")
     parser.add_argument("--reclip", type=float, default=None, help="fdem's reclip_ratio (default: the solver's)")
     parser.add_argument("--option", action="append", default=[], help="an fdem option KEY=VALUE")
     parser.add_argument("--twins", default="", help="walls whose 2D and 3D runs to compare, comma-separated")
-    parser.add_argument("--shares", default="0,1e-4", help="the reclip ratios the twins run at")
+    parser.add_argument("--variant", action="append", default=[],
+                        help="the twins' 3D options, KEY=VALUE[;KEY=VALUE] (repeatable: one variant each; default: "
+                             "reclip_ratio=0 and 1e-4)")
     args = parser.parse_args()
     if args.twins:
-        twin_rows(args.twins.split(","), [float(s) for s in args.shares.split(",")])
+        variants = [parsed_options(v.split(";")) for v in args.variant] or [{"reclip_ratio": 0.0},
+                                                                             {"reclip_ratio": 1e-4}]
+        twin_rows(args.twins.split(","), variants)
         return
-    options = {key: float(value) for key, value in (o.split("=", 1) for o in args.option)}
+    options = parsed_options(args.option)
     if args.reclip is not None:
         options["reclip_ratio"] = args.reclip
     model = model_3d(args.model)

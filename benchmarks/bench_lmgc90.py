@@ -56,8 +56,12 @@ def main() -> None:
     parser.add_argument("--times", type=float, nargs="+", default=[2.0, 4.0],
                         help="LMGC90's time to reach the settlement [s] (each a run)")
     parser.add_argument("--model", default="corner", help="corner (the kit's corner building) or a bundled wall")
+    parser.add_argument("--fdem", action="append", default=None,
+                        help="fdem's options for one run, KEY=VALUE[;KEY=VALUE] (repeatable; an empty string: the "
+                             "defaults; default: the defaults and the contacts half as stiff, as the old default)")
     parser.add_argument("--settlement", type=float, default=SETTLEMENT, help="the settlement to reach [m]")
     args = parser.parse_args()
+    args.fdem = args.fdem if args.fdem is not None else ["", "penetration_ratio=1e-4;rotational_inertia=physical"]
     settlement = args.settlement
     model = mt.corner_building() if args.model == "corner" else mf.checked_model(mfp.twin(mf.open_model(args.model)))
     masonry = mfp.masonry_blocks(model.block_role.values)
@@ -71,12 +75,13 @@ def main() -> None:
                             "--time", repr(seconds)], check=True)
             lmgc[seconds] = json.loads(out.read_text())
     fdem = {}
-    for ratio in (1e-4, 5e-5):
+    for variant in args.fdem:
         start = time.perf_counter()
-        fdem[ratio] = (mf.solve(model, "fdem", {"settlement": repr(settlement), "penetration_ratio": repr(ratio)}),
-                       time.perf_counter() - start)
+        options = dict(pair.split("=", 1) for pair in variant.split(";") if pair)
+        fdem[variant or "defaults"] = (mf.solve(model, "fdem", {"settlement": repr(settlement), **options}),
+                                       time.perf_counter() - start)
     la = mf.solve(model, "la")
-    r0 = float({n.name: n.value for n in mf.key_numbers(fdem[1e-4][0])}["dead_reaction"])
+    r0 = float({n.name: n.value for n in mf.key_numbers(next(iter(fdem.values()))[0])}["dead_reaction"])
     collapse = float({n.name: n.value for n in mf.key_numbers(la)}["collapse_reaction"])
     grid = np.linspace(0.0, settlement, 41)[1:]
     later = grid >= 1e-3
@@ -104,12 +109,12 @@ def main() -> None:
         rows = np.array(run["rows"])
         row(f"LMGC90, {settlement / seconds * 1e3:.2g} mm/s, {run['steps']} steps", run["seconds"], rows[:, 1],
             rows[:, 2], np.array(run["displacement"])[:, 2])
-    for ratio, (result, seconds) in fdem.items():
+    for variant, (result, seconds) in fdem.items():
         settling = result.step_phase.values == 1
         widest = result.step_wall_crack_width_max.values[-1] if "step_wall_crack_width_max" in result else \
             result.step_crack_width_max.values[-1:]
         widths = ", ".join(f"{w * 1e3:.3g}" for w in widest)
-        row(f"fdem, penetration ratio {ratio:g} (widest cracks {widths} mm)", seconds,
+        row(f"fdem, {variant.replace(';', ', ')} (widest cracks {widths} mm)", seconds,
             result.step_settlement.values[settling], result.step_reaction.values[settling],
             result.block_displacement.values[:, 2])
     body += ["", f"la (associative, the cone): alpha {float(la.collapse_multiplier):.4f}, collapse reaction "

@@ -33,7 +33,7 @@ MEMORY_PER_BLOCK = 20e3
 
 
 def estimate(model: xr.Dataset, options: Mapping[str, Any]) -> mfp.Estimate:
-    scene = scene_of(model)
+    scene = scene_of(model, options)
     controls = make_controls(scene, options)
     blocks = model.sizes["block"]
     steps = controls.gravity_steps_expected + (controls.target / (controls.rate * controls.dt) if controls.rate > 0 else 0.0)

@@ -28,9 +28,10 @@ OPTIONS = (
               "normal dashpot at every contact as a share of critical damping (damps contact chatter, "
               "not sliding)", at_least=0.0),
     mfp.Option("dt_safety", float, 0.3, "time step = dt_safety x estimated critical time step", above=0.0),
-    mfp.Option("penetration_ratio", float, 1e-4,
+    mfp.Option("penetration_ratio", float, None,
               "automatic contact stiffness: the mean base pressure of the wall's weight penetrates "
-              "this share of the median unit height", above=0.0),
+              "this share of the median unit height; auto: 1e-4 in 2D, 1.25e-5 in 3D (softer contacts set off an "
+              "out-of-plane lean of a building's slender walls: docs/fdem.md)", above=0.0),
     mfp.Option("contact_stiffness", float, None,
               "normal contact stiffness per unit contact length [N m-2]; auto: from penetration_ratio", above=0.0),
     mfp.Option("min_contact_length", float, 0.01,
@@ -74,6 +75,11 @@ OPTIONS = (
               "share of the smaller block's radius (its points stay on block A until then; 0 = whenever they "
               "have moved)",
               at_least=0.0),
+    mfp.Option("rotational_inertia", str, "scaled",
+              "3D: scaled: each block's inertia tensor is multiplied by the factor (at least 1, about 3 for a brick) "
+              "that makes its rotation no stiffer than the stiffest block's translation, so the time step is "
+              "translation's (sqrt(3) fewer steps; masses, loads and equilibria unchanged: for quasi-static runs); "
+              "physical: the polyhedra's own", ("scaled", "physical")),
     mfp.Option("sleep", float, 0.0,
               "blocks slower than this share of the settlement velocity for sleep_steps steps sleep "
               "(not integrated) until a contact moving faster wakes them; 0 = no sleeping", at_least=0.0),

@@ -8,7 +8,9 @@ masses are weight shares, so gravity has unit acceleration. Cohesion and tensile
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from collections.abc import Mapping
+from dataclasses import dataclass, replace
+from typing import Any
 
 import numpy as np
 import xarray as xr
@@ -85,24 +87,11 @@ class Scene3:
     def critical_time_step(self, kn: float) -> float:
         """2 / omega_max over the free blocks, each held by springs of ``kn`` per area (normal and shear alike,
         an upper bound for ``kt <= kn``) over its whole surface, a face's at its vertices (an equal share each,
-        as the contact points carry it): omega^2 the largest eigenvalue of ``M^-1 K``, the block's 6 x 6
-        stiffness ``K = sum a B^T B`` (``B = [I, -[r]x]`` at a vertex r from the centroid) over its mass and
-        inertia, doubled (a spring joins two blocks that can move against each other). Bounding translation by
-        ``kn S / m`` and rotation by ``kn S R^2 / I_min`` instead (the 2D bound's form) took 1.5-7x the planar
-        run's steps on the bundled walls' twins (this bound: 1.6-1.75x); without the doubling Test 12C's twin
-        blew up."""
-        poly = polyhedra(self)
-        _, area, _ = mfp.face_normals_areas(poly)
-        vertex = poly.face_vertex_index()
-        share = np.repeat(area / poly.face_node_count, poly.face_node_count)
-        block = np.repeat(poly.face_block(), poly.face_node_count)
-        r = self.bodies.vertices[vertex]
-        skew = np.zeros((r.shape[0], 3, 3))
-        skew[:, 0, 1], skew[:, 0, 2], skew[:, 1, 2] = -r[:, 2], r[:, 1], -r[:, 0]
-        skew -= skew.transpose(0, 2, 1)
-        b = np.concatenate([np.broadcast_to(np.eye(3), skew.shape), -skew], axis=2)  # (vertex, 3, 6)
-        stiffness = np.zeros((self.driven.size, 6, 6))
-        np.add.at(stiffness, block, share[:, None, None] * np.einsum("vij,vik->vjk", b, b))
+        as the contact points carry it): omega^2 the largest eigenvalue of ``M^-1 K`` (:func:`block_stiffness`)
+        over its mass and inertia, doubled (a spring joins two blocks that can move against each other).
+        Bounding translation by ``kn S / m`` and rotation by ``kn S R^2 / I_min`` instead (the 2D bound's form)
+        took 1.5-7x the planar run's steps on the bundled walls' twins (this bound: 1.6-1.75x); without the
+        doubling Test 12C's twin blew up."""
         free = np.flatnonzero(~self.driven)
         if free.size == 0:
             return np.inf
@@ -110,8 +99,47 @@ class Scene3:
         mass[:, :3, :3] = self.bodies.mass[free, None, None] * np.eye(3)
         mass[:, 3:, 3:] = self.bodies.inertia[free]
         # twice: a spring joins two blocks, and in the highest mode its neighbours move against it (Gershgorin)
-        largest = 2.0 * np.linalg.eigvals(np.linalg.solve(mass, kn * stiffness[free])).real.max()
+        largest = 2.0 * np.linalg.eigvals(np.linalg.solve(mass, kn * block_stiffness(self)[free])).real.max()
         return 2.0 / np.sqrt(largest) if largest > 0 else np.inf
+
+
+def block_stiffness(scene: Scene3) -> np.ndarray:
+    """(block, 6, 6) each block's stiffness under unit springs per area over its whole surface, a face's area
+    shared equally by its vertices: ``K = sum a B^T B``, ``B = [I, -[r]x]`` at a vertex r from the centroid."""
+    poly = polyhedra(scene)
+    _, area, _ = mfp.face_normals_areas(poly)
+    vertex = poly.face_vertex_index()
+    share = np.repeat(area / poly.face_node_count, poly.face_node_count)
+    block = np.repeat(poly.face_block(), poly.face_node_count)
+    r = scene.bodies.vertices[vertex]
+    skew = np.zeros((r.shape[0], 3, 3))
+    skew[:, 0, 1], skew[:, 0, 2], skew[:, 1, 2] = -r[:, 2], r[:, 1], -r[:, 0]
+    skew -= skew.transpose(0, 2, 1)
+    b = np.concatenate([np.broadcast_to(np.eye(3), skew.shape), -skew], axis=2)  # (vertex, 3, 6)
+    stiffness = np.zeros((scene.driven.size, 6, 6))
+    np.add.at(stiffness, block, share[:, None, None] * np.einsum("vij,vik->vjk", b, b))
+    return stiffness
+
+
+def with_rotation_scaled(scene: Scene3) -> Scene3:
+    """``scene`` with each free block's inertia tensor times the factor (at least 1) that brings its rotation's
+    highest frequency down to the highest translational one of any block (:func:`block_stiffness`), so the time
+    step is translation's. A box's corners hold its rotation three times as stiffly as its translation (per
+    mass), so the physical inertia takes sqrt(3) as many steps. The masses, the loads and the static
+    equilibria are unchanged; only how fast a block turns when it is out of balance changes, which a
+    quasi-static run does not depend on (docs/fdem.md, "In 3D", checked on the house, the corner building,
+    the twins and against LMGC90)."""
+    free = np.flatnonzero(~scene.driven)
+    if free.size == 0:
+        return scene
+    stiffness = block_stiffness(scene)[free]
+    translation = np.linalg.eigvalsh(stiffness[:, :3, :3]).max(axis=1) / scene.bodies.mass[free]
+    rotation = np.linalg.eigvals(np.linalg.solve(scene.bodies.inertia[free], stiffness[:, 3:, 3:])).real.max(axis=1)
+    factor = np.ones(scene.driven.size)
+    factor[free] = np.maximum(rotation / translation.max(), 1.0)
+    bodies = scene.bodies._replace(inertia=scene.bodies.inertia * factor[:, None, None],
+                                   inv_inertia=scene.bodies.inv_inertia / factor[:, None, None])
+    return replace(scene, bodies=bodies)
 
 
 def polyhedra(scene: Scene3) -> mfp.Polyhedra:
@@ -322,8 +350,10 @@ def new_pairs(bodies: Bodies3, faces: np.ndarray, props: np.ndarray, bonded_star
                   np.asarray(corner_friction, dtype=float), corner_shear)
 
 
-def scene_of(model: xr.Dataset) -> Scene | Scene3:
-    """The scene of ``model``, made once (the estimate's, then the solve's): blocks in the plane, or polyhedra."""
+def scene_of(model: xr.Dataset, options: Mapping[str, Any]) -> Scene | Scene3:
+    """The scene of ``model``, made once (the estimate's, then the solve's): blocks in the plane, or polyhedra
+    (their rotation's inertia scaled where ``options`` say, :func:`with_rotation_scaled`)."""
     if mfp.space(model) == 3:
-        return mfp.made_once(model, "fdem scene 3d", build_scene3)
+        scene = mfp.made_once(model, "fdem scene 3d", build_scene3)
+        return with_rotation_scaled(scene) if options["rotational_inertia"] == "scaled" else scene
     return mfp.made_once(model, "fdem scene", build_scene)

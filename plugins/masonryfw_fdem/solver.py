@@ -47,7 +47,7 @@ def solve(model: xr.Dataset, options: Mapping[str, Any], progress=mfp.no_progres
 
 
 def _solve(model: xr.Dataset, options: Mapping[str, Any], progress) -> xr.Dataset:
-    scene = scene_of(model)  # the one the estimate made
+    scene = scene_of(model, options)  # the one the estimate made
     mfp.refuse_rigid_settlement(model, "fdem")
     controls = make_controls(scene, options)
     load = scene.dead + (options["load_factor"] or 0.0) * scene.live

@@ -192,8 +192,13 @@ def corner_spec(scale: float, unit: str) -> dict:
 def test_a_building_in_mm_settles_as_in_m():
     """The same building written in mm and in m: the same reaction history to 1e-4 of R0 (the non-dimensional
     problem is one; what differs is the rounding of the units' conversion, measured 7e-6) and the same walls'
-    cracks."""
-    in_m, in_mm = (mf.solve(mf.build(corner_spec(scale, unit)), "fdem", {"settlement": 0.005})
+    cracks. Run with 2D's contacts and the physical inertia: at 3D's defaults (stiffer contacts, the rotation's
+    inertia scaled) the two trajectories part at round-off within the reaction's own record-to-record jitter
+    (measured 1.3 % of R0 where the jitter reaches 1.8 %, the walls' widest cracks within 0.2 %; with the scaled
+    inertia at 2D's contacts 7e-5 of R0 and 1.1e-4 of the widths), as any two orders of the same sums do, so the
+    units' conversion is checked where the run is not that sensitive."""
+    options = {"settlement": 0.005, "penetration_ratio": 1e-4, "rotational_inertia": "physical"}
+    in_m, in_mm = (mf.solve(mf.build(corner_spec(scale, unit)), "fdem", options)
                    for scale, unit in ((1.0, "m"), (1000.0, "mm")))
     r0 = float(in_m.step_reaction.values[0])
     assert np.abs(in_mm.step_reaction.values - in_m.step_reaction.values).max() <= 1e-4 * r0
