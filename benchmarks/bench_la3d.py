@@ -5,11 +5,16 @@
   pyramid of 8 sides, of 4, and with the cone (Clarabel, the default), against the planar la of the same
   wall; alpha's difference from the planar one.
 - The bundled ``house-tunnel`` (a two-storey house over a tunnel, 1,126 blocks): build and solve.
-- The same house in units of a half and a third of its own (about 4,400 and 9,800 blocks): the whole process
-  ``masonryfw solve SPEC --plugin la`` (start-up, build, solve, write) timed, and its peak memory.
+- The same house in units of a half and a third of its own (4,390 and 9,663 blocks), the bundled ``brick-house``
+  (20,884 bricks, two leaves, English bond) and ``brick-terrace`` (39,660): the whole process ``masonryfw solve
+  SPEC --plugin la`` (start-up, build, solve, write) timed, and its peak memory, with the cone solved by our
+  interior point (the default) and, up to ``--clarabel-up-to`` blocks, by Clarabel: alpha's difference between
+  the two, and the time's exponent in the blocks.
 
 Whole ``mf.build`` / ``mf.solve`` calls, one run each (the house's solve three times), this process.
-Run from the benchmarks folder: ``python bench_la3d.py``. Writes the ``la3d`` section of docs/benchmarks.md.
+Run from the benchmarks folder: ``python bench_la3d.py [--hog] [--only-scale]``. ``--hog`` runs a CPU hog
+(``python -c "while True: pass"``) beside the whole-process runs. Writes the ``la3d`` section of
+docs/benchmarks.md (``--only-scale``: the whole-process table alone, in the ``la3d-scale`` section).
 """
 from __future__ import annotations
 
@@ -21,6 +26,8 @@ import tempfile
 import time
 from pathlib import Path
 
+import numpy as np
+import xarray as xr
 from _report import command_line, write_section
 
 import masonryfw as mf
@@ -88,31 +95,69 @@ WATCHER = ("import resource, subprocess, sys\n"
            "sys.exit(done.returncode)\n")
 
 
-def whole_process() -> list[str]:
-    rows = ["| units | blocks | whole process | peak memory | alpha |", "|---|---|---|---|---|"]
+def scale_cases(folder: Path) -> list[str]:
+    """The specs of the whole-process table: the house in units of 1, 1/2 and 1/3, the brick house and terrace."""
+    return [str(house_in_smaller_units(divisor, folder)) for divisor in (1, 2, 3)] + ["brick-house", "brick-terrace"]
+
+
+def solved_whole(spec: str, folder: Path, backend: str) -> tuple[float, float, xr.Dataset]:
+    """``masonryfw solve SPEC --plugin la --option solver=BACKEND`` as a process: its seconds, peak GiB, result."""
+    result = folder / f"{Path(spec).stem}.{backend}.nc"
+    start = time.perf_counter()
+    done = subprocess.run([sys.executable, "-c", WATCHER, sys.executable, "-m", "masonryfw", "solve", spec,
+                           "--plugin", "la", "--option", f"solver={backend}", "--no-progress", "-o", str(result)],
+                          capture_output=True, text=True, check=True)
+    seconds = time.perf_counter() - start
+    return seconds, float(done.stderr.strip().splitlines()[-1]) / 2**20, mf.open_checked(result)
+
+
+def whole_process(clarabel_up_to: int) -> list[str]:
+    rows = ["| model | blocks | cone points | ipm: whole process, peak memory | its, status | clarabel: whole "
+            "process, peak memory | its | alpha (ipm) | ipm - clarabel |", "|---|---|---|---|---|---|---|---|---|"]
+    sizes, times = [], []
     with tempfile.TemporaryDirectory() as folder:
-        for divisor in (1, 2, 3):
-            spec = house_in_smaller_units(divisor, Path(folder))
-            result = spec.with_suffix(".nc")
-            start = time.perf_counter()
-            done = subprocess.run([sys.executable, "-c", WATCHER, sys.executable, "-m", "masonryfw", "solve", str(spec),
-                                   "--plugin", "la", "--no-progress", "-o", str(result)],
-                                  capture_output=True, text=True, check=True)
-            seconds = time.perf_counter() - start
-            peak = float(done.stderr.strip().splitlines()[-1]) / 2**20
-            solved = mf.open_checked(result)
-            rows.append(f"| {0.44 / divisor:.3g} x {0.22 / divisor:.3g} m | {solved.sizes['block']:,} | {seconds:.1f} s | "
-                        f"{peak:.2f} GiB | {float(solved.collapse_multiplier):.4f} |")
+        for spec in scale_cases(Path(folder)):
+            seconds, peak, ours = solved_whole(spec, Path(folder), "ipm")
+            blocks, alpha = ours.sizes["block"], float(ours.collapse_multiplier)
+            sizes.append(blocks)
+            times.append(seconds)
+            cells = "not run (slower than ipm by 2-3x from 4,000 blocks)", "", ""
+            if blocks <= clarabel_up_to:
+                other_seconds, other_peak, other = solved_whole(spec, Path(folder), "clarabel")
+                reference = float(other.collapse_multiplier)
+                cells = (f"{other_seconds:.1f} s, {other_peak:.2f} GiB", f"{int(other.lp_iterations)}",
+                         f"{(alpha - reference) / reference:+.1e}")
+            name = Path(spec).stem if spec.endswith(".toml") else spec
+            rows.append(f"| {name} | {blocks:,} | {ours.sizes['interface_node']:,} | {seconds:.1f} s, {peak:.2f} GiB | "
+                        f"{int(ours.lp_iterations)}, {ours.lp_status.item()} | {cells[0]} | {cells[1]} | {alpha:.6f} | "
+                        f"{cells[2]} |")
             print(rows[-1], flush=True)
-    return rows
+    slope = np.polyfit(np.log(sizes), np.log(times), 1)[0]
+    return rows + ["", f"Time against blocks (ipm, whole process, least squares in logs over the {len(sizes)} models): "
+                       f"blocks^{slope:.2f}."]
 
 
 def main() -> None:
-    command_line(__doc__).parse_args()
+    parser = command_line(__doc__)
+    parser.add_argument("--hog", action="store_true", help="a CPU hog beside the whole-process runs")
+    parser.add_argument("--only-scale", action="store_true", help="the whole-process table alone")
+    parser.add_argument("--clarabel-up-to", type=int, default=10_000, help="blocks up to which Clarabel runs too")
+    args = parser.parse_args()
+    hog = subprocess.Popen([sys.executable, "-c", "while True: pass"]) if args.hog else None
+    try:
+        scale = whole_process(args.clarabel_up_to)
+    finally:
+        if hog is not None:
+            hog.kill()
+    load = "with a CPU hog (`python -c \"while True: pass\"`) beside each run" if args.hog else "quiet"
+    scale_text = ["The cone at scale, `masonryfw solve SPEC --plugin la` as a user runs it (whole process, one run "
+                  f"each, {load}):", "", *scale]
+    if args.only_scale:
+        write_section("la3d-scale" + ("-hog" if args.hog else ""), "la in 3D at scale: our interior point on the cone"
+                      + (", beside a CPU hog" if args.hog else ""), "\n".join(scale_text))
+        return
     body = ["The running-bond walls one block thick in 3D against the planar la (one run each; alpha relative to the "
-            "planar la's):", "", *walls(), "",
-            *house(), "", "The house in smaller units, `masonryfw solve SPEC --plugin la` as a user runs it (the cone):",
-            "", *whole_process()]
+            "planar la's):", "", *walls(), "", *house(), "", *scale_text]
     write_section("la3d", "la in 3D: time against size, the pyramid against the cone, a house", "\n".join(body))
 
 

@@ -25,7 +25,7 @@ DRAWN_NAMES = ("lact3-wall", "lact3-portal", "lact3-arch", "arch-settlement", "s
 #: Walls over a settlement profile (``[settlement]``, docs/settlements.md and docs/tunnels.md).
 PROFILE_NAMES = ("facade-1-trough", "tunnel-facade")
 #: Buildings in 3D laid from a ``[building]`` spec (docs/buildings.md).
-BUILDING_NAMES = ("house-tunnel",)
+BUILDING_NAMES = ("house-tunnel", "brick-house", "brick-terrace")
 #: Buildings in 3D drawn block by block as an OBJ mesh (``datasets/drawings``, docs/import.md section 7).
 DRAWN_3D_NAMES = ("drawn-corner",)
 #: Every name :func:`bundled_spec_path` knows.

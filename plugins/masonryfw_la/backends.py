@@ -8,7 +8,8 @@ alpha), so that ``G^T y + alpha_dual a = c`` at the optimum.
   vertex; when mechanisms tie it returns one of them (not symmetric in general).
   Fast below ~100 blocks, slow beyond a few hundred (docs/benchmarks.md).
 - ``ipm``: our primal-dual interior point on the normal equations ``G^T D G``
-  with a CHOLMOD factor (:mod:`.ipm`; SciPy's SuperLU without ``cvxopt``). Like
+  with a CHOLMOD factor (:mod:`.ipm`; SciPy's SuperLU without ``cvxopt``), on
+  the LP or on second-order cones (la in 3D, Coulomb's cone). Like
   Clarabel it converges to the interior of the optimal face (tied mechanisms
   come out as their mean). Problems without a finite optimum, and any failure
   to converge, are handed to Clarabel, whose infeasibility certificates give
@@ -73,21 +74,24 @@ def solve_lp(backend: str, cost, constraints, live, tolerance: float) -> LPSolut
     )
 
 
-def solve_ipm(cost, constraints, live, tolerance) -> LPSolution:
-    """:func:`.ipm.solve`; when it cannot certify an optimum, Clarabel (the status names the reason)."""
+def solve_ipm(cost, constraints, live, tolerance, second_order: int = 0, progress=None) -> LPSolution:
+    """:func:`.ipm.solve` (``second_order`` as :func:`solve_clarabel`'s; ``progress(iteration, error)``); when it
+    cannot certify an optimum, Clarabel (the status names the reason)."""
     from . import ipm
 
+    acceptable = ipm.CONE_ACCEPTABLE * tolerance if second_order else None
     try:
-        sol = ipm.solve(cost, constraints, live, tolerance)
+        sol = ipm.solve(cost, constraints, live, tolerance, cone_size=max(second_order, 1), progress=progress,
+                        acceptable=acceptable)
     except ipm.IPMFailure as failure:
-        fallback = solve_clarabel(cost, constraints, live, tolerance)
+        fallback = solve_clarabel(cost, constraints, live, tolerance, second_order)
         return replace(fallback, status=f"{fallback.status} (ipm fell back to clarabel: {failure})")
     return LPSolution(
         x=sol.x,
         y=sol.y,
         alpha_primal=float(np.asarray(cost) @ sol.x),
         alpha_dual=sol.lam,
-        status="optimal",
+        status="optimal" if sol.error < tolerance else f"almost optimal (stalled at {sol.error:.1e})",
         iterations=sol.iterations,
     )
 

@@ -8,7 +8,8 @@ a regular pyramid of ``sides`` directions ``e_j = cos(2 pi j / sides) t0 + sin(2
 
     (n - mu e_j) . v >= 0        j = 0 .. sides - 1
 
-or, with ``sides = 0``, Coulomb's cone itself, ``(n.v, mu t0.v, mu t1.v)`` in the second-order cone (Clarabel).
+or, with ``sides = 0``, Coulomb's cone itself, ``(n.v, mu t0.v, mu t1.v)`` in the second-order cone (our interior
+point, :mod:`.ipm`, or Clarabel).
 Its dual (the static side) puts at each vertex the force ``sum_j y_j (n - mu e_j)`` on side 1, ``y >= 0``:
 a normal force ``N = sum y`` and a friction force inside the regular polygon inscribed in Coulomb's circle of
 radius ``mu N`` (exact in the pyramid's directions, ``cos(pi / sides)`` of it half-way between them; the first
@@ -35,8 +36,11 @@ import masonryfw.plugin_api as mfp
 from . import backends
 from .options import DEFAULT_BACKEND
 
+#: The backends that solve Coulomb's cone (a second-order cone programme).
+CONE_BACKENDS = ("ipm", "clarabel")
+
 #: Coulomb's cone itself unless a caller asks for a pyramid: on the bundled house the 8-sided pyramid is 4.2 %
-#: below the cone and takes 7.2 s against the cone's 4.9 s (docs/la.md, "In 3D").
+#: below the cone, and slower (docs/la.md, "In 3D").
 DEFAULT_SIDES = 0
 
 
@@ -182,9 +186,10 @@ def active_interfaces(blocks: Blocks3D, cmap: sp.csr_matrix) -> np.ndarray:
 
 
 def limit_state_3d(blocks: Blocks3D, sides: int = DEFAULT_SIDES, solver: str = "ipm",
-                   tolerance: float = 1e-9) -> LimitState3D:
+                   tolerance: float = 1e-9, progress=None) -> LimitState3D:
     """The collapse multiplier, mechanism and vertex forces of ``blocks`` (module docstring): a pyramid of
-    ``sides`` sides, or Coulomb's cone with ``sides = 0`` (Clarabel, whatever ``solver``).
+    ``sides`` sides, or Coulomb's cone with ``sides = 0`` (``solver`` ipm or clarabel). ``progress(iteration,
+    error)``: the interior point's.
 
     Raises :class:`~.backends.LiveLoadUnbounded` when no mechanism lets the live load work and
     :class:`~.backends.DeadLoadNotCarried` when the dead load alone is not carried.
@@ -205,7 +210,9 @@ def limit_state_3d(blocks: Blocks3D, sides: int = DEFAULT_SIDES, solver: str = "
     if not np.any(np.abs(live) > 1e-12 * max(1.0, np.abs(cost).max(initial=0.0))):
         raise mf.SolveError("no live load: the multiplier is undefined (the live load is zero on every component "
                             "of motion that is not held)")
-    if sides == 0:
+    if solver == "ipm":
+        sol = backends.solve_ipm(cost, constraints, live, tolerance, second_order=3 * (sides == 0), progress=progress)
+    elif sides == 0:
         sol = backends.solve_clarabel(cost, constraints, live, tolerance, second_order=3)
     else:
         sol = backends.solve_lp(solver, cost, constraints, live, tolerance)
@@ -214,6 +221,21 @@ def limit_state_3d(blocks: Blocks3D, sides: int = DEFAULT_SIDES, solver: str = "
     y[active_rows] = sol.y
     point_force = np.einsum("pj,pjd->pd", y.reshape(-1, per_point), axis) * scales.force
     return LimitState3D(float(sol.alpha_primal), motion, point_force, active, sol)
+
+
+def iteration_progress(progress, friction: str, tolerance: float):
+    """The interior point's ``(iteration, error)`` as progress from 0.2 to 0.95, by the error's decades from the
+    first iterate's to the tolerance."""
+    first: list[float] = []
+
+    def report(iteration: int, error: float) -> None:
+        first.append(error) if not first else None
+        decades = np.log10(max(first[0], tolerance) / tolerance)
+        done = np.log10(max(first[0], error) / max(error, tolerance)) / decades if decades > 0 else 1.0
+        progress(0.2 + 0.75 * min(1.0, done), f"la: {friction}, interior point iteration {iteration}, "
+                                              f"error {error:.1e}")
+
+    return report
 
 
 def support_wrenches(blocks: Blocks3D, state: LimitState3D) -> np.ndarray:
@@ -240,12 +262,14 @@ def solve(model: xr.Dataset, options: Mapping[str, Any], progress=mfp.no_progres
     progress(0.0, "la: assembling the 3D programme")
     blocks = blocks_of(model)
     sides = int(options["pyramid_sides"])
-    if sides == 0 and options["solver"] not in (None, "clarabel"):
-        raise mf.SolveError(f"la in 3D: Coulomb's cone is a second-order cone programme, which clarabel solves "
-                            f"(solver = {options['solver']} solves LPs: a pyramid, pyramid_sides = 8 or more)")
-    backend = "clarabel" if sides == 0 else options["solver"] or DEFAULT_BACKEND
-    progress(0.2, f"la: solving in 3D ({'the cone' if sides == 0 else f'a pyramid of {sides} sides'})")
-    state = limit_state_3d(blocks, sides, backend, options["tolerance"])
+    if sides == 0 and options["solver"] not in (None, *CONE_BACKENDS):
+        raise mf.SolveError(f"la in 3D: Coulomb's cone is a second-order cone programme, which ipm and clarabel "
+                            f"solve (solver = {options['solver']} solves LPs: a pyramid, pyramid_sides = 8 or more)")
+    backend = options["solver"] or DEFAULT_BACKEND
+    friction = "the cone" if sides == 0 else f"a pyramid of {sides} sides"
+    progress(0.2, f"la: solving in 3D ({friction}, {backend})")
+    state = limit_state_3d(blocks, sides, backend, options["tolerance"],
+                           iteration_progress(progress, friction, options["tolerance"]))
     axis = ("block", "axis")
     data = {
         "collapse_multiplier": ((), state.alpha, mfp.variable_attrs("collapse_multiplier", "result3d")),

@@ -259,7 +259,7 @@ def test_build_check_info_and_datasets_on_a_bundled_case(in_tmp):
     assert spec.read_bytes() == mf.bundled_spec_path("test-12c").read_bytes()
     assert invoke("check", "t12.nc").stdout.startswith("OK: 74 blocks, ")
     listing = invoke("datasets").stdout.splitlines()
-    assert len(listing) == len(mf.BUNDLED_NAMES) == 20
+    assert len(listing) == len(mf.BUNDLED_NAMES) == 22
     assert any(line.split()[:3] == ["test-12c", "Test", "12C"] and line.endswith(" 74 blocks") for line in listing)
     out = invoke("info", "t12.nc").stdout
     assert "blocks: 74 (unit 72, lintel 0, fixed support 1, moving support 1)" in out

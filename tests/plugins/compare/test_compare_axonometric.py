@@ -194,7 +194,7 @@ def test_the_report_of_two_3d_results(corner, tmp_path):
     text = report_html(paths, "masonryfw report cone.nc pyramid.nc")
     assert "<h2>The building</h2>" in text and text.count("<img ") == 6  # the building; each mechanism and cracks; both
     assert '<pre class="walls">' not in text  # a trough without a target settlement: no stages to assess
-    assert "A: la (cone, clarabel)" in text and "B: la (pyramid of 8 sides, ipm)" in text
+    assert "A: la (cone, ipm)" in text and "B: la (pyramid of 8 sides, ipm)" in text
     assert "<h2>Agreement</h2>" in text and 'id="agreement"' in text
 
 

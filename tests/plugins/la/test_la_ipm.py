@@ -8,7 +8,7 @@ import pytest
 
 import masonryfw as mf
 import masonryfw.plugin_api as mfp
-from masonryfw_la import backends, ipm
+from masonryfw_la import backends, cones, ipm
 
 ROLE = mfp.flags("block_role")
 
@@ -143,7 +143,7 @@ def test_la_ipm_eliminated_slip_columns_solve_the_whole_normal_matrix(nonassocia
     rhs = rng.standard_normal(lp.constraints.shape[1])
     for span, within in ((3, 1e-8), (10, None)):
         d = 10.0 ** rng.uniform(-span, span, lp.constraints.shape[0])
-        normal.factorise(d)
+        normal.factorise(cones.OrthantScaling(np.ones_like(d), d, np.zeros_like(d)))  # D = y / s = d
         whole = (lp.constraints.T @ sp.diags(d) @ lp.constraints).tocsc()
         solved = normal.solve(rhs)
         if within is not None:

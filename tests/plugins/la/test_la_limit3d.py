@@ -192,8 +192,8 @@ def test_joints_with_cohesion_and_too_few_sides_are_refused(walls):
 
 def test_the_backend_a_3d_result_names_is_the_one_that_ran():
     """The report's provenance named one backend while its title named another (``"solver": "ipm"`` under "la
-    (cone, clarabel)"): the option is automatic, the cone's backend clarabel, and asking the cone of another is
-    refused; a pyramid runs on the backend asked."""
+    (cone, clarabel)"): the option is automatic, the cone's backend our interior point (or clarabel when asked),
+    and asking the cone of an LP backend is refused; a pyramid runs on the backend asked."""
     import json
 
     from masonryfw.testing import corner_building
@@ -201,9 +201,11 @@ def test_the_backend_a_3d_result_names_is_the_one_that_ran():
     model = corner_building()
     cone = mf.solve(model, "la")
     assert json.loads(cone.attrs["solver_options"])["solver"] is None
-    assert cone.attrs["method"] == "cone, clarabel" and cone.attrs["la_backend"] == "clarabel"
-    assert mf.result_label(cone) == "la (cone, clarabel)"
-    with pytest.raises(mf.SolveError, match="cone is a second-order cone programme, which clarabel solves"):
+    assert cone.attrs["method"] == "cone, ipm" and cone.attrs["la_backend"] == "ipm"
+    assert mf.result_label(cone) == "la (cone, ipm)"
+    checked = mf.solve(model, "la", {"solver": "clarabel"})
+    assert checked.attrs["la_backend"] == "clarabel" and mf.result_label(checked) == "la (cone, clarabel)"
+    with pytest.raises(mf.SolveError, match="cone is a second-order cone programme, which ipm and clarabel solve"):
         mf.solve(model, "la", {"solver": "highs"})
     pyramid = mf.solve(model, "la", {"pyramid_sides": 8, "solver": "highs"})
     assert pyramid.attrs["la_backend"] == "highs" and mf.result_label(pyramid) == "la (pyramid of 8 sides, highs)"

@@ -1,0 +1,251 @@
+"""The cones of the interior point (:mod:`.ipm`): the non-negative orthant (an LP) and 3-dimensional second-order
+cones (Coulomb's).
+
+The interior point works in the scaled space of Nesterov and Todd: for ``s`` and ``y`` inside the cone a scaling
+``W`` with ``W^-1 s = W y = lambda``. The Newton step's complementarity ``lambda o (W^-1 ds + W dy) = rc``
+(``o`` the cone's Jordan product) eliminates ``ds`` and ``dy``, and the normal matrix is ``G^T W^-2 G``: for
+the orthant ``W^-2 = diag(y / s)``, for second-order cones of dimension ``k`` a symmetric ``k x k`` block per
+cone, so the normal matrix keeps the sparsity of ``G^T G`` over each cone's rows (its ``k`` rows are one contact
+point's: they touch the same blocks). Formulas: Vandenberghe, "The CVXOPT linear and quadratic cone program
+solvers" (2010), sections 3-4.
+
+Every method is vectorised over the cones, column by column (numpy's einsum and batched matmul are several times
+slower on 3 x 3 blocks); vectors are stacked cone after cone (``k`` entries each).
+"""
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+
+HALF_ROOT = np.sqrt(0.5)
+
+
+class OrthantScaling(NamedTuple):
+    """``W = diag(sqrt(s / y))``: ``lambda = sqrt(s y)``; with ``weight`` (a regularised programme) the normal
+    weight is ``y / (s + w y)``."""
+
+    s: np.ndarray
+    y: np.ndarray
+    weight: np.ndarray
+
+    @property
+    def normal_weights(self) -> np.ndarray:
+        """The weights the normal matrix is formed with: ``W^-2`` (one per row)."""
+        return self.y / (self.s + self.weight * self.y)
+
+    def times_normal_weights(self, v: np.ndarray) -> np.ndarray:
+        return self.normal_weights * v
+
+    def times_normal_weights_inverse(self, v: np.ndarray) -> np.ndarray:
+        return (self.s / self.y + self.weight) * v
+
+    def target_rhs(self, rc: np.ndarray) -> np.ndarray:
+        """``W (lambda \\ rc)``: the primal rows' share of the complementarity ``rc`` (``rc / y``)."""
+        return rc / self.y
+
+    def scaled_product(self, ds: np.ndarray, dy: np.ndarray) -> np.ndarray:
+        """``(W^-1 ds) o (W dy)``: Mehrotra's second-order term."""
+        return ds * dy
+
+
+class Orthant:
+    """The non-negative orthant of ``m`` rows (an LP)."""
+
+    size = 1
+
+    def __init__(self, rows: int):
+        self.degree = rows
+
+    @staticmethod
+    def identity(v: np.ndarray) -> np.ndarray:
+        return np.ones_like(v)
+
+    @staticmethod
+    def product(u: np.ndarray, v: np.ndarray) -> np.ndarray:
+        return u * v
+
+    @staticmethod
+    def smallest_eigenvalue(v: np.ndarray) -> float:
+        return float(v.min(initial=np.inf))
+
+    @staticmethod
+    def identity_weight(v: np.ndarray) -> float:
+        """``e . v``."""
+        return float(v.sum())
+
+    @staticmethod
+    def max_step(v: np.ndarray, dv: np.ndarray) -> float:
+        """Largest ``t <= 1`` with ``v + t dv >= 0`` (``v > 0``)."""
+        fastest = (dv / v).min(initial=0.0)
+        return 1.0 if fastest >= -1.0 else -1.0 / fastest
+
+    @staticmethod
+    def scaling(s: np.ndarray, y: np.ndarray, weight: np.ndarray) -> OrthantScaling:
+        return OrthantScaling(s, y, weight)
+
+    @staticmethod
+    def trial_product(scaling, s, ds, y, dy, primal: float, dual: float) -> np.ndarray:
+        """The complementarity products after steps ``primal`` and ``dual``."""
+        return (s + primal * ds) * (y + dual * dy)
+
+    @staticmethod
+    def centring(product: np.ndarray, target: float) -> np.ndarray:
+        """Gondzio's correction: what brings each product into ``[0.1, 10] x target``."""
+        return gondzio(product, target)
+
+
+def gondzio(values: np.ndarray, target: float) -> np.ndarray:
+    """What moves each of ``values`` into ``[0.1, 10] x target`` (down by at most ``10 x target``)."""
+    return np.clip(0.1 * target - values, 0.0, None) + np.clip(10.0 * target - values, -10.0 * target, 0.0)
+
+
+class LorentzScaling(NamedTuple):
+    """The Nesterov-Todd scaling of 3-dimensional second-order cones, ``W = eta (2 v v^T - J)`` per cone (``J =
+    diag(1, -1, -1)``, ``v^T J v = 1``), kept as its eigen-decomposition ``W^-1 = U diag(sigma) U^T``: the
+    eigenvectors ``u0, u1 = (1, -+d) / sqrt(2)`` and ``u2 = (0, d')`` (``d`` the unit direction of ``v1``, ``d'``
+    it turned by 90 degrees) with ``sigma = (v0 + |v1|)^2 / eta``, ``(v0 - |v1|)^2 / eta`` (``v0 - |v1| = 1 /
+    (v0 + |v1|)``, no cancellation) and ``1 / eta``. The normal matrix is formed from the rows ``diag(sigma) U^T
+    G`` of each cone, a sum of positive rank-one terms as an LP's ``d g g^T``: the entries of ``W^-2`` itself span
+    ``sigma``'s range squared and, formed first, would lose its small directions."""
+
+    direction: np.ndarray  # (cone, 2) d
+    sigma: np.ndarray  # (cone, 3) eigenvalues of W^-1
+    lam: np.ndarray  # (cone, 3) W y = W^-1 s
+
+    def eigen_coordinates(self, v: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``U^T v`` per cone, as three columns."""
+        v = v.reshape(-1, 3)
+        along = self.direction[:, 0] * v[:, 1] + self.direction[:, 1] * v[:, 2]
+        across = self.direction[:, 0] * v[:, 2] - self.direction[:, 1] * v[:, 1]
+        return HALF_ROOT * (v[:, 0] - along), HALF_ROOT * (v[:, 0] + along), across
+
+    def times(self, power: int, v: np.ndarray) -> np.ndarray:
+        """``W^-power v`` (``power`` = 1, -1, 2, -2)."""
+        c0, c1, c2 = (c * self.sigma[:, i] ** power for i, c in enumerate(self.eigen_coordinates(v)))
+        mean, half = HALF_ROOT * (c0 + c1), HALF_ROOT * (c1 - c0)
+        d = self.direction
+        return np.c_[mean, d[:, 0] * half - d[:, 1] * c2, d[:, 1] * half + d[:, 0] * c2].ravel()
+
+    @property
+    def normal_rows(self) -> np.ndarray:
+        """(cone, 3, 3): ``diag(sigma) U^T``, whose rows times ``G``'s are the normal matrix's (``M = sum r r^T``)."""
+        d0, d1 = self.direction[:, 0], self.direction[:, 1]
+        zero = np.zeros_like(d0)
+        rows = np.stack([np.c_[np.full_like(d0, HALF_ROOT), -HALF_ROOT * d0, -HALF_ROOT * d1],
+                         np.c_[np.full_like(d0, HALF_ROOT), HALF_ROOT * d0, HALF_ROOT * d1],
+                         np.c_[zero, -d1, d0]], axis=1)
+        return self.sigma[:, :, None] * rows
+
+    def times_normal_weights(self, v: np.ndarray) -> np.ndarray:
+        return self.times(2, v)
+
+    def times_normal_weights_inverse(self, v: np.ndarray) -> np.ndarray:
+        return self.times(-2, v)
+
+    def target_rhs(self, rc: np.ndarray) -> np.ndarray:
+        """``W (lambda \\ rc)``."""
+        return self.times(-1, arrow_solve(self.lam, rc.reshape(-1, 3)).ravel())
+
+    def scaled_product(self, ds: np.ndarray, dy: np.ndarray) -> np.ndarray:
+        """``(W^-1 ds) o (W dy)``."""
+        return jordan(self.times(1, ds).reshape(-1, 3), self.times(-1, dy).reshape(-1, 3))
+
+
+def dots(u: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """``u_c . v_c`` per cone (rows of ``u`` and ``v``), column by column."""
+    out = u[:, 0] * v[:, 0]
+    for a in range(1, u.shape[1]):
+        out += u[:, a] * v[:, a]
+    return out
+
+
+def jordan(u: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """``u o v = (u . v, u0 v1 + v0 u1)`` per cone, stacked."""
+    head = dots(u, v)
+    return np.concatenate([head[:, None], u[:, :1] * v[:, 1:] + v[:, :1] * u[:, 1:]], axis=1).ravel()
+
+
+def arrow_solve(lam: np.ndarray, r: np.ndarray) -> np.ndarray:
+    """``x`` with ``lam o x = r`` per cone (``lam`` inside the cone)."""
+    head = (lam[:, 0] * r[:, 0] - dots(lam[:, 1:], r[:, 1:])) / lorentz_norm2(lam)
+    return np.concatenate([head[:, None], (r[:, 1:] - head[:, None] * lam[:, 1:]) / lam[:, :1]], axis=1)
+
+
+def lorentz_norm2(v: np.ndarray) -> np.ndarray:
+    """``v^T J v = v0^2 - |v1|^2`` per cone, as ``(v0 - |v1|) (v0 + |v1|)`` (no cancellation near the boundary)."""
+    tail = np.sqrt(dots(v[:, 1:], v[:, 1:]))
+    return (v[:, 0] - tail) * (v[:, 0] + tail)
+
+
+class SecondOrderCones:
+    """``count`` second-order cones of dimension 3 (Coulomb's: ``v0 >= |(v1, v2)|``)."""
+
+    size = 3
+
+    def __init__(self, count: int):
+        self.degree = count
+
+    def identity(self, v: np.ndarray) -> np.ndarray:
+        e = np.zeros((v.size // self.size, self.size))
+        e[:, 0] = 1.0
+        return e.ravel()
+
+    def product(self, u: np.ndarray, v: np.ndarray) -> np.ndarray:
+        return jordan(u.reshape(-1, self.size), v.reshape(-1, self.size))
+
+    def trial_product(self, scaling: LorentzScaling, s, ds, y, dy, primal: float, dual: float) -> np.ndarray:
+        """The scaled complementarity ``(lambda + primal W^-1 ds) o (lambda + dual W dy)`` after the steps."""
+        lam = scaling.lam.ravel()
+        return self.product(lam + primal * scaling.times(1, ds), lam + dual * scaling.times(-1, dy))
+
+    def centring(self, product: np.ndarray, target: float) -> np.ndarray:
+        """Gondzio's correction on each cone's spectral values ``p0 -+ |p1|`` (frames ``(1, -+p1 / |p1|) / 2``):
+        what brings them into ``[0.1, 10] x target``."""
+        p = product.reshape(-1, self.size)
+        norm = np.sqrt(dots(p[:, 1:], p[:, 1:]))
+        low, high = p[:, 0] - norm, p[:, 0] + norm
+        shift_low, shift_high = gondzio(low, target), gondzio(high, target)
+        unit = p[:, 1:] / np.where(norm > 0.0, norm, 1.0)[:, None]
+        return np.c_[0.5 * (shift_low + shift_high), 0.5 * (shift_high - shift_low)[:, None] * unit].ravel()
+
+    def smallest_eigenvalue(self, v: np.ndarray) -> float:
+        v = v.reshape(-1, self.size)
+        return float((v[:, 0] - np.sqrt(dots(v[:, 1:], v[:, 1:]))).min(initial=np.inf))
+
+    def identity_weight(self, v: np.ndarray) -> float:
+        return float(v.reshape(-1, self.size)[:, 0].sum())
+
+    def max_step(self, v: np.ndarray, dv: np.ndarray) -> float:
+        """Largest ``t <= 1`` keeping ``v + t dv`` in every cone (``v`` inside): the smallest positive root of
+        ``(v0 + t d0)^2 - |v1 + t d1|^2``, ``a t^2 + 2 b t + c`` with ``c > 0``."""
+        v, d = v.reshape(-1, self.size), dv.reshape(-1, self.size)
+        a = d[:, 0] ** 2 - dots(d[:, 1:], d[:, 1:])
+        b = v[:, 0] * d[:, 0] - dots(v[:, 1:], d[:, 1:])
+        c = lorentz_norm2(v)
+        disc = b * b - a * c
+        real = disc >= 0.0
+        root = np.sqrt(np.where(real, disc, 0.0))
+        q = -(b + np.where(b >= 0.0, root, -root))  # the larger root in magnitude, without cancellation
+        with np.errstate(divide="ignore", invalid="ignore"):
+            roots = np.stack([np.where(a != 0.0, q / a, np.inf), np.where(q != 0.0, c / q, np.inf)])
+        roots = np.where(real & (roots > 0.0), roots, np.inf)
+        # a linear f (a = 0) has its root at -c / 2b, which c / q gives (q = -2b)
+        return float(min(1.0, roots.min(initial=np.inf)))
+
+    def scaling(self, s: np.ndarray, y: np.ndarray, weight: np.ndarray | None = None) -> LorentzScaling:
+        s, y = s.reshape(-1, 3), y.reshape(-1, 3)
+        ns, ny = np.sqrt(lorentz_norm2(s)), np.sqrt(lorentz_norm2(y))
+        sbar, ybar = s / ns[:, None], y / ny[:, None]
+        gamma = np.sqrt(0.5 * (1.0 + dots(sbar, ybar)))
+        wbar = (sbar + ybar * np.array([1.0, -1.0, -1.0])) / (2.0 * gamma[:, None])  # W^2 = eta^2 (2 wbar wbar^T - J)
+        v = wbar + np.array([1.0, 0.0, 0.0])
+        v /= np.sqrt(2.0 * v[:, :1])  # (wbar + e) / sqrt(2 (wbar0 + 1))
+        eta = np.sqrt(ns / ny)
+        tail = np.sqrt(dots(v[:, 1:], v[:, 1:]))
+        direction = np.where(tail[:, None] > 0.0, v[:, 1:] / np.where(tail > 0.0, tail, 1.0)[:, None],
+                             np.array([1.0, 0.0]))  # v1 / |v1|, any unit vector when v1 = 0
+        big = (v[:, 0] + tail) ** 2
+        sigma = np.c_[big, 1.0 / big, np.ones_like(big)] / eta[:, None]
+        scaling = LorentzScaling(direction, sigma, np.zeros_like(s))
+        return scaling._replace(lam=scaling.times(-1, y.ravel()).reshape(-1, 3))
