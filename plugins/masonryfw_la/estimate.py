@@ -17,13 +17,14 @@ import masonryfw.plugin_api as mfp
 SECONDS_AT_10K_BLOCKS = 5.9
 TIME_EXPONENT = 1.4
 NONASSOCIATIVE_FACTOR = 45.0
-#: 3D models (Coulomb's cone by Clarabel): the bundled house in units of 1, 1/2 and 1/3 of its own (docs/la.md,
-#: "In 3D", 2026-11-28, quiet): 1,126 / 4,390 / 9,663 blocks solved in 2.4 / 24.4 / about 195 s, peak memory of the
-#: whole process 0.18 / 0.40 / 0.78 GiB: time through the ends as blocks^2.04 (1.6 times the middle one), memory
-#: linear.
-SECONDS_3D_AT_1126_BLOCKS = 2.4
-TIME_EXPONENT_3D = 2.04
-MEMORY_PER_BLOCK_3D = 80e3  # bytes
+#: 3D models (Coulomb's cone by our interior point), fitted by the cones' points (interface vertices) to the
+#: whole-process runs of docs/benchmarks.md, "la in 3D at scale" (2026-12-07, quiet): the house in units of 1, 1/2
+#: and 1/3, the brick house and the brick terrace, 12,408 to 649,828 points, 2.3 to 281 s and 0.19 to 2.96 GiB,
+#: every one within 11 % of the fit (by the blocks no power law came within 40 %: a brick has more vertices).
+STARTUP_3D_SECONDS = 1.5
+SECONDS_3D_AT_100K_POINTS = 17.6
+TIME_EXPONENT_3D = 1.5
+MEMORY_PER_POINT_3D = 4.7e3  # bytes
 BASE_MEMORY = 160 * 2**20  # the interpreter, numpy, scipy, xarray, cvxopt
 MEMORY_PER_BLOCK = 25e3  # bytes
 
@@ -31,10 +32,12 @@ MEMORY_PER_BLOCK = 25e3  # bytes
 def estimate(model: xr.Dataset, options: Mapping[str, Any]) -> mfp.Estimate:
     blocks = model.sizes["block"]
     if mfp.space(model) == 3:
-        return mfp.Estimate(seconds=SECONDS_3D_AT_1126_BLOCKS * (blocks / 1126) ** TIME_EXPONENT_3D,
-                            memory=BASE_MEMORY + MEMORY_PER_BLOCK_3D * blocks,
-                            basis=f"{blocks:,} blocks in 3D, as fitted on the bundled house on the 2-core machine of "
-                                  "docs/la.md (the cone; a pyramid of many sides takes longer)")
+        points = model.sizes["interface_node"]
+        return mfp.Estimate(seconds=STARTUP_3D_SECONDS + SECONDS_3D_AT_100K_POINTS * (points / 1e5) ** TIME_EXPONENT_3D,
+                            memory=BASE_MEMORY + MEMORY_PER_POINT_3D * points,
+                            basis=f"{blocks:,} blocks with {points:,} interface vertices in 3D, as fitted on the "
+                                  "buildings of docs/benchmarks.md on its 2-core machine (the cone; a pyramid of many "
+                                  "sides takes longer)")
     seconds = SECONDS_AT_10K_BLOCKS * (blocks / 10_000) ** TIME_EXPONENT
     if options["flow"] == "nonassociative":
         seconds *= NONASSOCIATIVE_FACTOR
