@@ -48,6 +48,14 @@ class OrthantScaling(NamedTuple):
         """``(W^-1 ds) o (W dy)``: Mehrotra's second-order term."""
         return ds * dy
 
+    def lam_squared(self) -> np.ndarray:
+        """``lambda o lambda = s y``."""
+        return self.s * self.y
+
+    def primal_shift(self, dy: np.ndarray) -> np.ndarray:
+        """``ds - G dx - rp``: ``w dy`` (a regularised programme's ``y`` is in its primal rows)."""
+        return self.weight * dy
+
 
 class Orthant:
     """The non-negative orthant of ``m`` rows (an LP)."""
@@ -60,10 +68,6 @@ class Orthant:
     @staticmethod
     def identity(v: np.ndarray) -> np.ndarray:
         return np.ones_like(v)
-
-    @staticmethod
-    def product(u: np.ndarray, v: np.ndarray) -> np.ndarray:
-        return u * v
 
     @staticmethod
     def smallest_eigenvalue(v: np.ndarray) -> float:
@@ -150,6 +154,15 @@ class LorentzScaling(NamedTuple):
     def scaled_product(self, ds: np.ndarray, dy: np.ndarray) -> np.ndarray:
         """``(W^-1 ds) o (W dy)``."""
         return jordan(self.times(1, ds).reshape(-1, 3), self.times(-1, dy).reshape(-1, 3))
+
+    def lam_squared(self) -> np.ndarray:
+        """``lambda o lambda``."""
+        return jordan(self.lam, self.lam)
+
+    @staticmethod
+    def primal_shift(dy: np.ndarray) -> float:
+        """``ds - G dx - rp``: nothing (no regularised programme on cones)."""
+        return 0.0
 
 
 def dots(u: np.ndarray, v: np.ndarray) -> np.ndarray:

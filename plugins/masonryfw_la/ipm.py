@@ -282,14 +282,9 @@ class NewtonSystem:
         g_dx = G @ dx
         return dx, weights(f1 - g_dx), dlam, g_dx
 
-    def _primal_shift(self, dy: np.ndarray) -> np.ndarray:
-        """``ds - G dx - rp``: ``w dy`` of a regularised LP, else 0."""
-        weight = getattr(self.scaling, "weight", None)
-        return 0.0 * dy if weight is None else weight * dy
-
     def direction(self, rc: np.ndarray) -> Direction:
         dx, dy, dlam, g_dx = self._through_factor(self.scaling.target_rhs(rc) - self.rp, self.rd, -self.ra)
-        return Direction(dx, dy, dlam, g_dx + self._primal_shift(dy) + self.rp)
+        return Direction(dx, dy, dlam, g_dx + self.scaling.primal_shift(dy) + self.rp)
 
     def refine(self, step: Direction, rc: np.ndarray, dual_target: float) -> Direction:
         """Iterative refinement on the unreduced equations until the dual equation holds to ``dual_target``.
@@ -301,7 +296,7 @@ class NewtonSystem:
         Gt, a = self.normal.Gt, self.a
         f1 = self.scaling.target_rhs(rc) - self.rp
         dx, dy, dlam = step.dx, step.dy, step.dlam
-        g_dx = step.ds - self.rp - self._primal_shift(dy)
+        g_dx = step.ds - self.rp - self.scaling.primal_shift(dy)
         previous = np.inf
         for _ in range(REFINEMENT_STEPS):
             r2 = self.rd - Gt @ dy - a * dlam
@@ -312,7 +307,7 @@ class NewtonSystem:
             r1 = f1 - g_dx - self.scaling.times_normal_weights_inverse(dy)
             ex, ey, el, g_ex = self._through_factor(r1, r2, -self.ra - dot(a, dx))
             dx, dy, dlam, g_dx = dx + ex, dy + ey, dlam + el, g_dx + g_ex
-        return Direction(dx, dy, dlam, g_dx + self._primal_shift(dy) + self.rp)
+        return Direction(dx, dy, dlam, g_dx + self.scaling.primal_shift(dy) + self.rp)
 
 
 def cones_of(rows: int, cone_size: int):
@@ -329,7 +324,7 @@ def solve(cost, constraints, live, tolerance: float, weight: np.ndarray | None =
           progress=None) -> IPMResult:
     """Solve ``min c.x, G x in K, a.x = 1`` to ``tolerance`` (relative residuals and gap) or raise IPMFailure.
 
-    ``K`` is the orthant (an LP: ``G x >= 0``) or, with ``cone_size = k > 1``, second-order cones of ``k`` rows.
+    ``K`` is the orthant (an LP: ``G x >= 0``) or, with ``cone_size = 3``, second-order cones of three rows.
     With ``weight`` (``w >= 0``, one per row; LPs only) the static side becomes ``max lam - sum(w y^2) / 2``:
     the programme regularised by a quadratic in the multipliers, whose primal constraint is
     ``G x + w y >= 0``. The Newton steps keep their form, with ``D = y / (s + w y)``.
@@ -386,7 +381,7 @@ def solve(cost, constraints, live, tolerance: float, weight: np.ndarray | None =
         scaling = cones.scaling(s, y, w)
         newton = NewtonSystem(normal, scaling, a, rp, ra, rd)
         # Mehrotra: the affine-scaling predictor sets the centring and the second-order term
-        squared = cones.product(s, y) if orthant else cones.product(scaling.lam.ravel(), scaling.lam.ravel())
+        squared = scaling.lam_squared()
         affine = newton.direction(-squared)
         step_p, step_d = affine.steps(cones, s, y, together=not orthant)
         mu_affine = dot(s + step_p * affine.ds, y + step_d * affine.dy) / cones.degree

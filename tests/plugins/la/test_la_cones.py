@@ -63,7 +63,7 @@ def test_the_nesterov_todd_scaling_maps_s_and_y_to_one_point(margin):
     assert np.allclose(np.einsum("cab,bd,cde->cae", w, j, w), eta2[:, None, None] * j, rtol=1e-8,
                        atol=1e-10 * eta2.max())
     assert soc.smallest_eigenvalue(lam) > 0.0
-    assert np.allclose(soc.product(lam, lam), scaling.scaled_product(s, y))  # lambda o lambda = (W^-1 s) o (W y)
+    assert np.allclose(scaling.lam_squared(), scaling.scaled_product(s, y))  # lambda o lambda = (W^-1 s) o (W y)
 
 
 def test_the_arrow_solve_inverts_the_jordan_product():
