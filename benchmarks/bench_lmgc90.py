@@ -1,7 +1,7 @@
 """fdem-3D and la-3D against LMGC90 (a second physics: non-smooth contact dynamics of rigid polyhedra, Coulomb
 friction without dilatancy, through ``compas_lmgc90`` on PyPI) on the corner building of ``masonryfw.testing``
 (two walls toothed at a corner, a door, 134 blocks over a Gaussian trough) to 10 mm, or with ``--model WALL`` on
-a bundled wall's 3D twin (``mfp.twin``) to ``--settlement``: the settlement reaction against the settlement, its
+a bundled 3D model or a bundled wall's 3D twin (``mfp.twin``) to ``--settlement``: the settlement reaction against the settlement, its
 minimum, the walls' final widest cracks (fdem), which blocks follow the ground.
 
 LMGC90 runs in its own environment (it pulls compas_viewer and Qt): ``--lmgc-python`` names that Python, e.g.
@@ -55,7 +55,8 @@ def main() -> None:
     parser.add_argument("--lmgc-python", required=True, help="the Python that has compas_lmgc90")
     parser.add_argument("--times", type=float, nargs="+", default=[2.0, 4.0],
                         help="LMGC90's time to reach the settlement [s] (each a run)")
-    parser.add_argument("--model", default="corner", help="corner (the kit's corner building) or a bundled wall")
+    parser.add_argument("--model", default="corner",
+                        help="corner (the kit's corner building), a bundled 3D model or a bundled wall (its twin)")
     parser.add_argument("--fdem", action="append", default=None,
                         help="fdem's options for one run, KEY=VALUE[;KEY=VALUE] (repeatable; an empty string: the "
                              "defaults; default: the defaults and the contacts half as stiff, as the old default)")
@@ -63,7 +64,8 @@ def main() -> None:
     args = parser.parse_args()
     args.fdem = args.fdem if args.fdem is not None else ["", "penetration_ratio=1e-4;rotational_inertia=physical"]
     settlement = args.settlement
-    model = mt.corner_building() if args.model == "corner" else mf.checked_model(mfp.twin(mf.open_model(args.model)))
+    model = mt.corner_building() if args.model == "corner" else mf.open_model(args.model)
+    model = model if mfp.space(model) == 3 else mf.checked_model(mfp.twin(model))
     masonry = mfp.masonry_blocks(model.block_role.values)
     with tempfile.TemporaryDirectory() as folder:
         spec = Path(folder) / "model.json"
@@ -81,8 +83,10 @@ def main() -> None:
         fdem[variant or "defaults"] = (mf.solve(model, "fdem", {"settlement": repr(settlement), **options}),
                                        time.perf_counter() - start)
     la = mf.solve(model, "la")
+    la_non = mf.solve(model, "la", {"flow": "nonassociative"})
     r0 = float({n.name: n.value for n in mf.key_numbers(next(iter(fdem.values()))[0])}["dead_reaction"])
     collapse = float({n.name: n.value for n in mf.key_numbers(la)}["collapse_reaction"])
+    collapse_non = float({n.name: n.value for n in mf.key_numbers(la_non)}["collapse_reaction"])
     grid = np.linspace(0.0, settlement, 41)[1:]
     later = grid >= 1e-3
     reference = np.array(lmgc[args.times[0]]["rows"])
@@ -117,8 +121,10 @@ def main() -> None:
         row(f"fdem, {variant.replace(';', ', ')} (widest cracks {widths} mm)", seconds,
             result.step_settlement.values[settling], result.step_reaction.values[settling],
             result.block_displacement.values[:, 2])
+    wanders = "" if la_non.attrs["la_flow_converged"] else f" (not converged: {la_non.attrs['stop_reason']})"
     body += ["", f"la (associative, the cone): alpha {float(la.collapse_multiplier):.4f}, collapse reaction "
-             f"(1 - alpha) R0 = {collapse / r0:.4f} of fdem's R0."]
+             f"(1 - alpha) R0 = {collapse / r0:.4f} of fdem's R0. la non-associative: alpha "
+             f"{float(la_non.collapse_multiplier):.4f}, collapse reaction {collapse_non / r0:.4f} of fdem's R0{wanders}."]
     print("\n".join(body))
     if args.model == "corner":
         write_section("lmgc90", "fdem-3D and la-3D against LMGC90 on the corner building", "\n".join(body))

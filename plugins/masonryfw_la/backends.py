@@ -74,15 +74,16 @@ def solve_lp(backend: str, cost, constraints, live, tolerance: float) -> LPSolut
     )
 
 
-def solve_ipm(cost, constraints, live, tolerance, second_order: int = 0, progress=None) -> LPSolution:
-    """:func:`.ipm.solve` (``second_order`` as :func:`solve_clarabel`'s; ``progress(iteration, error)``); when it
-    cannot certify an optimum, Clarabel (the status names the reason)."""
+def solve_ipm(cost, constraints, live, tolerance, second_order: int = 0, progress=None, normal=None) -> LPSolution:
+    """:func:`.ipm.solve` (``second_order`` as :func:`solve_clarabel`'s; ``progress(iteration, error)``; ``normal``
+    the :class:`.ipm.NormalMatrix` of ``constraints`` when the caller has it); when it cannot certify an optimum,
+    Clarabel (the status names the reason)."""
     from . import ipm
 
     acceptable = ipm.CONE_ACCEPTABLE * tolerance if second_order else None
     try:
         sol = ipm.solve(cost, constraints, live, tolerance, cone_size=max(second_order, 1), progress=progress,
-                        acceptable=acceptable)
+                        acceptable=acceptable, normal=normal)
     except ipm.IPMFailure as failure:
         fallback = solve_clarabel(cost, constraints, live, tolerance, second_order)
         return replace(fallback, status=f"{fallback.status} (ipm fell back to clarabel: {failure})")

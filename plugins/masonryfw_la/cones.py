@@ -243,15 +243,21 @@ class SecondOrderCones:
         with np.errstate(divide="ignore", invalid="ignore"):
             roots = np.stack([np.where(a != 0.0, q / a, np.inf), np.where(q != 0.0, c / q, np.inf)])
         roots = np.where(real & (roots > 0.0), roots, np.inf)
-        # a linear f (a = 0) has its root at -c / 2b, which c / q gives (q = -2b)
-        return float(min(1.0, roots.min(initial=np.inf)))
+        # a linear f (a = 0) has its root at -c / 2b, which c / q gives (q = -2b). The first component stays
+        # positive too: through the apex f is positive again, and a cone whose tail is zero (the orthant written
+        # as a cone) has a double root that rounding can make complex
+        with np.errstate(divide="ignore"):
+            apex = np.where(d[:, 0] < 0.0, -v[:, 0] / d[:, 0], np.inf)
+        return float(min(1.0, roots.min(initial=np.inf), apex.min(initial=np.inf)))
 
     def scaling(self, s: np.ndarray, y: np.ndarray, weight: np.ndarray | None = None) -> LorentzScaling:
         s, y = s.reshape(-1, 3), y.reshape(-1, 3)
-        ns, ny = np.sqrt(lorentz_norm2(s)), np.sqrt(lorentz_norm2(y))
-        sbar, ybar = s / ns[:, None], y / ny[:, None]
-        gamma = np.sqrt(0.5 * (1.0 + dots(sbar, ybar)))
-        wbar = (sbar + ybar * np.array([1.0, -1.0, -1.0])) / (2.0 * gamma[:, None])  # W^2 = eta^2 (2 wbar wbar^T - J)
+        # an iterate rounded onto a cone's boundary gives nan here, and the next iteration's error says so
+        with np.errstate(invalid="ignore", divide="ignore"):
+            ns, ny = np.sqrt(lorentz_norm2(s)), np.sqrt(lorentz_norm2(y))
+            sbar, ybar = s / ns[:, None], y / ny[:, None]
+            gamma = np.sqrt(0.5 * (1.0 + dots(sbar, ybar)))
+            wbar = (sbar + ybar * np.array([1.0, -1.0, -1.0])) / (2.0 * gamma[:, None])  # W^2 = eta^2 (2 wbar wbar^T - J)
         v = wbar + np.array([1.0, 0.0, 0.0])
         v /= np.sqrt(2.0 * v[:, :1])  # (wbar + e) / sqrt(2 (wbar0 + 1))
         eta = np.sqrt(ns / ny)

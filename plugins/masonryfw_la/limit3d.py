@@ -177,6 +177,18 @@ def relative_velocity_rows(blocks: Blocks3D, scales: Scales3D, axis: np.ndarray)
     return sp.csr_matrix((coef.ravel(), (rows.ravel(), cols.ravel())), shape=(n_point * sides, 6 * blocks.n_block))
 
 
+def programme_loads(blocks: Blocks3D, scales: Scales3D, cmap: sp.csr_matrix) -> tuple[np.ndarray, np.ndarray]:
+    """The cost (minus the dead load's work) and the live load's work per programme column; a live load that does
+    no work on any free component of motion is refused."""
+    unit = np.r_[np.ones(3), np.full(3, 1.0 / scales.block)] / scales.force  # loads per programme unit
+    cost = -(cmap.T @ (blocks.dead * unit).ravel())
+    live = cmap.T @ (blocks.live * unit).ravel()
+    if not np.any(np.abs(live) > 1e-12 * max(1.0, np.abs(cost).max(initial=0.0))):
+        raise mf.SolveError("no live load: the multiplier is undefined (the live load is zero on every component "
+                            "of motion that is not held)")
+    return cost, live
+
+
 def active_interfaces(blocks: Blocks3D, cmap: sp.csr_matrix) -> np.ndarray:
     """Interfaces that constrain the motion: not ground on ground, and at least one side with a column."""
     support = mfp.support_blocks(blocks.role)
@@ -204,12 +216,7 @@ def limit_state_3d(blocks: Blocks3D, sides: int = DEFAULT_SIDES, solver: str = "
     active_rows = np.repeat(active[blocks.contacts.point_interface()], per_point)
     constraints = (rows[active_rows] @ cmap).tocsr()
     constraints.eliminate_zeros()
-    unit = np.r_[np.ones(3), np.full(3, 1.0 / scales.block)] / scales.force  # loads per programme unit
-    cost = -(cmap.T @ (blocks.dead * unit).ravel())
-    live = cmap.T @ (blocks.live * unit).ravel()
-    if not np.any(np.abs(live) > 1e-12 * max(1.0, np.abs(cost).max(initial=0.0))):
-        raise mf.SolveError("no live load: the multiplier is undefined (the live load is zero on every component "
-                            "of motion that is not held)")
+    cost, live = programme_loads(blocks, scales, cmap)
     if solver == "ipm":
         sol = backends.solve_ipm(cost, constraints, live, tolerance, second_order=3 * (sides == 0), progress=progress)
     elif sides == 0:
@@ -256,20 +263,29 @@ def support_wrenches(blocks: Blocks3D, state: LimitState3D) -> np.ndarray:
 
 def solve(model: xr.Dataset, options: Mapping[str, Any], progress=mfp.no_progress) -> xr.Dataset:
     """``la`` on a 3D model: the collapse multiplier, the mechanism and the forces at the interfaces' vertices."""
-    if options["flow"] != "associative":
-        raise mf.SolveError("la in 3D: flow = nonassociative is not supported in 3D yet (associative joints only)")
     clock = time.perf_counter()
     progress(0.0, "la: assembling the 3D programme")
     blocks = blocks_of(model)
     sides = int(options["pyramid_sides"])
+    flow_rule = options["flow"]
+    if flow_rule == "nonassociative" and sides != 0:
+        raise mf.SolveError(f"la in 3D: non-associative friction is solved on Coulomb's cone (pyramid_sides = 0), "
+                            f"not on a pyramid of {sides} sides")
     if sides == 0 and options["solver"] not in (None, *CONE_BACKENDS):
         raise mf.SolveError(f"la in 3D: Coulomb's cone is a second-order cone programme, which ipm and clarabel "
                             f"solve (solver = {options['solver']} solves LPs: a pyramid, pyramid_sides = 8 or more)")
     backend = options["solver"] or DEFAULT_BACKEND
     friction = "the cone" if sides == 0 else f"a pyramid of {sides} sides"
     progress(0.2, f"la: solving in 3D ({friction}, {backend})")
-    state = limit_state_3d(blocks, sides, backend, options["tolerance"],
-                           iteration_progress(progress, friction, options["tolerance"]))
+    flow = None
+    if flow_rule == "nonassociative":
+        from . import nonassociative3d
+
+        flow = nonassociative3d.solve(blocks, options, progress)
+        state = flow.state
+    else:
+        state = limit_state_3d(blocks, sides, backend, options["tolerance"],
+                               iteration_progress(progress, friction, options["tolerance"]))
     axis = ("block", "axis")
     data = {
         "collapse_multiplier": ((), state.alpha, mfp.variable_attrs("collapse_multiplier", "result3d")),
@@ -291,9 +307,18 @@ def solve(model: xr.Dataset, options: Mapping[str, Any], progress=mfp.no_progres
     if mfp.moving_blocks(blocks.role).any():
         data["moving_support_reaction"] = ((), float(mf.settlement_reaction(model, wrench)),
                                            mfp.variable_attrs("moving_support_reaction", "result3d"))
-    progress(1.0, f"la: alpha = {state.alpha:.6g}")
+    unconverged = "" if flow is None or flow.converged else " (NOT CONVERGED: the last iterate)"
+    progress(1.0, f"la: alpha = {state.alpha:.6g}{unconverged}")
     method = f"cone, {backend}" if sides == 0 else f"pyramid of {sides} sides, {backend}"
-    return xr.Dataset(data, attrs={"rotations": "small", "flow_rule": "associative", "method": method,
-                                   "la_backend": backend,
-                                   "la_pyramid_sides": sides, "la_time_s": time.perf_counter() - clock,
-                                   "la_alpha_dual": float(state.solution.alpha_dual)})
+    attrs = {"rotations": "small", "flow_rule": flow_rule, "method": method, "la_backend": backend,
+             "la_pyramid_sides": sides, "la_time_s": time.perf_counter() - clock,
+             "la_alpha_dual": float(state.solution.alpha_dual)}
+    if flow is not None:
+        attrs.update(la_flow_iterations=len(flow.alphas), la_flow_converged=int(flow.converged),
+                     la_flow_last_change=flow.change, la_alpha_associative=flow.alpha_associative,
+                     la_flow_selection="the first fixed point of the sequence of cone programmes started from the "
+                                       "associative cone's normal forces; each programme's contact forces with the "
+                                       f"least squared normal forces, by a QP after the {backend} solve (docs/la.md)")
+        if not flow.converged:
+            attrs["stop_reason"] = flow.stop_reason
+    return xr.Dataset(data, attrs=attrs)

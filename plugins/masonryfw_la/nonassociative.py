@@ -53,7 +53,7 @@ of the blocks, the thread count or the length unit (tested).
 from __future__ import annotations
 
 import logging
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -71,6 +71,8 @@ MIN_RELAXATION = 0.05
 ALIGNED = 0.99
 EXTRAPOLATE_ABOVE = 0.3
 MAX_CONTRACTION = 0.98
+#: A sequence whose last this many LPs did not halve its smallest change roams without converging (3D).
+WANDER_WINDOW = 15
 #: The finish (the exact selection) stops at this share of the tolerances (alpha's and the forces').
 FINISH = 0.01
 #: Converged only if no end's normal force is estimated farther than this from its limit (over the dead load).
@@ -108,6 +110,58 @@ def oscillates(last: list[float], tolerance: float) -> bool:
     return bool(steps[0] * steps[1] < 0 and np.abs(steps).min() > tolerance * max(1.0, abs(last[-1])))
 
 
+@dataclass
+class FixedPoint:
+    """The sequence's steps on the normal forces (module docstring), in 2D and 3D: relaxation, the extrapolation
+    of one slow mode, and the test of steadiness."""
+
+    tolerance: float  # alpha's, relative
+    relaxation: float
+    alphas: list[float] = field(default_factory=list)  # of every LP so far
+    change: float = np.inf  # the last residual's largest normal force (over the dead load)
+    rho: float = 0.0  # the residuals' contraction
+    previous: np.ndarray | None = None  # the last plain (not extrapolated) residual
+    finish_from: int = 0  # the first LP of a finish, whose steadiness is judged on its own
+    changes: list[float] = field(default_factory=list)  # of every LP so far
+
+    def steady(self, alpha: float, residual: np.ndarray, finish: float = 1.0) -> bool:
+        """Record one LP (its alpha, the change it asks of the normal forces): steady when the estimated distance
+        to the limit, the last step over ``1 - rho``, is within ``finish`` times both tolerances."""
+        self.change = float(np.abs(residual).max(initial=0.0))
+        self.changes.append(self.change)
+        if self.previous is not None:
+            self.rho = contraction(residual, self.previous)
+        slow = 1.0 / (1.0 - min(self.rho, MAX_CONTRACTION))  # distance to the limit over the last step
+        # alpha's last two steps: one alone can be a turning point while the forces still move
+        steps = np.abs(np.diff([*self.alphas[max(len(self.alphas) - 2, self.finish_from):], alpha]))
+        self.alphas.append(alpha)
+        return bool(steps.size == 2 and steps.max() * slow <= finish * self.tolerance * max(1.0, abs(alpha))
+                    and self.change * slow <= finish * FORCE_TOLERANCE)
+
+    def wandering(self) -> bool:
+        """The last :data:`WANDER_WINDOW` LPs did not halve the smallest change of the ones before them: the
+        sequence roams a set of near fixed points (3D; module docstring of :mod:`.nonassociative3d`)."""
+        before, recent = self.changes[:-WANDER_WINDOW], self.changes[-WANDER_WINDOW:]
+        return len(before) >= WANDER_WINDOW and min(recent) > 0.5 * min(before)
+
+    def start_finish(self) -> None:
+        self.finish_from = len(self.alphas)
+
+    def next_normal(self, normal: np.ndarray, residual: np.ndarray) -> np.ndarray:
+        """The next LP's normal forces: relaxed, or extrapolated to the limit of one slow mode."""
+        factor = self.relaxation
+        if (self.previous is not None and aligned(residual, self.previous)
+                and EXTRAPOLATE_ABOVE < self.rho < MAX_CONTRACTION):
+            factor = self.relaxation / (1.0 - self.rho)  # to the limit of the slow mode
+            self.previous = None  # the next residual says nothing about the contraction
+        else:
+            if len(self.alphas) >= 3 and oscillates(self.alphas[-3:], self.tolerance):
+                self.relaxation = max(0.5 * self.relaxation, MIN_RELAXATION)  # take smaller steps
+                factor = self.relaxation
+            self.previous = residual
+        return normal + factor * residual
+
+
 @dataclass(frozen=True)
 class FlowIteration:
     """The reported LP and how the sequence went."""
@@ -132,41 +186,52 @@ def end_normal_forces(lp: assembly.KinematicLP, y: np.ndarray, n_interface: int,
 
 def least_compression(lp: assembly.KinematicLP, alpha: float, tolerance: float) -> np.ndarray:
     """Among the contact forces in equilibrium with ``dead + alpha live`` within the LP's capacities,
-    those with the least sum of squared normal forces (a QP, Clarabel): unique normal forces, and no
-    self-stress that the loads do not need.
+    those with the least sum of squared normal forces (:func:`least_squared_forces`).
 
     The static problem of an LP has many solutions where blocks can be squeezed between
     supports (a unit under a cap that only touches it); the interior point backends return
     the centre of that set, whose made-up clamping force would raise the next capacities,
     and a vertex (least total compression by the simplex) jumps from one LP to the next.
-    Variables ``(y, a)``: ``G^T y + a live = cost``, ``y >= 0``, ``a >= alpha - slack``;
-    minimise ``|y_n|^2 / 2`` over the multipliers ``y_n`` of the ``dn >= 0`` rows (normal force
-    plus the constant tension share).
+    """
+    return least_squared_forces(lp.cost, lp.constraints, lp.live, selection_rows(lp), alpha, tolerance)
+
+
+def least_squared_forces(cost, constraints, live, squared: np.ndarray, alpha: float, tolerance: float,
+                         cone_size: int = 1) -> np.ndarray:
+    """The multipliers ``y`` in equilibrium with ``dead + alpha live`` with the least ``sum(squared * y^2) / 2``
+    (a QP, Clarabel): unique normal forces, and no self-stress that the loads do not need.
+
+    Variables ``(y, a)``: ``G^T y + a live = cost``, ``y`` in the programme's cones (the orthant, or second-order
+    cones of ``cone_size`` rows), ``a >= alpha - slack``; ``squared`` is 1 on the rows whose multipliers are
+    normal forces.
     """
     import clarabel
     import scipy.sparse as sp
 
-    n_row, n_col = lp.constraints.shape
-    weight = np.append(selection_rows(lp), 0.0)  # nothing on the live multiplier
+    n_row, n_col = constraints.shape
+    weight = np.append(squared, 0.0)  # nothing on the live multiplier
     slack = 10 * tolerance * max(1.0, abs(alpha))
     matrix = sp.vstack([
-        sp.hstack([lp.constraints.T, sp.csr_matrix(lp.live[:, None])]),  # = cost (zero cone)
-        -sp.identity(n_row + 1, format="csr"),  # y >= 0, a >= alpha - slack (non-negative cone)
+        sp.hstack([constraints.T, sp.csr_matrix(np.asarray(live)[:, None])]),  # = cost (zero cone)
+        -sp.identity(n_row + 1, format="csr"),  # y in the cones, a >= alpha - slack
     ], format="csc")
-    rhs = np.concatenate([lp.cost, np.zeros(n_row), [-(alpha - slack)]])
+    rhs = np.concatenate([cost, np.zeros(n_row), [-(alpha - slack)]])
     settings = clarabel.DefaultSettings()
     settings.verbose = False
     settings.direct_solve_method = "qdldl"
     # the forces only move the next capacities; the iteration's force test is 1e-3 of the dead load
     settings.tol_gap_abs = settings.tol_gap_rel = settings.tol_feas = SELECTION_TOLERANCE
+    cones = ([clarabel.NonnegativeConeT(n_row + 1)] if cone_size == 1
+             else [clarabel.SecondOrderConeT(cone_size)] * (n_row // cone_size) + [clarabel.NonnegativeConeT(1)])
     solver = clarabel.DefaultSolver(sp.diags(weight, format="csc"), np.zeros(n_row + 1), matrix, rhs,
-                                    [clarabel.ZeroConeT(n_col), clarabel.NonnegativeConeT(n_row + 1)], settings)
+                                    [clarabel.ZeroConeT(n_col), *cones], settings)
     solution = mfp.interruptible(solver.solve)
     status = str(solution.status).split(".")[-1]
     if status not in ("Solved", "AlmostSolved"):
         raise mf.SolveError(f"la: the least-compression contact forces at alpha = {alpha:.6g} were not found "
                             f"(Clarabel: {status})")
-    return np.maximum(np.asarray(solution.x)[:n_row], 0.0)
+    y = np.asarray(solution.x)[:n_row]
+    return np.maximum(y, 0.0) if cone_size == 1 else y
 
 
 def selection_rows(lp: assembly.KinematicLP) -> np.ndarray:
@@ -246,10 +311,8 @@ def solve(wall: assembly.Wall, scales: assembly.Scales, kin: assembly.Kinematics
         normal = np.zeros(2 * wall.n_interface)  # the dilatancy is blocked: start from no friction at all
         alpha_associative = np.nan
     selection = Selection(backend, lp_tolerance, SELECTION_WEIGHT * min(1.0, SELECTION_BLOCKS / wall.n_block))
-    alphas: list[float] = []
-    change, rho = np.inf, 0.0
-    previous: np.ndarray | None = None  # the last plain (not extrapolated) residual
-    finish_from = 0  # the first LP of the finish, whose steadiness is judged on its own
+    sequence = FixedPoint(tolerance, relaxation)
+    alphas = sequence.alphas
     regularised_end = None  # the regularised sequence's fixed point, kept in case the finish fails
     solution: backends.LPSolution | None = None
     for k in range(cap):
@@ -268,39 +331,23 @@ def solve(wall: assembly.Wall, scales: assembly.Scales, kin: assembly.Kinematics
             reason = f"LP {k + 1} of the non-associative sequence failed ({error}): the last iterate is reported"
             LOG.warning("la: %s", reason)
             return FlowIteration(lp, admissible(selection, lp, solution), alpha_associative, tuple(alphas), False,
-                                 change, selection.weight, reason)
+                                 sequence.change, selection.weight, reason)
         lp, solution = lp_k, solution_k
         residual = end_normal_forces(lp, solution.y, wall.n_interface, scales) - normal
-        change = float(np.abs(residual).max(initial=0.0))
         alpha = solution.alpha_primal
-        if previous is not None:
-            rho = contraction(residual, previous)
-        slow = 1.0 / (1.0 - min(rho, MAX_CONTRACTION))  # distance to the limit over the last step
-        # alpha's last two steps: one alone can be a turning point while the forces still move
-        steps = np.abs(np.diff([*alphas[max(len(alphas) - 2, finish_from):], alpha]))
-        finish = FINISH if selection.finishing else 1.0  # the finish goes on to a tighter tolerance
-        steady = (steps.size == 2 and steps.max() * slow <= finish * tolerance * max(1.0, abs(alpha))
-                  and change * slow <= finish * FORCE_TOLERANCE)
-        alphas.append(alpha)
+        steady = sequence.steady(alpha, residual, FINISH if selection.finishing else 1.0)
         progress(0.2 + 0.7 * (k + 1) / cap, f"la: non-associative LP {k + 1}: alpha = {alpha:.6g}, "
-                                              f"normal forces moved {change:.2e} W")
+                                              f"normal forces moved {sequence.change:.2e} W")
         if steady and selection.regularised:  # finish with the exact selection: see the module docstring
-            selection.finishing, finish_from = True, len(alphas)
-            regularised_end = (lp, solution, tuple(alphas), change)
+            selection.finishing = True
+            sequence.start_finish()
+            regularised_end = (lp, solution, tuple(alphas), sequence.change)
         elif steady:
-            return FlowIteration(lp, solution, alpha_associative, tuple(alphas), True, change, selection.weight)
-        factor = relaxation
-        if previous is not None and aligned(residual, previous) and EXTRAPOLATE_ABOVE < rho < MAX_CONTRACTION:
-            factor = relaxation / (1.0 - rho)  # to the limit of the slow mode
-            previous = None  # the next residual says nothing about the contraction
-        else:
-            if len(alphas) >= 3 and oscillates(alphas[-3:], tolerance):
-                relaxation = max(0.5 * relaxation, MIN_RELAXATION)  # take smaller steps
-                factor = relaxation
-            previous = residual
-        normal = normal + factor * residual
+            return FlowIteration(lp, solution, alpha_associative, tuple(alphas), True, sequence.change,
+                                 selection.weight)
+        normal = sequence.next_normal(normal, residual)
     LOG.warning("la: the non-associative iteration did not converge in %d LPs (alpha %s, normal forces still "
-                "moving %.2e W); the last iterate is reported", cap, alphas[-3:], change)
-    return FlowIteration(lp, admissible(selection, lp, solution), alpha_associative, tuple(alphas), False, change,
-                         selection.weight, f"the non-associative iteration did not converge in {cap} LPs: the last "
-                                           "iterate is reported")
+                "moving %.2e W); the last iterate is reported", cap, alphas[-3:], sequence.change)
+    return FlowIteration(lp, admissible(selection, lp, solution), alpha_associative, tuple(alphas), False,
+                         sequence.change, selection.weight, f"the non-associative iteration did not converge in "
+                                                            f"{cap} LPs: the last iterate is reported")

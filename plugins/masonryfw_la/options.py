@@ -25,8 +25,9 @@ OPTIONS = (
     mfp.Option("tolerance", float, 1e-9, "feasibility / optimality tolerance of the backend", above=0.0, below=1.0),
     mfp.Option("flow", str, "associative",
               "associative: a sliding joint opens by mu |slip| (dilatant, the paper's and ALMA's; an upper bound); "
-              "nonassociative: joints slide without opening, by a sequence of LPs with the shear capacity of the "
-              "previous normal forces (Gilbert, Casapulla & Ahmed 2006; docs/la.md)",
+              "nonassociative: joints slide without opening, by a sequence of LPs (in 3D of cone programmes, Coulomb's "
+              "cone only) with the shear capacity of the previous normal forces (Gilbert, Casapulla & Ahmed 2006; "
+              "docs/la.md)",
               ("associative", "nonassociative")),
     mfp.Option("flow_tolerance", float, 1e-6,
               "nonassociative: stop when alpha (relative) and every end's normal force (over the dead load) "

@@ -101,8 +101,8 @@ def test_what_handles_2d_only_refuses_a_3d_model_before_it_starts(in_3d):
     result = mf.solve(model, "la")
     with pytest.raises(mf.ModelError, match="the forces plot handles 2D models and results"):
         mf.render([result], "forces")
-    with pytest.raises(mf.SolveError, match="nonassociative is not supported in 3D"):
-        mf.solve(model, "la", {"flow": "nonassociative"})
+    with pytest.raises(mf.SolveError, match="non-associative friction is solved on Coulomb's cone"):
+        mf.solve(model, "la", {"flow": "nonassociative", "pyramid_sides": 8})
 
 
 def test_the_command_line_says_so_without_a_traceback(in_3d, tmp_path):

@@ -1,0 +1,179 @@
+"""Non-associative friction in 3D: joints that slide without opening, by a sequence of cone programmes.
+
+The 2D sequence (:mod:`.nonassociative`, after Gilbert, Casapulla & Ahmed 2006) on Coulomb's cone. At every
+vertex of an interface the cone ``|T| <= mu N`` is replaced by a disc of fixed radius ``R = mu N_k``, ``N_k`` the
+vertex's normal force in the previous programme, with the flow rule of a joint that slides without dilatancy:
+``dn >= 0`` and a slip ``s >= |dt|`` that dissipates ``R s``. Each programme is a second-order cone programme
+with one more column per vertex, its slip ``s``, and two cones of three rows per vertex:
+
+    (n.v, 0, 0)          the orthant dn >= 0, written as a cone so that one interior point serves (its zero rows
+                         carry nothing: their multipliers go to zero with the centring)
+    (s, t0.v, t1.v)      the slip bounds the tangential motion
+
+The static side puts at the vertex a normal force ``N >= 0`` and a friction force ``T`` with ``|T| <= R`` (the
+slip column's equation makes the cone's first multiplier ``R``). Each programme's contact forces are the least
+squared normal forces (:func:`.nonassociative.least_squared_forces`, the QP the 2D backends other than ipm use),
+for the 2D reason: the interior point's centre of a tied set of forces is a made-up clamping force that raises the
+next capacities. The sequence (relaxation, the extrapolation of one slow mode, the test of steadiness) is the 2D
+one (:class:`.nonassociative.FixedPoint`), on the vertices' normal forces; it starts from the associative
+cone's forces, or from none when the associative programme has no mechanism (the dilatancy is blocked).
+"""
+from __future__ import annotations
+
+import logging
+from typing import NamedTuple
+
+import numpy as np
+import scipy.sparse as sp
+
+import masonryfw as mf
+
+from . import backends, ipm, limit3d, nonassociative
+from .options import DEFAULT_BACKEND
+
+LOG = logging.getLogger("masonryfw.la")
+
+
+class FlowProgramme3D(NamedTuple):
+    """What stays the same along the sequence (non-dimensional, the programme's columns: the blocks', then one
+    slip per vertex)."""
+
+    constraints: sp.csr_matrix  # (6 vertex, columns): the normal cones, then the slip cones
+    dead: np.ndarray  # the cost of the block columns (the dead load's work)
+    live: np.ndarray  # (columns,)
+    friction: np.ndarray  # (vertex,) mu
+    vertices: np.ndarray  # (vertex,) the programme's vertices among the contacts' points
+    block_columns: int
+
+    def cost(self, normal: np.ndarray) -> np.ndarray:
+        """The slips dissipate ``mu N`` each for the normal forces ``normal`` (over the dead load)."""
+        return np.r_[self.dead, self.friction * np.maximum(normal, 0.0)]
+
+    def normal_forces(self, y: np.ndarray) -> np.ndarray:
+        """Each vertex's normal force: the first multiplier of its normal cone."""
+        return y[:3 * self.vertices.size:3]
+
+    def squared_rows(self) -> np.ndarray:
+        """1 on the rows whose multipliers are the normal forces."""
+        rows = np.zeros(self.constraints.shape[0])
+        rows[:3 * self.vertices.size:3] = 1.0
+        return rows
+
+    def point_forces(self, y: np.ndarray, axes: np.ndarray, n_point: int, force: float) -> np.ndarray:
+        """``(point, 3)`` the force on side 1 at every interface vertex [N] (zero off the programme)."""
+        n_vertex = self.vertices.size
+        slip = y[3 * n_vertex:].reshape(-1, 3)
+        local = np.c_[self.normal_forces(y), slip[:, 1:]]  # N, T0, T1
+        forces = np.zeros((n_point, 3))
+        forces[self.vertices] = np.einsum("pj,pjd->pd", local, axes[self.vertices]) * force
+        return forces
+
+
+class Flow3D(NamedTuple):
+    """The reported programme's state and how the sequence went."""
+
+    state: limit3d.LimitState3D
+    alpha_associative: float  # nan when the associative programme has no mechanism
+    alphas: tuple[float, ...]
+    converged: bool
+    change: float  # the last step's largest vertex normal force change (over the dead load)
+    stop_reason: str = ""
+
+
+def vertex_axes(blocks: limit3d.Blocks3D) -> np.ndarray:
+    """``(point, 3, 3)``: each interface vertex's normal and its interface's two tangents."""
+    contacts = blocks.contacts
+    owner = contacts.point_interface()
+    return np.concatenate([contacts.normal[owner][:, None, :], contacts.tangent[owner]], axis=1)
+
+
+def flow_programme(blocks: limit3d.Blocks3D, scales: limit3d.Scales3D) -> tuple[FlowProgramme3D, sp.csr_matrix]:
+    """The programme of the module docstring, and the map of its block columns to all block dofs."""
+    cmap, _ = limit3d.column_map(blocks, scales)
+    owner = blocks.contacts.point_interface()
+    vertices = np.flatnonzero(limit3d.active_interfaces(blocks, cmap)[owner])
+    rows = limit3d.relative_velocity_rows(blocks, scales, vertex_axes(blocks))
+    velocity = (rows[(3 * vertices[:, None] + np.arange(3)).ravel()] @ cmap).tocoo()  # rows 3 vertex + axis
+    n_vertex, n_column = vertices.size, cmap.shape[1]
+    cone_row = np.where(velocity.row % 3 == 0, velocity.row, 3 * n_vertex + velocity.row)
+    slip = np.arange(n_vertex)
+    constraints = sp.csr_matrix(
+        (np.r_[velocity.data, np.ones(n_vertex)],
+         (np.r_[cone_row, 3 * (n_vertex + slip)], np.r_[velocity.col, n_column + slip])),
+        shape=(6 * n_vertex, n_column + n_vertex))
+    constraints.eliminate_zeros()
+    dead, live = limit3d.programme_loads(blocks, scales, cmap)
+    programme = FlowProgramme3D(constraints, dead, np.r_[live, np.zeros(n_vertex)], blocks.friction[owner][vertices],
+                                vertices, n_column)
+    return programme, cmap
+
+
+def associative_start(blocks: limit3d.Blocks3D, programme: FlowProgramme3D, backend: str,
+                      tolerance: float) -> tuple[np.ndarray, float]:
+    """The vertices' normal forces (over the dead load) and alpha of the associative cone, or none and nan when it
+    has no mechanism."""
+    try:
+        state = limit3d.limit_state_3d(blocks, 0, backend, tolerance)
+    except backends.LiveLoadUnbounded:
+        return np.zeros(programme.vertices.size), np.nan
+    normal = np.einsum("pd,pd->p", state.point_force, vertex_axes(blocks)[:, 0])
+    return normal[programme.vertices] / limit3d.scales_of(blocks).force, state.alpha
+
+
+def solve(blocks: limit3d.Blocks3D, options, progress) -> Flow3D:
+    """The sequence of cone programmes of the module docstring (options as the 2D sequence's)."""
+    backend, cone_tolerance = options["solver"] or DEFAULT_BACKEND, options["tolerance"]
+    scales = limit3d.scales_of(blocks)
+    programme, cmap = flow_programme(blocks, scales)
+    axes = vertex_axes(blocks)
+    normal, alpha_associative = associative_start(blocks, programme, backend, cone_tolerance)
+    sequence = nonassociative.FixedPoint(options["flow_tolerance"], options["flow_relaxation"])
+    cap = options["flow_iterations"]
+    squared = programme.squared_rows()
+    reported: limit3d.LimitState3D | None = None
+
+    def state_of(solution: backends.LPSolution, y: np.ndarray) -> limit3d.LimitState3D:
+        motion = (cmap @ solution.x[:programme.block_columns]).reshape(-1, 6) * scales.dof
+        forces = programme.point_forces(y, axes, axes.shape[0], scales.force)
+        return limit3d.LimitState3D(float(solution.alpha_primal), motion, forces,
+                                    limit3d.active_interfaces(blocks, cmap), solution)
+
+    def finished(converged: bool, reason: str = "") -> Flow3D:
+        return Flow3D(reported, alpha_associative, tuple(sequence.alphas), converged, sequence.change, reason)
+
+    # the interior point's normal matrix pattern and its symbolic factor: the constraints are the same throughout
+    normal_matrix = ipm.NormalMatrix(programme.constraints, 3) if backend == "ipm" else None
+    for k in range(cap):
+        cost = programme.cost(normal)
+        try:
+            if backend == "ipm":
+                solution = backends.solve_ipm(cost, programme.constraints, programme.live, cone_tolerance, 3,
+                                              normal=normal_matrix)
+            else:
+                solution = backends.solve_clarabel(cost, programme.constraints, programme.live, cone_tolerance, 3)
+            y = nonassociative.least_squared_forces(cost, programme.constraints, programme.live, squared,
+                                                    solution.alpha_primal, cone_tolerance, cone_size=3)
+        except mf.SolveError as error:
+            if reported is None:
+                raise
+            reason = f"programme {k + 1} of the non-associative sequence failed ({error}): the last iterate is reported"
+            LOG.warning("la: %s", reason)
+            return finished(False, reason)
+        reported = state_of(solution, y)
+        residual = programme.normal_forces(y) - normal
+        steady = sequence.steady(solution.alpha_primal, residual)
+        progress(0.2 + 0.7 * (k + 1) / cap, f"la: non-associative cone programme {k + 1}: alpha = "
+                                              f"{solution.alpha_primal:.6g}, normal forces moved {sequence.change:.2e} W")
+        if steady:
+            return finished(True)
+        if sequence.wandering():
+            tail = sequence.alphas[-nonassociative.WANDER_WINDOW:]
+            reason = (f"the non-associative sequence wanders: alpha between {min(tail):.6g} and {max(tail):.6g} over "
+                      f"its last {len(tail)} programmes, the normal forces still moving {sequence.change:.2e} W (no "
+                      f"fixed point to the tolerance: docs/la.md); the last iterate is reported")
+            LOG.warning("la: %s", reason)
+            return finished(False, reason)
+        normal = sequence.next_normal(normal, residual)
+    reason = f"the non-associative iteration did not converge in {cap} programmes: the last iterate is reported"
+    LOG.warning("la: %s (alpha %s, normal forces still moving %.2e W)", reason, sequence.alphas[-3:], sequence.change)
+    return finished(False, reason)
