@@ -25,6 +25,7 @@ from .kernels3d import (
     Motion3,
     Pairs3,
     detect_corners3,
+    detect_edges3,
     detect_face_pairs3,
     place_vertices3,
 )
@@ -210,10 +211,10 @@ def block_pair_properties(scene: Scene3, block: np.ndarray) -> np.ndarray:
     return props
 
 
-def corner_friction3(scene: Scene3, corners: np.ndarray) -> np.ndarray:
-    """(corner,) the friction coefficient of each corner contact: its blocks' model interface's, or the model's
-    median (:func:`face_properties3`'s rule)."""
-    return block_pair_properties(scene, corners[:, 1:].reshape(-1, 2))[:, 0]
+def friction_between3(scene: Scene3, blocks: np.ndarray) -> np.ndarray:
+    """(k,) the friction coefficient of a corner or edge contact between the blocks ``(k, 2)``: their model
+    interface's, or the model's median (:func:`face_properties3`'s rule)."""
+    return block_pair_properties(scene, blocks.reshape(-1, 2))[:, 0]
 
 
 def bodies_of(poly: mfp.Polyhedra, unit_weight: np.ndarray, driven: np.ndarray, moving: np.ndarray,
@@ -243,7 +244,30 @@ def bodies_of(poly: mfp.Polyhedra, unit_weight: np.ndarray, driven: np.ndarray, 
                    mfp.block_offsets(poly.block_face_count), mfp.block_offsets(poly.face_node_count),
                    poly.face_vertex_index().astype(np.int64), poly.face_block().astype(np.int64), mass, inertia,
                    inv_inertia, np.asarray(driven, dtype=bool), np.asarray(moving, dtype=bool),
-                   np.asarray(direction, dtype=float), surface / (3.0 * poly.block_node_count), convex_blocks(poly))
+                   np.asarray(direction, dtype=float), surface / (3.0 * poly.block_node_count), convex_blocks(poly),
+                   *block_edges(poly))
+
+
+def block_edges(poly: mfp.Polyhedra) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Every block's edges (edge, 2: global vertex numbers, block after block), the two faces each one joins
+    (edge, 2) and the blocks' offsets into them. A side shared by other than two faces (a vertex of one face
+    on another's side) is not an edge of a convex block's and is left out."""
+    index = poly.face_vertex_index().astype(np.int64)
+    following = index[mfp.next_node(poly.face_node_count)]
+    face = np.repeat(np.arange(poly.face_node_count.size), poly.face_node_count)
+    low, high = np.minimum(index, following), np.maximum(index, following)
+    n_vertex = max(poly.vertices.shape[0], 1)
+    key = low * n_vertex + high
+    order = np.argsort(key, kind="stable")
+    unique, first, count = np.unique(key[order], return_index=True, return_counts=True)
+    kept = count == 2
+    sides = order[first[kept]]
+    edges = np.c_[low[sides], high[sides]]
+    faces = np.c_[face[order[first[kept]]], face[order[first[kept] + 1]]]
+    block = poly.face_block()[faces[:, 0]]
+    by_block = np.argsort(block, kind="stable")
+    counts = np.bincount(block, minlength=poly.n_block)
+    return edges[by_block], faces[by_block], mfp.block_offsets(counts)
 
 
 def convex_blocks(poly: mfp.Polyhedra) -> np.ndarray:
@@ -297,11 +321,12 @@ def world_vertices(bodies: Bodies3, motion: Motion3) -> np.ndarray:
 
 
 def contacts(bodies: Bodies3, motion: Motion3, buffer: float, max_penetration: float, min_cos: float
-             ) -> tuple[np.ndarray, np.ndarray]:
+             ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The contacts at ``motion`` of blocks whose boxes come within ``buffer`` (core's broad phase; none between two
-    supports): (pair, 2) the face pairs, faces that face each other (:func:`.kernels3d.detect_face_pairs3`), and
-    (corner, 3) the corner contacts of the blocks that have none (a block turned past ``max_contact_angle``, its
-    corner against a face: :func:`.kernels3d.detect_corners3`)."""
+    supports): (pair, 2) the face pairs, faces that face each other (:func:`.kernels3d.detect_face_pairs3`), and of
+    the blocks that have none (a block turned past ``max_contact_angle``) (corner, 3) the corner contacts, a corner
+    against a face (:func:`.kernels3d.detect_corners3`), and (edge contact, 4) the edge contacts, an edge across an
+    edge (:func:`.kernels3d.detect_edges3`)."""
     world = world_vertices(bodies, motion)
     low = np.minimum.reduceat(world, bodies.vertex_offs[:-1], axis=0)
     high = np.maximum.reduceat(world, bodies.vertex_offs[:-1], axis=0)
@@ -311,7 +336,8 @@ def contacts(bodies: Bodies3, motion: Motion3, buffer: float, max_penetration: f
     faces = detect_face_pairs3(bodies, world, blocks, buffer, max_penetration, min_cos)
     n = bodies.pos0.shape[0]
     joined = np.isin(mfp.pair_key(blocks, n), mfp.pair_key(bodies.face_block[faces], n))
-    return faces, detect_corners3(bodies, world, blocks, joined, buffer, max_penetration, buffer)
+    return (faces, detect_corners3(bodies, world, blocks, joined, buffer, max_penetration, buffer),
+            detect_edges3(bodies, world, motion.pos, blocks, joined, buffer, max_penetration, buffer))
 
 
 def rows_before(before: np.ndarray, now: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -323,10 +349,12 @@ def rows_before(before: np.ndarray, now: np.ndarray) -> tuple[np.ndarray, np.nda
 
 
 def new_pairs(bodies: Bodies3, faces: np.ndarray, props: np.ndarray, bonded_start: np.ndarray,
-              corners: np.ndarray, corner_friction: np.ndarray, old: Pairs3 | None = None) -> Pairs3:
-    """The :class:`.kernels3d.Pairs3` of ``faces`` with their ``props`` (pair, 3) and of the ``corners`` with
-    their friction coefficients; a pair that was in ``old`` keeps its points' histories, a new one starts with its
-    points bonded where ``bonded_start`` says; a corner contact that was in ``old`` keeps its shear spring."""
+              corners: np.ndarray, corner_friction: np.ndarray, edges: np.ndarray, edge_friction: np.ndarray,
+              old: Pairs3 | None = None) -> Pairs3:
+    """The :class:`.kernels3d.Pairs3` of ``faces`` with their ``props`` (pair, 3) and of the ``corners`` and
+    ``edges`` with their friction coefficients; a pair that was in ``old`` keeps its points' histories, a new one
+    starts with its points bonded where ``bonded_start`` says; a corner or edge contact that was in ``old`` keeps
+    its shear spring."""
     counts = np.diff(bodies.face_offs)
     most = int((counts[faces[:, 0]] + counts[faces[:, 1]]).max(initial=3))
     held = np.full((faces.shape[0], most), -1, dtype=np.int64)
@@ -344,10 +372,16 @@ def new_pairs(bodies: Bodies3, faces: np.ndarray, props: np.ndarray, bonded_star
         n = bodies.pos0.shape[0]
         kept, source = rows_before(old.corners[:, 0] * n + old.corners[:, 2], corners[:, 0] * n + corners[:, 2])
         corner_shear[kept] = old.corner_shear[source]
+    edge_shear = np.zeros((edges.shape[0], 3))
+    if old is not None and old.edges.size and edges.size:
+        n_edge = bodies.edges.shape[0]
+        kept, source = rows_before(old.edges[:, 0] * n_edge + old.edges[:, 2], edges[:, 0] * n_edge + edges[:, 2])
+        edge_shear[kept] = old.edge_shear[source]
     return Pairs3(faces, np.asarray(props, dtype=float), held, points, shear, bonded,
                   np.zeros((faces.shape[0], most)), np.full(faces.shape[0], -1, dtype=np.int64),
                   np.zeros((faces.shape[0], most)), np.zeros((faces.shape[0], 7)), corners.astype(np.int64),
-                  np.asarray(corner_friction, dtype=float), corner_shear)
+                  np.asarray(corner_friction, dtype=float), corner_shear, edges.astype(np.int64),
+                  np.asarray(edge_friction, dtype=float), edge_shear)
 
 
 def scene_of(model: xr.Dataset, options: Mapping[str, Any]) -> Scene | Scene3:

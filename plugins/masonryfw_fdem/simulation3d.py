@@ -9,7 +9,7 @@ import numpy as np
 
 from . import kernels, kernels3d
 from .controls import Controls
-from .scene3d import Scene3, contacts, corner_friction3, face_properties3, new_pairs
+from .scene3d import Scene3, contacts, face_properties3, friction_between3, new_pairs
 from .simulation import State
 
 
@@ -74,10 +74,11 @@ def detect3(scene: Scene3, controls: Controls, motion: kernels3d.Motion3,
             old: kernels3d.Pairs3 | None) -> kernels3d.Pairs3:
     """The face pairs at ``motion`` with their properties; those of ``old`` keep their points' histories, the
     first detection's pairs start bonded where their joint has a strength."""
-    faces, corners = contacts(scene.bodies, motion, controls.buffer, controls.max_penetration, controls.min_cos)
+    faces, corners, edges = contacts(scene.bodies, motion, controls.buffer, controls.max_penetration,
+                                     controls.min_cos)
     props, bonded = face_properties3(scene, faces)
     return new_pairs(scene.bodies, faces, props, bonded if old is None else np.zeros(len(faces), bool), corners,
-                     corner_friction3(scene, corners), old)
+                     friction_between3(scene, corners[:, 1:]), edges, friction_between3(scene, edges[:, [1, 3]]), old)
 
 
 def initial_state3(scene: Scene3, controls: Controls) -> State3:

@@ -27,19 +27,21 @@ def block_on_base(size=(1.0, 1.0, 1.0), base=(8.0, 8.0)):
     return s3.bodies_of(poly, np.array([0.0, 1.0]), np.array([True, False]), np.zeros(2, bool), np.zeros((2, 6)))
 
 
-def run(bodies, load, friction, steps, dt=1e-3, damping=0.0, dashpot=0.2, ramp=0.0):
+def run(bodies, load, friction, steps, dt=1e-3, damping=0.0, dashpot=0.2, ramp=0.0, edge_contacts=True):
     """``steps`` steps from rest under ``load`` (block, 6; ramped in over ``ramp``) on joints of ``friction``, face
-    pairs found again whenever the kernel asks; returns the motion, the last pairs and the wrench on the
-    supports."""
+    pairs found again whenever the kernel asks (and edge contacts unless told not to); returns the motion, the last
+    pairs and the wrench on the supports."""
     motion = s3.at_rest(bodies)
     law = k3.ContactLaw3(KN, 0.5 * KN, 1e-12, dashpot, RECLIP_SHARE, BUFFER)
     loading = k3.Loading3(load, ramp, 0.0, 0.0, 0.0, 0.0)
     stepping = k3.Stepping3(dt, damping, 0.5 * BUFFER)
     pairs, wrench, left = None, np.zeros((bodies.pos0.shape[0], 6)), steps
     while left > 0:
-        faces, corners = s3.contacts(bodies, motion, BUFFER, 0.2, MIN_COS)
+        faces, corners, edges = s3.contacts(bodies, motion, BUFFER, 0.2, MIN_COS)
+        if not edge_contacts:
+            edges = edges[:0]
         pairs = s3.new_pairs(bodies, faces, np.tile([friction, 0.0, 0.0], (len(faces), 1)), np.zeros(len(faces)),
-                             corners, np.full(len(corners), friction), pairs)
+                             corners, np.full(len(corners), friction), edges, np.full(len(edges), friction), pairs)
         done, rebuild, *_ = k3.advance3(left, bodies, pairs, law, motion, loading, stepping, wrench)
         left -= done
         motion.pos_detect[:] = motion.pos
@@ -170,6 +172,41 @@ def test_a_toppling_block_lands_on_its_side_and_never_passes_through_the_base():
     assert len(pairs.faces) == 1 and len(pairs.corners) == 0  # lying on its side: a face pair again
 
 
+def crossed_ridges(gap):
+    """Two beams 0.6 x 0.6 x 4 across each other, each turned 45 degrees about its length: a fixed one along x,
+    its ridge at z = 0, and a free one along y above it, its lower ridge ``gap`` higher. Their only touch is ridge
+    across ridge: no vertex of either is ever inside the other, and no faces face each other."""
+    half = 0.3 * np.sqrt(2.0)
+    poly = mfp.boxes(np.array([[-2.0, -0.3, -0.3], [-0.3, -2.0, -0.3]]), np.array([[2.0, 0.3, 0.3], [0.3, 2.0, 0.3]]))
+    c, s = np.cos(np.pi / 4), np.sin(np.pi / 4)
+    about_x = np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
+    about_y = np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
+    owner = np.repeat(np.arange(2), poly.block_node_count)
+    vertices = np.where((owner == 0)[:, None], poly.vertices @ about_x.T - [0.0, 0.0, half],
+                        poly.vertices @ about_y.T + [0.0, 0.0, half + gap])
+    return s3.bodies_of(poly._replace(vertices=vertices), np.array([0.0, 1.0]), np.array([True, False]),
+                        np.zeros(2, bool), np.zeros((2, 6)))
+
+
+def test_a_beam_dropped_ridge_on_ridge_across_another_rests_on_the_crossing():
+    """A ridge that lands across another meets it at one point, inside both edges: an edge contact. The beam comes
+    to rest there, its ridge sunk by its weight over the point's stiffness (``W / (kn A)``, A the smaller corner
+    area), not turned. Without edge contacts it fell straight through the fixed beam (2 s of free fall)."""
+    bodies = crossed_ridges(gap=0.02)
+    load = weight_load(bodies)
+    weight = bodies.mass[1]
+    rested, pairs, wrench = run(bodies, load, 0.6, 2000)
+    half = 0.3 * np.sqrt(2.0)
+    sunk = weight / (KN * bodies.corner_area.min())
+    assert rested.pos[1, 2] - half == pytest.approx(-sunk, rel=1e-3)  # measured: 5.5e-7
+    assert wrench[0, 2] == pytest.approx(-weight, rel=1e-4) and np.abs(wrench[0, :2]).max() < 1e-9 * weight
+    assert np.degrees(k3.rotation_angle(rested.quat[1], np.array([1.0, 0.0, 0.0, 0.0]))) < 1e-6
+    assert np.abs(rested.pos[1, :2]).max() < 1e-9
+    assert len(pairs.faces) == 0 and len(pairs.corners) == 0 and len(pairs.edges) == 1
+    fallen, _, _ = run(bodies, load, 0.6, 2000, edge_contacts=False)
+    assert fallen.pos[1, 2] < -1.0
+
+
 def test_a_free_symmetric_top_keeps_its_angular_momentum_and_precesses_at_l_over_i1():
     """No contact, no load: the angular momentum stays (world frame) and the symmetry axis turns about it at
     ``|L| / I1`` (I1 the inertia about a transverse axis)."""
@@ -178,7 +215,7 @@ def test_a_free_symmetric_top_keeps_its_angular_momentum_and_precesses_at_l_over
     motion = s3.at_rest(bodies)
     motion.omega[0] = (0.6, 0.0, 2.0)
     pairs = s3.new_pairs(bodies, np.zeros((0, 2), dtype=np.int64), np.zeros((0, 3)), np.zeros(0),
-                         np.zeros((0, 3), dtype=np.int64), np.zeros(0))
+                         np.zeros((0, 3), dtype=np.int64), np.zeros(0), np.zeros((0, 4), dtype=np.int64), np.zeros(0))
     momentum = bodies.inertia[0] @ motion.omega[0]
     steps, dt = 20000, 1e-4
     k3.advance3(steps, bodies, pairs, k3.ContactLaw3(KN, KN, 0.0, 0.0, RECLIP_SHARE, BUFFER), motion,
