@@ -9,8 +9,10 @@ cone, so the normal matrix keeps the sparsity of ``G^T G`` over each cone's rows
 point's: they touch the same blocks). Formulas: Vandenberghe, "The CVXOPT linear and quadratic cone program
 solvers" (2010), sections 3-4.
 
-Every method is vectorised over the cones, column by column (numpy's einsum and batched matmul are several times
-slower on 3 x 3 blocks); vectors are stacked cone after cone (``k`` entries each).
+The second-order cones' scaled products, Jordan products and steps are compiled loops over the cones
+(:mod:`.lorentz_kernels`, numba, imported by 3D solves only: an LP does not pay for numba's import); the rest is
+vectorised over the cones, column by column (numpy's einsum and batched matmul are several times slower on 3 x 3
+blocks). Vectors are stacked cone after cone (``k`` entries each).
 """
 from __future__ import annotations
 
@@ -117,19 +119,11 @@ class LorentzScaling(NamedTuple):
     sigma: np.ndarray  # (cone, 3) eigenvalues of W^-1
     lam: np.ndarray  # (cone, 3) W y = W^-1 s
 
-    def eigen_coordinates(self, v: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """``U^T v`` per cone, as three columns."""
-        v = v.reshape(-1, 3)
-        along = self.direction[:, 0] * v[:, 1] + self.direction[:, 1] * v[:, 2]
-        across = self.direction[:, 0] * v[:, 2] - self.direction[:, 1] * v[:, 1]
-        return HALF_ROOT * (v[:, 0] - along), HALF_ROOT * (v[:, 0] + along), across
-
     def times(self, power: int, v: np.ndarray) -> np.ndarray:
-        """``W^-power v`` (``power`` = 1, -1, 2, -2)."""
-        c0, c1, c2 = (c * self.sigma[:, i] ** power for i, c in enumerate(self.eigen_coordinates(v)))
-        mean, half = HALF_ROOT * (c0 + c1), HALF_ROOT * (c1 - c0)
-        d = self.direction
-        return np.c_[mean, d[:, 0] * half - d[:, 1] * c2, d[:, 1] * half + d[:, 0] * c2].ravel()
+        """``W^-power v`` (``power`` = 1, -1, 2, -2): ``U diag(sigma^power) U^T v``."""
+        from . import lorentz_kernels
+
+        return lorentz_kernels.scaled(self.direction, self.sigma, power, np.ascontiguousarray(v, dtype=float))
 
     @property
     def normal_rows(self) -> np.ndarray:
@@ -149,15 +143,22 @@ class LorentzScaling(NamedTuple):
 
     def target_rhs(self, rc: np.ndarray) -> np.ndarray:
         """``W (lambda \\ rc)``."""
-        return self.times(-1, arrow_solve(self.lam, rc.reshape(-1, 3)).ravel())
+        from . import lorentz_kernels
+
+        return self.times(-1, lorentz_kernels.arrow_solve(self.lam.ravel(), np.ascontiguousarray(rc)))
 
     def scaled_product(self, ds: np.ndarray, dy: np.ndarray) -> np.ndarray:
         """``(W^-1 ds) o (W dy)``."""
-        return jordan(self.times(1, ds).reshape(-1, 3), self.times(-1, dy).reshape(-1, 3))
+        from . import lorentz_kernels
+
+        return lorentz_kernels.jordan(self.times(1, ds), self.times(-1, dy))
 
     def lam_squared(self) -> np.ndarray:
         """``lambda o lambda``."""
-        return jordan(self.lam, self.lam)
+        from . import lorentz_kernels
+
+        lam = self.lam.ravel()
+        return lorentz_kernels.jordan(lam, lam)
 
     @staticmethod
     def primal_shift(dy: np.ndarray) -> float:
@@ -171,18 +172,6 @@ def dots(u: np.ndarray, v: np.ndarray) -> np.ndarray:
     for a in range(1, u.shape[1]):
         out += u[:, a] * v[:, a]
     return out
-
-
-def jordan(u: np.ndarray, v: np.ndarray) -> np.ndarray:
-    """``u o v = (u . v, u0 v1 + v0 u1)`` per cone, stacked."""
-    head = dots(u, v)
-    return np.concatenate([head[:, None], u[:, :1] * v[:, 1:] + v[:, :1] * u[:, 1:]], axis=1).ravel()
-
-
-def arrow_solve(lam: np.ndarray, r: np.ndarray) -> np.ndarray:
-    """``x`` with ``lam o x = r`` per cone (``lam`` inside the cone)."""
-    head = (lam[:, 0] * r[:, 0] - dots(lam[:, 1:], r[:, 1:])) / lorentz_norm2(lam)
-    return np.concatenate([head[:, None], (r[:, 1:] - head[:, None] * lam[:, 1:]) / lam[:, :1]], axis=1)
 
 
 def lorentz_norm2(v: np.ndarray) -> np.ndarray:
@@ -204,8 +193,11 @@ class SecondOrderCones:
         e[:, 0] = 1.0
         return e.ravel()
 
-    def product(self, u: np.ndarray, v: np.ndarray) -> np.ndarray:
-        return jordan(u.reshape(-1, self.size), v.reshape(-1, self.size))
+    @staticmethod
+    def product(u: np.ndarray, v: np.ndarray) -> np.ndarray:
+        from . import lorentz_kernels
+
+        return lorentz_kernels.jordan(np.ascontiguousarray(u, dtype=float), np.ascontiguousarray(v, dtype=float))
 
     def trial_product(self, scaling: LorentzScaling, s, ds, y, dy, primal: float, dual: float) -> np.ndarray:
         """The scaled complementarity ``(lambda + primal W^-1 ds) o (lambda + dual W dy)`` after the steps."""
@@ -229,26 +221,17 @@ class SecondOrderCones:
     def identity_weight(self, v: np.ndarray) -> float:
         return float(v.reshape(-1, self.size)[:, 0].sum())
 
-    def max_step(self, v: np.ndarray, dv: np.ndarray) -> float:
+    @staticmethod
+    def max_step(v: np.ndarray, dv: np.ndarray) -> float:
         """Largest ``t <= 1`` keeping ``v + t dv`` in every cone (``v`` inside): the smallest positive root of
-        ``(v0 + t d0)^2 - |v1 + t d1|^2``, ``a t^2 + 2 b t + c`` with ``c > 0``."""
-        v, d = v.reshape(-1, self.size), dv.reshape(-1, self.size)
-        a = d[:, 0] ** 2 - dots(d[:, 1:], d[:, 1:])
-        b = v[:, 0] * d[:, 0] - dots(v[:, 1:], d[:, 1:])
-        c = lorentz_norm2(v)
-        disc = b * b - a * c
-        real = disc >= 0.0
-        root = np.sqrt(np.where(real, disc, 0.0))
-        q = -(b + np.where(b >= 0.0, root, -root))  # the larger root in magnitude, without cancellation
-        with np.errstate(divide="ignore", invalid="ignore"):
-            roots = np.stack([np.where(a != 0.0, q / a, np.inf), np.where(q != 0.0, c / q, np.inf)])
-        roots = np.where(real & (roots > 0.0), roots, np.inf)
-        # a linear f (a = 0) has its root at -c / 2b, which c / q gives (q = -2b). The first component stays
-        # positive too: through the apex f is positive again, and a cone whose tail is zero (the orthant written
-        # as a cone) has a double root that rounding can make complex
-        with np.errstate(divide="ignore"):
-            apex = np.where(d[:, 0] < 0.0, -v[:, 0] / d[:, 0], np.inf)
-        return float(min(1.0, roots.min(initial=np.inf), apex.min(initial=np.inf)))
+        ``(v0 + t d0)^2 - |v1 + t d1|^2``, ``a t^2 + 2 b t + c`` with ``c > 0`` (a linear one, ``a = 0``, at
+        ``-c / 2b``, which ``c / q`` gives), and the first component kept positive: through the apex ``f`` is
+        positive again, and a cone whose tail is zero (the orthant written as a cone) has a double root that rounding
+        can make complex."""
+        from . import lorentz_kernels
+
+        return float(lorentz_kernels.max_step(np.ascontiguousarray(v, dtype=float),
+                                              np.ascontiguousarray(dv, dtype=float)))
 
     def scaling(self, s: np.ndarray, y: np.ndarray, weight: np.ndarray | None = None) -> LorentzScaling:
         s, y = s.reshape(-1, 3), y.reshape(-1, 3)

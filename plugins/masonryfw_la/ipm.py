@@ -158,22 +158,17 @@ class ConeEntries(NamedTuple):
     columns are sorted: ``M[cols[i], cols[j]]`` is in the lower triangle); a pair with a padded column goes to a
     slot past the pattern's, dropped."""
 
-    values: np.ndarray  # (k, width, cone) each row's values in its cone's columns (0 where it has none)
+    values: np.ndarray  # (cone, k, width) each row's values in its cone's columns (0 where it has none)
     group_start: np.ndarray  # (group,) each group's first cone
-    slot: np.ndarray  # (pair, group) the place of each pair of positions in the pattern's data
+    slot: np.ndarray  # (group, pair) the place of each pair of positions in the pattern's data
 
     def normal_values(self, rows: np.ndarray, size: int) -> np.ndarray:
         """The pattern's values of ``sum over cones of (R_c G_c)^T (R_c G_c)`` for ``rows`` R (cone, r, k)."""
-        k = self.values.shape[0]
-        scaled = np.stack([sum(rows[:, r, a] * self.values[a] for a in range(k)) for r in range(rows.shape[1])])
-        first, second = np.tril_indices(scaled.shape[1])
-        products = np.empty((first.size, scaled.shape[2]))
-        for pair, (i, j) in enumerate(zip(first, second)):  # 78 pairs of 12 columns: long vectors, no temporaries
-            np.multiply(scaled[0, i], scaled[0, j], out=products[pair])
-            for r in range(1, scaled.shape[0]):
-                products[pair] += scaled[r, i] * scaled[r, j]
-        summed = np.add.reduceat(products, self.group_start, axis=1)  # (pair, group)
-        return np.bincount(self.slot.ravel(), weights=summed.ravel(), minlength=size + 1)[:size]
+        from . import normal_products
+
+        first, second = np.tril_indices(self.values.shape[2])
+        return normal_products.normal_values(self.values, np.ascontiguousarray(rows), self.group_start, self.slot,
+                                             first, second, size)
 
 
 def cone_pattern(constraints: sp.csr_matrix, cone_size: int = 1) -> tuple[sp.csc_matrix, ConeEntries]:
@@ -210,17 +205,17 @@ def cone_pattern(constraints: sp.csr_matrix, cone_size: int = 1) -> tuple[sp.csc
     valid = (lead[:, first] >= 0) & (lead[:, second] >= 0)
     slot = np.full(valid.shape, pattern.nnz, dtype=np.int64)
     slot[valid] = np.asarray(slot_of[lead[:, first][valid], lead[:, second][valid]]).ravel() - 1
-    return pattern, ConeEntries(np.ascontiguousarray(values.transpose(1, 2, 0)), group_start, slot.T.copy())
+    return pattern, ConeEntries(values, group_start, slot)
 
 
 def lower_pattern(constraints: sp.csr_matrix) -> tuple[sp.csc_matrix, sp.csr_matrix]:
     """An LP's :func:`cone_pattern` and the map from the row weights to its values: ``values = pairs.T @ d``
     (one row per row of ``G``)."""
     pattern, entries = cone_pattern(constraints)
-    row = entries.values[0].T
+    row = entries.values[:, 0, :]
     n_row = row.shape[0]
     first, second = np.tril_indices(row.shape[1])
-    slot = entries.slot.T[np.repeat(np.arange(entries.group_start.size), np.diff(np.r_[entries.group_start, n_row]))]
+    slot = entries.slot[np.repeat(np.arange(entries.group_start.size), np.diff(np.r_[entries.group_start, n_row]))]
     kept = slot < pattern.nnz  # (row, pair): each row has its group's pairs, with its own products
     products = (row[:, first] * row[:, second])[kept]
     indptr = np.concatenate([[0], np.cumsum(kept.sum(axis=1))])

@@ -10,7 +10,7 @@ import scipy.sparse as sp
 import masonryfw as mf
 import masonryfw.plugin_api as mfp
 import masonryfw.testing as mt
-from masonryfw_la import backends, cones, ipm, limit3d
+from masonryfw_la import backends, cones, ipm, limit3d, lorentz_kernels
 
 from .test_la_limit3d import WALLS, single_box
 
@@ -68,9 +68,14 @@ def test_the_nesterov_todd_scaling_maps_s_and_y_to_one_point(margin):
 
 def test_the_arrow_solve_inverts_the_jordan_product():
     rng = np.random.default_rng(7)
-    lam = points_inside(rng, 50).reshape(-1, 3)
-    x = rng.normal(size=(50, 3))
-    assert np.allclose(cones.arrow_solve(lam, cones.jordan(lam, x).reshape(-1, 3)), x, rtol=1e-10, atol=1e-12)
+    lam = points_inside(rng, 50)
+    x = rng.normal(size=150)
+    product = lorentz_kernels.jordan(lam, x)
+    c = lam.reshape(-1, 3)  # u o v = (u . v, u0 v1 + v0 u1), written out
+    assert np.allclose(product.reshape(-1, 3), np.c_[np.einsum("ij,ij->i", c, x.reshape(-1, 3)),
+                                                     c[:, :1] * x.reshape(-1, 3)[:, 1:] + x.reshape(-1, 3)[:, :1]
+                                                     * c[:, 1:]], rtol=1e-14)
+    assert np.allclose(lorentz_kernels.arrow_solve(lam, product), x, rtol=1e-10, atol=1e-12)
 
 
 def test_the_longest_step_ends_on_a_cones_boundary():
