@@ -279,7 +279,7 @@ def solve(model: xr.Dataset, options: Mapping[str, Any], progress=mfp.no_progres
     progress(0.2, f"la: solving in 3D ({friction}, {backend})")
     flow = None
     if flow_rule == "nonassociative":
-        from . import nonassociative3d
+        from . import nonassociative, nonassociative3d
 
         flow = nonassociative3d.solve(blocks, options, progress)
         state = flow.state
@@ -321,4 +321,9 @@ def solve(model: xr.Dataset, options: Mapping[str, Any], progress=mfp.no_progres
                                        f"least squared normal forces, by a QP after the {backend} solve (docs/la.md)")
         if not flow.converged:
             attrs["stop_reason"] = flow.stop_reason
+        if options["flow_starts"] == 2:
+            progress(0.55, "la: the non-associative sequence again, from zero normal forces")
+            again = nonassociative3d.solve(blocks, options, progress, from_zero=True)
+            attrs.update(nonassociative.second_start(state.alpha, flow.converged, again.state.alpha, again.converged,
+                                                     options["flow_tolerance"]))
     return xr.Dataset(data, attrs=attrs)

@@ -184,6 +184,20 @@ def end_normal_forces(lp: assembly.KinematicLP, y: np.ndarray, n_interface: int,
     return forces.normal.ravel() / scales.force
 
 
+def second_start(alpha: float, converged: bool, alpha_from_zero: float, converged_from_zero: bool,
+                 tolerance: float) -> dict:
+    """The attributes of option ``flow_starts = 2``: the second sequence's alpha (from zero normal forces) and whether
+    the two starts end at one alpha (both converged, within ten times the flow tolerance); a warning when not."""
+    agree = bool(converged and converged_from_zero
+                 and abs(alpha_from_zero - alpha) <= 10 * tolerance * max(1.0, abs(alpha)))
+    if not agree:
+        LOG.warning("la: from zero normal forces the non-associative sequence ends at alpha %.7g%s, the first start at "
+                    "%.7g%s: the two starts do not agree (a fixed point need not be unique: docs/la.md)",
+                    alpha_from_zero, "" if converged_from_zero else " (not converged)", alpha,
+                    "" if converged else " (not converged)")
+    return {"la_flow_alpha_from_zero": float(alpha_from_zero), "la_flow_starts_agree": int(agree)}
+
+
 def least_compression(lp: assembly.KinematicLP, alpha: float, tolerance: float) -> np.ndarray:
     """Among the contact forces in equilibrium with ``dead + alpha live`` within the LP's capacities,
     those with the least sum of squared normal forces (:func:`least_squared_forces`).
@@ -298,18 +312,20 @@ def admissible(selection: Selection, lp: assembly.KinematicLP, solution: backend
 
 
 def solve(wall: assembly.Wall, scales: assembly.Scales, kin: assembly.Kinematics, options,
-          progress=mfp.no_progress) -> FlowIteration:
-    """The sequence of LPs of the module docstring."""
+          progress=mfp.no_progress, from_zero: bool = False) -> FlowIteration:
+    """The sequence of LPs of the module docstring (``from_zero``: started from zero normal forces, the second start
+    of option ``flow_starts``)."""
     backend, lp_tolerance = options["solver"] or DEFAULT_BACKEND, options["tolerance"]
     tolerance, cap, relaxation = options["flow_tolerance"], options["flow_iterations"], options["flow_relaxation"]
-    try:
-        lp = assembly.assemble(wall, scales, kin)
-        first = backends.solve_lp(backend, lp.cost, lp.constraints, lp.live, lp_tolerance)
-        normal = end_normal_forces(lp, first.y, wall.n_interface, scales)
-        alpha_associative = first.alpha_primal
-    except backends.LiveLoadUnbounded:
-        normal = np.zeros(2 * wall.n_interface)  # the dilatancy is blocked: start from no friction at all
-        alpha_associative = np.nan
+    normal, alpha_associative = np.zeros(2 * wall.n_interface), np.nan
+    lp = assembly.assemble(wall, scales, kin)
+    if not from_zero:
+        try:
+            first = backends.solve_lp(backend, lp.cost, lp.constraints, lp.live, lp_tolerance)
+            normal = end_normal_forces(lp, first.y, wall.n_interface, scales)
+            alpha_associative = first.alpha_primal
+        except backends.LiveLoadUnbounded:
+            pass  # the dilatancy is blocked: start from no friction at all
     selection = Selection(backend, lp_tolerance, SELECTION_WEIGHT * min(1.0, SELECTION_BLOCKS / wall.n_block))
     sequence = FixedPoint(tolerance, relaxation)
     alphas = sequence.alphas

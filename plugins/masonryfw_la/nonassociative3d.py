@@ -120,13 +120,15 @@ def associative_start(blocks: limit3d.Blocks3D, programme: FlowProgramme3D, back
     return normal[programme.vertices] / limit3d.scales_of(blocks).force, state.alpha
 
 
-def solve(blocks: limit3d.Blocks3D, options, progress) -> Flow3D:
-    """The sequence of cone programmes of the module docstring (options as the 2D sequence's)."""
+def solve(blocks: limit3d.Blocks3D, options, progress, from_zero: bool = False) -> Flow3D:
+    """The sequence of cone programmes of the module docstring (options as the 2D sequence's; ``from_zero``: started
+    from zero normal forces, the second start of option ``flow_starts``)."""
     backend, cone_tolerance = options["solver"] or DEFAULT_BACKEND, options["tolerance"]
     scales = limit3d.scales_of(blocks)
     programme, cmap = flow_programme(blocks, scales)
     axes = vertex_axes(blocks)
-    normal, alpha_associative = associative_start(blocks, programme, backend, cone_tolerance)
+    normal, alpha_associative = ((np.zeros(programme.vertices.size), np.nan) if from_zero
+                                 else associative_start(blocks, programme, backend, cone_tolerance))
     sequence = nonassociative.FixedPoint(options["flow_tolerance"], options["flow_relaxation"])
     cap = options["flow_iterations"]
     squared = programme.squared_rows()

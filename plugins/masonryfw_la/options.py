@@ -39,6 +39,9 @@ OPTIONS = (
               "for a multiple of 4), solved by the option solver (docs/la.md, \"In 3D\"); at most 64 (32 sides are "
               "within 0.1 % of the cone)", at_least=0, at_most=64),
     mfp.Option("flow_iterations", int, 100, "nonassociative: the largest number of LPs", above=0),
+    mfp.Option("flow_starts", int, 1,
+              "nonassociative: 2 runs the sequence again from zero normal forces and says whether it ends at the "
+              "same alpha (a fixed point need not be unique: docs/la.md; twice the time)", at_least=1, at_most=2),
     mfp.Option("flow_relaxation", float, 1.0,
               "nonassociative: share of the change of the normal forces taken from one LP to the next",
               above=0.0, at_most=1.0),

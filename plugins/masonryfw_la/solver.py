@@ -66,6 +66,12 @@ def solve(model: xr.Dataset, options: Mapping[str, Any], progress=mfp.no_progres
         )
         if not flow.converged:
             result.attrs["stop_reason"] = flow.stop_reason
+        if options["flow_starts"] == 2:
+            progress(0.55, "la: the non-associative sequence again, from zero normal forces")
+            again = nonassociative.solve(wall, scales, kin, options, progress, from_zero=True)
+            result.attrs.update(nonassociative.second_start(float(sol.alpha_primal), flow.converged,
+                                                            float(again.solution.alpha_primal), again.converged,
+                                                            options["flow_tolerance"]))
     result.attrs.update(
         method=backend,
         la_backend=backend,

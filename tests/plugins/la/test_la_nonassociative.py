@@ -207,3 +207,16 @@ def test_a_failed_exact_finish_reports_the_regularised_fixed_point_and_says_so(w
     assert "exact finish by LP + QP (docs/la.md)" in exact.attrs["la_flow_selection"]
     assert result.attrs["la_flow_iterations"] < exact.attrs["la_flow_iterations"]
     assert float(result.collapse_multiplier) == pytest.approx(float(exact.collapse_multiplier), abs=2e-5)
+
+
+def test_a_second_start_from_zero_forces_says_whether_it_ends_at_the_same_alpha(walls, caplog):
+    """Option flow_starts = 2: Test 12C's sequence from zero normal forces ends where the one from the associative
+    forces does (measured 6.8e-10 apart); Panel 1's does not converge in 100 LPs from zero (it oscillates 7.4e-6 off
+    the first start's alpha), and the result says the starts do not agree."""
+    agreeing = walls.solve(mf.open_model("test-12c"), flow="nonassociative", flow_starts=2)
+    assert agreeing.attrs["la_flow_starts_agree"] == 1
+    assert agreeing.attrs["la_flow_alpha_from_zero"] == pytest.approx(float(agreeing.collapse_multiplier), abs=1e-6)
+    assert "do not agree" not in caplog.text
+    disagreeing = walls.solve(mf.open_model("panel-1"), flow="nonassociative", flow_starts=2)
+    assert disagreeing.attrs["la_flow_starts_agree"] == 0
+    assert "the two starts do not agree" in caplog.text and "(not converged)" in caplog.text

@@ -141,3 +141,9 @@ def test_a_sequence_that_wanders_says_so_and_stays_below_the_associative_bound(c
 def test_a_pyramid_is_refused():
     with pytest.raises(mf.SolveError, match="non-associative friction is solved on Coulomb's cone"):
         mf.solve(mt.corner_building(), "la", {"flow": "nonassociative", "pyramid_sides": 8})
+
+
+def test_a_second_start_from_zero_forces_ends_at_the_same_alpha_on_a_twin():
+    result = mf.solve(mfp.twin(mf.open_model("test-8c")), "la", {"flow": "nonassociative", "flow_starts": 2})
+    assert result.attrs["la_flow_starts_agree"] == 1
+    assert result.attrs["la_flow_alpha_from_zero"] == pytest.approx(float(result.collapse_multiplier), abs=1e-5)
