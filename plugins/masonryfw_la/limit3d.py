@@ -277,11 +277,11 @@ def solve(model: xr.Dataset, options: Mapping[str, Any], progress=mfp.no_progres
     backend = options["solver"] or DEFAULT_BACKEND
     friction = "the cone" if sides == 0 else f"a pyramid of {sides} sides"
     progress(0.2, f"la: solving in 3D ({friction}, {backend})")
-    flow = None
+    flow, flow_attrs = None, {}
     if flow_rule == "nonassociative":
-        from . import nonassociative, nonassociative3d
+        from . import nonassociative3d
 
-        flow = nonassociative3d.solve(blocks, options, progress)
+        flow, flow_attrs = nonassociative3d.reported(blocks, options, progress)
         state = flow.state
     else:
         state = limit_state_3d(blocks, sides, backend, options["tolerance"],
@@ -312,18 +312,5 @@ def solve(model: xr.Dataset, options: Mapping[str, Any], progress=mfp.no_progres
     method = f"cone, {backend}" if sides == 0 else f"pyramid of {sides} sides, {backend}"
     attrs = {"rotations": "small", "flow_rule": flow_rule, "method": method, "la_backend": backend,
              "la_pyramid_sides": sides, "la_time_s": time.perf_counter() - clock,
-             "la_alpha_dual": float(state.solution.alpha_dual)}
-    if flow is not None:
-        attrs.update(la_flow_iterations=len(flow.alphas), la_flow_converged=int(flow.converged),
-                     la_flow_last_change=flow.change, la_alpha_associative=flow.alpha_associative,
-                     la_flow_selection="the first fixed point of the sequence of cone programmes started from the "
-                                       "associative cone's normal forces; each programme's contact forces with the "
-                                       f"least squared normal forces, by a QP after the {backend} solve (docs/la.md)")
-        if not flow.converged:
-            attrs["stop_reason"] = flow.stop_reason
-        if options["flow_starts"] == 2:
-            progress(0.55, "la: the non-associative sequence again, from zero normal forces")
-            again = nonassociative3d.solve(blocks, options, progress, from_zero=True)
-            attrs.update(nonassociative.second_start(state.alpha, flow.converged, again.state.alpha, again.converged,
-                                                     options["flow_tolerance"]))
+             "la_alpha_dual": float(state.solution.alpha_dual), **flow_attrs}
     return xr.Dataset(data, attrs=attrs)
