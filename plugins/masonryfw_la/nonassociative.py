@@ -184,6 +184,15 @@ def end_normal_forces(lp: assembly.KinematicLP, y: np.ndarray, n_interface: int,
     return forces.normal.ravel() / scales.force
 
 
+def halves(progress, starts: int) -> tuple:
+    """The progress of each of ``starts`` sequences (each reports shares 0.2 to 0.9): one after the other, so that
+    the bar does not run backwards when the second start begins."""
+    if starts == 1:
+        return (progress,)
+    return tuple((lambda share, message="", low=low: progress(low + 0.35 * (share - 0.2) / 0.7, message))
+                 for low in (0.2, 0.55))
+
+
 def second_start(alpha: float, converged: bool, alpha_from_zero: float, converged_from_zero: bool,
                  tolerance: float) -> dict:
     """The attributes of option ``flow_starts = 2``: the second sequence's alpha (from zero normal forces) and whether

@@ -185,7 +185,8 @@ def reported(blocks: limit3d.Blocks3D, options, progress) -> tuple[Flow3D, dict]
     """The sequence (:func:`solve`) and the result's attributes that say how it went, with the second start of
     option ``flow_starts = 2``."""
     backend = options["solver"] or DEFAULT_BACKEND
-    flow = solve(blocks, options, progress)
+    shown = nonassociative.halves(progress, options["flow_starts"])
+    flow = solve(blocks, options, shown[0])
     attrs = {"la_flow_iterations": len(flow.alphas), "la_flow_converged": int(flow.converged),
              "la_flow_last_change": flow.change, "la_alpha_associative": flow.alpha_associative,
              "la_flow_selection": "the first fixed point of the sequence of cone programmes started from the "
@@ -195,7 +196,7 @@ def reported(blocks: limit3d.Blocks3D, options, progress) -> tuple[Flow3D, dict]
         attrs["stop_reason"] = flow.stop_reason
     if options["flow_starts"] == 2:
         progress(0.55, "la: the non-associative sequence again, from zero normal forces")
-        again = solve(blocks, options, progress, from_zero=True)
+        again = solve(blocks, options, shown[1], from_zero=True)
         attrs.update(nonassociative.second_start(flow.state.alpha, flow.converged, again.state.alpha, again.converged,
                                                  options["flow_tolerance"]))
     return flow, attrs

@@ -42,7 +42,8 @@ def solve(model: xr.Dataset, options: Mapping[str, Any], progress=mfp.no_progres
     clock = time.perf_counter()
     flow = None
     if options["flow"] == "nonassociative":
-        flow = nonassociative.solve(wall, scales, kin, options, progress)
+        shown = nonassociative.halves(progress, options["flow_starts"])
+        flow = nonassociative.solve(wall, scales, kin, options, shown[0])
         lp, sol = flow.lp, flow.solution
     else:
         sol = backends.solve_lp(backend, lp.cost, lp.constraints, lp.live, options["tolerance"])
@@ -68,7 +69,7 @@ def solve(model: xr.Dataset, options: Mapping[str, Any], progress=mfp.no_progres
             result.attrs["stop_reason"] = flow.stop_reason
         if options["flow_starts"] == 2:
             progress(0.55, "la: the non-associative sequence again, from zero normal forces")
-            again = nonassociative.solve(wall, scales, kin, options, progress, from_zero=True)
+            again = nonassociative.solve(wall, scales, kin, options, shown[1], from_zero=True)
             result.attrs.update(nonassociative.second_start(float(sol.alpha_primal), flow.converged,
                                                             float(again.solution.alpha_primal), again.converged,
                                                             options["flow_tolerance"]))
