@@ -64,6 +64,10 @@ CONE_ACCEPTABLE = 100.0
 REGULARISATION = 1e-13  # diagonal shift of M, relative to each diagonal entry
 MAX_REGULARISATION = 1e-5
 REFINEMENT_STEPS = 4
+#: Refinement stops once the dual equation holds to this share of the tolerance: the dual residual sits at 1e-16
+#: while the gap decides convergence (the 10,000-unit wall), and below it refining cannot change when the iterate
+#: converges (65 solves fewer there, the same iterations).
+DUAL_FLOOR = 1e-3
 STALL = 5  # iterations without halving the error: stalled (see ``acceptable``)
 DIVERGENCE = 1e12  # |x| or |y| beyond this (non-dimensional): no finite optimum
 
@@ -395,7 +399,7 @@ def solve(cost, constraints, live, tolerance: float, weight: np.ndarray | None =
             if new_p + new_d < 1.01 * (step_p + step_d):
                 break
             step, step_p, step_d, rc = corrected, new_p, new_d, rc + correction
-        dual_target = 0.1 * max(np.abs(rd).max(), tolerance * scale_c * 1e-6)
+        dual_target = 0.1 * max(np.abs(rd).max(), DUAL_FLOOR * tolerance * scale_c)
         step = newton.refine(step, rc, dual_target)
         # y is in a regularised LP's primal residual too, and the cones' scaling is of both: one step for all
         step_p, step_d = step.steps(cones, s, y, together=weight is not None or not orthant)
