@@ -12,7 +12,7 @@ import pytest
 import masonryfw as mf
 import masonryfw.plugin_api as mfp
 
-BACKENDS = ("highs", "clarabel", "osqp")
+BACKENDS = ("ipm", "highs", "clarabel", "osqp")
 ROLE = mfp.flags("block_role")
 TOL = 1e-6  # relative to the total dead load (forces) and dead load x model size (moments)
 
