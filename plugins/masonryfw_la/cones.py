@@ -113,17 +113,25 @@ class LorentzScaling(NamedTuple):
     it turned by 90 degrees) with ``sigma = (v0 + |v1|)^2 / eta``, ``(v0 - |v1|)^2 / eta`` (``v0 - |v1| = 1 /
     (v0 + |v1|)``, no cancellation) and ``1 / eta``. The normal matrix is formed from the rows ``diag(sigma) U^T
     G`` of each cone, a sum of positive rank-one terms as an LP's ``d g g^T``: the entries of ``W^-2`` itself span
-    ``sigma``'s range squared and, formed first, would lose its small directions."""
+    ``sigma``'s range squared and, formed first, would lose its small directions.
+
+    A regularised programme (``weight`` ``w`` on each cone's first component, ``s = G x + w y0 e0``) has the normal
+    weights ``(W^2 + w e0 e0^T)^-1``, ``W^-2`` less a rank-one term (Sherman and Morrison), and its normal rows
+    are ``diag(sigma) U^T`` times ``I - gamma z z^T``, ``z`` the unit first column of those rows and ``(1 -
+    gamma)^2 = 1 / (1 + w h)``, ``h = (W^-2)_00``: still rows, never the difference of two matrices."""
 
     direction: np.ndarray  # (cone, 2) d
     sigma: np.ndarray  # (cone, 3) eigenvalues of W^-1
     lam: np.ndarray  # (cone, 3) W y = W^-1 s
+    weight: np.ndarray | None = None  # (cone,) a regularised programme's weight on each cone's first component
 
     def times(self, power: int, v: np.ndarray) -> np.ndarray:
         """``W^-power v`` (``power`` = 1, -1, 2, -2): ``U diag(sigma^power) U^T v``."""
         from . import lorentz_kernels
 
-        return lorentz_kernels.scaled(self.direction, self.sigma, power, np.ascontiguousarray(v, dtype=float))
+        with np.errstate(divide="ignore"):  # a cone on its boundary: inf, and the iteration's error says so
+            powered = self.sigma ** float(power)
+        return lorentz_kernels.scaled(self.direction, powered, np.ascontiguousarray(v, dtype=float))
 
     @property
     def normal_rows(self) -> np.ndarray:
@@ -133,13 +141,33 @@ class LorentzScaling(NamedTuple):
         rows = np.stack([np.c_[np.full_like(d0, HALF_ROOT), -HALF_ROOT * d0, -HALF_ROOT * d1],
                          np.c_[np.full_like(d0, HALF_ROOT), HALF_ROOT * d0, HALF_ROOT * d1],
                          np.c_[zero, -d1, d0]], axis=1)
-        return self.sigma[:, :, None] * rows
+        rows = self.sigma[:, :, None] * rows
+        if self.weight is None:
+            return rows
+        first = rows[:, :, 0]
+        h = dots(first, first)
+        gamma = 1.0 - 1.0 / np.sqrt(1.0 + self.weight * h)
+        z = first / np.sqrt(h)[:, None]
+        return rows - (gamma[:, None] * z)[:, :, None] * np.einsum("ck,ckj->cj", z, rows)[:, None, :]
 
     def times_normal_weights(self, v: np.ndarray) -> np.ndarray:
-        return self.times(2, v)
+        """``(W^2 + w e0 e0^T)^-1 v``."""
+        out = self.times(2, v)
+        if self.weight is None:
+            return out
+        out = out.reshape(-1, 3)
+        u = self.times(2, first_unit(out.shape[0])).reshape(-1, 3)  # W^-2 e0
+        out -= (self.weight * out[:, 0] / (1.0 + self.weight * u[:, 0]))[:, None] * u
+        return out.ravel()
 
     def times_normal_weights_inverse(self, v: np.ndarray) -> np.ndarray:
-        return self.times(-2, v)
+        """``(W^2 + w e0 e0^T) v``."""
+        out = self.times(-2, v)
+        if self.weight is not None:
+            out = out.reshape(-1, 3)
+            out[:, 0] += self.weight * np.asarray(v).reshape(-1, 3)[:, 0]
+            out = out.ravel()
+        return out
 
     def target_rhs(self, rc: np.ndarray) -> np.ndarray:
         """``W (lambda \\ rc)``."""
@@ -160,10 +188,20 @@ class LorentzScaling(NamedTuple):
         lam = self.lam.ravel()
         return lorentz_kernels.jordan(lam, lam)
 
-    @staticmethod
-    def primal_shift(dy: np.ndarray) -> float:
-        """``ds - G dx - rp``: nothing (no regularised programme on cones)."""
-        return 0.0
+    def primal_shift(self, dy: np.ndarray) -> np.ndarray | float:
+        """``ds - G dx - rp``: ``w dy0 e0`` (a regularised programme's ``y0`` is in its primal rows), else nothing."""
+        if self.weight is None:
+            return 0.0
+        out = np.zeros((self.weight.size, 3))
+        out[:, 0] = self.weight * np.asarray(dy).reshape(-1, 3)[:, 0]
+        return out.ravel()
+
+
+def first_unit(count: int) -> np.ndarray:
+    """``e0`` of ``count`` cones of three, stacked."""
+    e = np.zeros((count, 3))
+    e[:, 0] = 1.0
+    return e.ravel()
 
 
 def dots(u: np.ndarray, v: np.ndarray) -> np.ndarray:
@@ -189,9 +227,7 @@ class SecondOrderCones:
         self.degree = count
 
     def identity(self, v: np.ndarray) -> np.ndarray:
-        e = np.zeros((v.size // self.size, self.size))
-        e[:, 0] = 1.0
-        return e.ravel()
+        return first_unit(v.size // self.size)
 
     @staticmethod
     def product(u: np.ndarray, v: np.ndarray) -> np.ndarray:
@@ -234,6 +270,9 @@ class SecondOrderCones:
                                               np.ascontiguousarray(dv, dtype=float)))
 
     def scaling(self, s: np.ndarray, y: np.ndarray, weight: np.ndarray | None = None) -> LorentzScaling:
+        """The scaling at ``(s, y)``; ``weight`` (one per row, zero but on first components) a regularised
+        programme's."""
+        first_weight = None if weight is None or not np.any(weight) else np.asarray(weight).reshape(-1, 3)[:, 0]
         s, y = s.reshape(-1, 3), y.reshape(-1, 3)
         # an iterate rounded onto a cone's boundary gives nan here, and the next iteration's error says so
         with np.errstate(invalid="ignore", divide="ignore"):
@@ -241,13 +280,13 @@ class SecondOrderCones:
             sbar, ybar = s / ns[:, None], y / ny[:, None]
             gamma = np.sqrt(0.5 * (1.0 + dots(sbar, ybar)))
             wbar = (sbar + ybar * np.array([1.0, -1.0, -1.0])) / (2.0 * gamma[:, None])  # W^2 = eta^2 (2 wbar wbar^T - J)
+            eta = np.sqrt(ns / ny)
         v = wbar + np.array([1.0, 0.0, 0.0])
         v /= np.sqrt(2.0 * v[:, :1])  # (wbar + e) / sqrt(2 (wbar0 + 1))
-        eta = np.sqrt(ns / ny)
         tail = np.sqrt(dots(v[:, 1:], v[:, 1:]))
         direction = np.where(tail[:, None] > 0.0, v[:, 1:] / np.where(tail > 0.0, tail, 1.0)[:, None],
                              np.array([1.0, 0.0]))  # v1 / |v1|, any unit vector when v1 = 0
         big = (v[:, 0] + tail) ** 2
         sigma = np.c_[big, 1.0 / big, np.ones_like(big)] / eta[:, None]
         scaling = LorentzScaling(direction, sigma, np.zeros_like(s))
-        return scaling._replace(lam=scaling.times(-1, y.ravel()).reshape(-1, 3))
+        return scaling._replace(lam=scaling.times(-1, y.ravel()).reshape(-1, 3), weight=first_weight)

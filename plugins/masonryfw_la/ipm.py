@@ -324,9 +324,10 @@ def solve(cost, constraints, live, tolerance: float, weight: np.ndarray | None =
     """Solve ``min c.x, G x in K, a.x = 1`` to ``tolerance`` (relative residuals and gap) or raise IPMFailure.
 
     ``K`` is the orthant (an LP: ``G x >= 0``) or, with ``cone_size = 3``, second-order cones of three rows.
-    With ``weight`` (``w >= 0``, one per row; LPs only) the static side becomes ``max lam - sum(w y^2) / 2``:
-    the programme regularised by a quadratic in the multipliers, whose primal constraint is
-    ``G x + w y >= 0``. The Newton steps keep their form, with ``D = y / (s + w y)``.
+    With ``weight`` (``w >= 0``, one per row; on cones zero but on each cone's first row) the static side becomes
+    ``max lam - sum(w y^2) / 2``: the programme regularised by a quadratic in the multipliers, whose primal
+    constraint is ``G x + w y`` in ``K``. The Newton steps keep their form, with ``D = y / (s + w y)`` (cones:
+    ``(W^2 + w e0 e0^T)^-1``, :class:`.cones.LorentzScaling`).
     ``normal``: the :class:`NormalMatrix` of ``constraints`` when the caller has it (a sequence of
     LPs with the same ``G``). ``acceptable``: a looser tolerance at which an iterate that has
     stopped improving (:data:`STALL` iterations without halving its error) is returned.
@@ -340,8 +341,8 @@ def solve(cost, constraints, live, tolerance: float, weight: np.ndarray | None =
     if m == 0:
         raise IPMFailure("no constraints")
     cones = cones_of(m, cone_size)
-    if weight is not None and cone_size != 1:
-        raise ValueError("a regularised programme (weight) is an LP's")
+    if weight is not None and cone_size != 1 and np.any(np.asarray(weight).reshape(-1, cone_size)[:, 1:]):
+        raise ValueError("on cones a regularised programme's weight is on each cone's first row only")
     w = np.zeros(m) if weight is None else np.asarray(weight, dtype=float)
     orthant = cone_size == 1
 

@@ -13,17 +13,18 @@ HALF_ROOT = np.sqrt(0.5)
 
 
 @njit(cache=True, error_model="numpy")
-def scaled(direction, sigma, power, v):
-    """``W^-power v`` for the scalings ``W^-1 = U diag(sigma) U^T`` (:class:`.cones.LorentzScaling`)."""
-    n = sigma.shape[0]
+def scaled(direction, powered, v):
+    """``W^-power v`` for the scalings ``W^-1 = U diag(sigma) U^T`` (:class:`.cones.LorentzScaling`), given
+    ``powered = sigma^power``."""
+    n = powered.shape[0]
     out = np.empty(3 * n)
     for c in range(n):
         d0, d1 = direction[c, 0], direction[c, 1]
         v0, v1, v2 = v[3 * c], v[3 * c + 1], v[3 * c + 2]
         along = d0 * v1 + d1 * v2
-        c0 = HALF_ROOT * (v0 - along) * sigma[c, 0] ** power
-        c1 = HALF_ROOT * (v0 + along) * sigma[c, 1] ** power
-        c2 = (d0 * v2 - d1 * v1) * sigma[c, 2] ** power
+        c0 = HALF_ROOT * (v0 - along) * powered[c, 0]
+        c1 = HALF_ROOT * (v0 + along) * powered[c, 1]
+        c2 = (d0 * v2 - d1 * v1) * powered[c, 2]
         half = HALF_ROOT * (c1 - c0)
         out[3 * c] = HALF_ROOT * (c0 + c1)
         out[3 * c + 1] = d0 * half - d1 * c2

@@ -37,7 +37,7 @@ which would otherwise raise its capacity (the interior point backends return the
 centre of the optimal face, a made-up prestress). With the ipm backend each LP is
 one solve of the LP regularised by ``w |N|^2 / 2`` (:func:`selected_solution`; exact
 below a threshold weight); the other backends solve their LP and then the selection
-QP (:func:`least_compression`, Clarabel). The regularised selection is exact in alpha but
+QP (:func:`least_squared_forces`, Clarabel). The regularised selection is exact in alpha but
 not quite in the forces: its fixed point lay 3e-6 (Test 12C) to 1.5e-5 (Panel 4) from the
 exact selection's, and on a small symmetric wall its forces moved with the round-off, so
 that the order of the blocks changed alpha by up to 4.4e-6 (12 orders; 1e-5 once in CI).
@@ -54,6 +54,7 @@ from __future__ import annotations
 
 import logging
 from dataclasses import dataclass, field, replace
+from typing import NamedTuple
 
 import numpy as np
 
@@ -139,9 +140,11 @@ class FixedPoint:
                     and self.change * slow <= finish * FORCE_TOLERANCE)
 
     def wandering(self) -> bool:
-        """The last :data:`WANDER_WINDOW` LPs did not halve the smallest change of the ones before them: the
-        sequence roams a set of near fixed points (3D; module docstring of :mod:`.nonassociative3d`)."""
-        before, recent = self.changes[:-WANDER_WINDOW], self.changes[-WANDER_WINDOW:]
+        """The last :data:`WANDER_WINDOW` LPs did not halve the smallest change of the ones before them (in this
+        phase: the finish is judged on its own): the sequence roams a set of near fixed points (3D; module docstring
+        of :mod:`.nonassociative3d`)."""
+        phase = self.changes[self.finish_from:]
+        before, recent = phase[:-WANDER_WINDOW], phase[-WANDER_WINDOW:]
         return len(before) >= WANDER_WINDOW and min(recent) > 0.5 * min(before)
 
     def start_finish(self) -> None:
@@ -207,16 +210,27 @@ def second_start(alpha: float, converged: bool, alpha_from_zero: float, converge
     return {"la_flow_alpha_from_zero": float(alpha_from_zero), "la_flow_starts_agree": int(agree)}
 
 
-def least_compression(lp: assembly.KinematicLP, alpha: float, tolerance: float) -> np.ndarray:
-    """Among the contact forces in equilibrium with ``dead + alpha live`` within the LP's capacities,
-    those with the least sum of squared normal forces (:func:`least_squared_forces`).
+class Programme(NamedTuple):
+    """One programme of a sequence as its selection sees it, in 2D (an LP) or 3D (cones of ``cone_size`` rows):
+    ``min cost.x``, ``G x`` in the cones, ``live.x = 1``, and ``squared``: 1 on the rows whose multipliers are the
+    normal forces.
 
-    The static problem of an LP has many solutions where blocks can be squeezed between
+    The static problem of a programme has many solutions where blocks can be squeezed between
     supports (a unit under a cap that only touches it); the interior point backends return
     the centre of that set, whose made-up clamping force would raise the next capacities,
-    and a vertex (least total compression by the simplex) jumps from one LP to the next.
-    """
-    return least_squared_forces(lp.cost, lp.constraints, lp.live, selection_rows(lp), alpha, tolerance)
+    and a vertex (least total compression by the simplex) jumps from one LP to the next: the
+    selection takes the least squared normal forces (:func:`selected_solution`)."""
+
+    cost: np.ndarray
+    constraints: object  # sp.csr_matrix
+    live: np.ndarray
+    squared: np.ndarray
+    cone_size: int = 1
+
+
+def programme_of(lp: assembly.KinematicLP) -> Programme:
+    """A 2D LP of the sequence as a :class:`Programme`."""
+    return Programme(lp.cost, lp.constraints, lp.live, selection_rows(lp))
 
 
 def least_squared_forces(cost, constraints, live, squared: np.ndarray, alpha: float, tolerance: float,
@@ -267,57 +281,76 @@ def selection_rows(lp: assembly.KinematicLP) -> np.ndarray:
 
 @dataclass
 class Selection:
-    """How each LP of the sequence gets its contact forces (see :func:`selected_solution`)."""
+    """How each programme of the sequence gets its contact forces (see :func:`selected_solution`)."""
 
     backend: str
     tolerance: float
-    weight: float = SELECTION_WEIGHT  # of the ipm's regularised LP
-    normal_matrix: object = None  # the ipm's G^T D G pattern: G is the same in every LP of the sequence
-    finishing: bool = False  # the last LPs: the exact selection (the QP) whatever the backend
+    weight: float = SELECTION_WEIGHT  # of the ipm's regularised programme
+    normal_matrix: object = None  # the ipm's G^T D G pattern: G is the same in every programme of the sequence
+    finishing: bool = False  # the last programmes: the exact selection (the QP) whatever the backend
 
     @property
     def regularised(self) -> bool:
         return self.backend == "ipm" and not self.finishing
 
 
-def selected_solution(selection: Selection, lp: assembly.KinematicLP) -> backends.LPSolution:
-    """Alpha and the selected contact forces of one LP of the sequence.
+def selection_weight(blocks: int) -> float:
+    """The regularised programme's weight for a model of ``blocks`` blocks (:data:`SELECTION_WEIGHT`)."""
+    return SELECTION_WEIGHT * min(1.0, SELECTION_BLOCKS / blocks)
 
-    ipm: one solve of the LP regularised by ``weight |y_n|^2 / 2`` (exact regularisation: below
-    a threshold weight its optimum is the LP's optimum with the least squared normal forces,
+
+def selected_solution(selection: Selection, programme: Programme) -> backends.LPSolution:
+    """Alpha and the selected contact forces of one programme of the sequence.
+
+    ipm: one solve of the programme regularised by ``weight |y_n|^2 / 2`` (exact regularisation: below
+    a threshold weight its optimum is the programme's optimum with the least squared normal forces,
     Mangasarian & Meyer 1979, Friedlander & Tseng 2007; :func:`solve` finishes with the exact
-    selection whatever it gave). ``alpha_primal`` is then the static multiplier, a lower bound of the LP's.
-    An LP the regularised interior point fails on is tried once more with the weight times
+    selection whatever it gave). ``alpha_primal`` is then the static multiplier, a lower bound of the programme's.
+    A programme the regularised interior point fails on is tried once more with the weight times
     :data:`RETRY_WEIGHT` (the 10,000-unit wall's 32nd LP diverged at 1e-4), then, like the other
-    backends' LPs, solved plainly and followed by :func:`least_compression` (one LP of Test 8C's
-    sequence stalls at a gap of 2e-8 whatever the weight).
+    backends' programmes, solved plainly and followed by the selection QP (:func:`least_squared_forces`; one LP
+    of Test 8C's sequence stalls at a gap of 2e-8 whatever the weight).
     """
     from . import ipm
 
+    cones = programme.cone_size > 1
     if selection.regularised:
         if selection.normal_matrix is None:
-            selection.normal_matrix = ipm.NormalMatrix(lp.constraints)
+            selection.normal_matrix = ipm.NormalMatrix(programme.constraints, programme.cone_size)
+        acceptable = selection.tolerance * (ipm.CONE_ACCEPTABLE if cones else 1.0)
         for weight in (selection.weight, RETRY_WEIGHT * selection.weight):
             try:
-                result = ipm.solve(lp.cost, lp.constraints, lp.live, min(selection.tolerance, SELECTION_IPM_TOLERANCE),
-                                   weight=weight * selection_rows(lp), normal=selection.normal_matrix,
-                                   acceptable=selection.tolerance)
+                result = ipm.solve(programme.cost, programme.constraints, programme.live,
+                                   min(selection.tolerance, SELECTION_IPM_TOLERANCE), weight=weight * programme.squared,
+                                   normal=selection.normal_matrix, acceptable=acceptable, cone_size=programme.cone_size)
             except ipm.IPMFailure as failure:
-                LOG.info("la: the regularised LP with weight %g failed (%s)", weight, failure)
+                LOG.info("la: the regularised programme with weight %g failed (%s)", weight, failure)
             else:
                 return backends.LPSolution(x=result.x, y=result.y, alpha_primal=result.lam, alpha_dual=result.lam,
                                            status=REGULARISED, iterations=result.iterations)
-    solution = backends.solve_lp(selection.backend, lp.cost, lp.constraints, lp.live, selection.tolerance)
-    return replace(solution, y=least_compression(lp, solution.alpha_primal, selection.tolerance))
+    solution = plain_solution(selection, programme)
+    return replace(solution, y=least_squared_forces(programme.cost, programme.constraints, programme.live,
+                                                    programme.squared, solution.alpha_primal, selection.tolerance,
+                                                    programme.cone_size))
 
 
-def admissible(selection: Selection, lp: assembly.KinematicLP, solution: backends.LPSolution) -> backends.LPSolution:
-    """The solution to report: a regularised one gets the plain LP's mechanism and alpha (its own
+def plain_solution(selection: Selection, programme: Programme) -> backends.LPSolution:
+    """The programme solved as it is (its mechanism and alpha; its forces the backend's)."""
+    cost, constraints, live, tolerance = programme.cost, programme.constraints, programme.live, selection.tolerance
+    if programme.cone_size == 1:
+        return backends.solve_lp(selection.backend, cost, constraints, live, tolerance)
+    if selection.backend == "ipm":
+        return backends.solve_ipm(cost, constraints, live, tolerance, programme.cone_size,
+                                  normal=selection.normal_matrix)
+    return backends.solve_clarabel(cost, constraints, live, tolerance, programme.cone_size)
+
+
+def admissible(selection: Selection, programme: Programme, solution: backends.LPSolution) -> backends.LPSolution:
+    """The solution to report: a regularised one gets the plain programme's mechanism and alpha (its own
     mechanism may open by ``weight y_n``) and keeps its selected forces."""
     if solution.status != REGULARISED:
         return solution
-    plain = backends.solve_lp(selection.backend, lp.cost, lp.constraints, lp.live, selection.tolerance)
-    return replace(plain, y=solution.y)
+    return replace(plain_solution(selection, programme), y=solution.y)
 
 
 def solve(wall: assembly.Wall, scales: assembly.Scales, kin: assembly.Kinematics, options,
@@ -335,7 +368,7 @@ def solve(wall: assembly.Wall, scales: assembly.Scales, kin: assembly.Kinematics
             alpha_associative = first.alpha_primal
         except backends.LiveLoadUnbounded:
             pass  # the dilatancy is blocked: start from no friction at all
-    selection = Selection(backend, lp_tolerance, SELECTION_WEIGHT * min(1.0, SELECTION_BLOCKS / wall.n_block))
+    selection = Selection(backend, lp_tolerance, selection_weight(wall.n_block))
     sequence = FixedPoint(tolerance, relaxation)
     alphas = sequence.alphas
     regularised_end = None  # the regularised sequence's fixed point, kept in case the finish fails
@@ -343,7 +376,7 @@ def solve(wall: assembly.Wall, scales: assembly.Scales, kin: assembly.Kinematics
     for k in range(cap):
         try:
             lp_k = assembly.assemble(wall, scales, kin, normal_force=normal)
-            solution_k = selected_solution(selection, lp_k)
+            solution_k = selected_solution(selection, programme_of(lp_k))
         except mf.SolveError as error:
             if solution is None:
                 raise
@@ -351,11 +384,11 @@ def solve(wall: assembly.Wall, scales: assembly.Scales, kin: assembly.Kinematics
                 finish = f"failed at LP {k + 1} ({error}): the regularised selection's fixed point is reported"
                 LOG.warning("la: the exact finish %s", finish)
                 lp_r, solution_r, alphas_r, change_r = regularised_end
-                return FlowIteration(lp_r, admissible(selection, lp_r, solution_r), alpha_associative, alphas_r,
+                return FlowIteration(lp_r, admissible(selection, programme_of(lp_r), solution_r), alpha_associative, alphas_r,
                                      True, change_r, selection.weight, finish=finish)
             reason = f"LP {k + 1} of the non-associative sequence failed ({error}): the last iterate is reported"
             LOG.warning("la: %s", reason)
-            return FlowIteration(lp, admissible(selection, lp, solution), alpha_associative, tuple(alphas), False,
+            return FlowIteration(lp, admissible(selection, programme_of(lp), solution), alpha_associative, tuple(alphas), False,
                                  sequence.change, selection.weight, reason)
         lp, solution = lp_k, solution_k
         residual = end_normal_forces(lp, solution.y, wall.n_interface, scales) - normal
@@ -373,6 +406,6 @@ def solve(wall: assembly.Wall, scales: assembly.Scales, kin: assembly.Kinematics
         normal = sequence.next_normal(normal, residual)
     LOG.warning("la: the non-associative iteration did not converge in %d LPs (alpha %s, normal forces still "
                 "moving %.2e W); the last iterate is reported", cap, alphas[-3:], sequence.change)
-    return FlowIteration(lp, admissible(selection, lp, solution), alpha_associative, tuple(alphas), False,
+    return FlowIteration(lp, admissible(selection, programme_of(lp), solution), alpha_associative, tuple(alphas), False,
                          sequence.change, selection.weight, f"the non-associative iteration did not converge in "
                                                             f"{cap} LPs: the last iterate is reported")

@@ -108,8 +108,9 @@ def test_the_regularised_lp_selects_the_least_squared_normal_forces(case, monkey
     lp = nonassociative_lp(case)
     exact = backends.solve_lp("highs", lp.cost, lp.constraints, lp.live, 1e-10)
     monkeypatch.setattr(nonassociative, "SELECTION_TOLERANCE", 1e-10)
-    selected = nonassociative.least_compression(lp, exact.alpha_primal, 1e-10)
     rows = nonassociative.selection_rows(lp) > 0
+    selected = nonassociative.least_squared_forces(lp.cost, lp.constraints, lp.live, rows * 1.0, exact.alpha_primal,
+                                                   1e-10)
     regularised = ipm.solve(lp.cost, lp.constraints, lp.live, nonassociative.SELECTION_IPM_TOLERANCE,
                             weight=nonassociative.SELECTION_WEIGHT * rows)
     assert regularised.lam == pytest.approx(exact.alpha_primal, abs=1e-9)
@@ -141,11 +142,11 @@ def test_an_lp_that_fails_mid_sequence_stops_it_with_the_last_iterate(walls, mon
     solved = nonassociative.selected_solution
     calls = []
 
-    def failing_third(selection, lp):
-        calls.append(lp)
+    def failing_third(selection, programme):
+        calls.append(programme)
         if len(calls) == 3:
             raise mf.SolveError("la: the least-compression contact forces were not found (Clarabel: MaxIterations)")
-        return solved(selection, lp)
+        return solved(selection, programme)
 
     monkeypatch.setattr(nonassociative, "selected_solution", failing_third)
     result = walls.solve(mf.open_model("test-12c"), **NONASSOCIATIVE)
@@ -197,10 +198,10 @@ def test_a_failed_exact_finish_reports_the_regularised_fixed_point_and_says_so(w
     model = mf.open_model("panel-2")
     exact = walls.solve(model, **NONASSOCIATIVE)
 
-    def failing(lp, alpha, tolerance):
+    def failing(*args):
         raise mf.SolveError("la: the least-compression contact forces were not found (Clarabel: MaxIterations)")
 
-    monkeypatch.setattr(nonassociative, "least_compression", failing)
+    monkeypatch.setattr(nonassociative, "least_squared_forces", failing)
     result = walls.solve(model, **NONASSOCIATIVE)
     assert result.attrs["la_flow_converged"] == 1 and "stop_reason" not in result.attrs
     assert "exact finish by LP + QP: failed at LP" in result.attrs["la_flow_selection"]
