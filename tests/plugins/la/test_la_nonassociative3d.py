@@ -87,6 +87,27 @@ def test_a_slender_block_overturns_as_with_associative_joints(degrees, expected)
     assert result.alpha_associative == pytest.approx(expected, rel=1e-7)
 
 
+def test_a_failed_exact_finish_reports_the_regularised_fixed_point_and_says_so(monkeypatch):
+    """The regularised programmes take Test 8C's twin to a fixed point, then the finish's selection QP fails
+    (Clarabel's iteration cap, say): the regularised fixed point is reported, converged, within the planar
+    sequence's alpha to a few flow tolerances, and the result says the finish failed."""
+    from masonryfw_la import nonassociative
+
+    model = mfp.twin(mf.open_model("test-8c"))
+    exact = mf.solve(model, "la", {"flow": "nonassociative"})
+
+    def failing(*args):
+        raise mf.SolveError("la: the least-compression contact forces were not found (Clarabel: MaxIterations)")
+
+    monkeypatch.setattr(nonassociative, "least_squared_forces", failing)
+    result = mf.solve(model, "la", {"flow": "nonassociative"})
+    assert result.attrs["la_flow_converged"] == 1 and "stop_reason" not in result.attrs
+    assert "exact finish by programme + QP: failed at programme" in result.attrs["la_flow_selection"]
+    assert "exact finish by programme + QP (docs/la.md)" in exact.attrs["la_flow_selection"]
+    assert result.attrs["la_flow_iterations"] < exact.attrs["la_flow_iterations"]
+    assert float(result.collapse_multiplier) == pytest.approx(float(exact.collapse_multiplier), abs=5e-6)
+
+
 @pytest.mark.parametrize("name, tolerance", [("test-12c", 2e-6), ("test-8c", 5e-6), ("panel-1", 5e-5)])
 def test_every_wall_built_one_block_thick_in_3d_gives_the_planar_nonassociative_alpha(name, tolerance):
     """The planar sequence (two ends per joint) against the 3D one (four vertices, Coulomb's cone, six velocities
