@@ -2,7 +2,9 @@
 dilatancy) on a masonryfw model written by ``bench_lmgc90.py`` as JSON: the supports driven at a constant rate along
 their ``settlement_direction`` (after a velocity ramp), the settlement reaction recorded every ``--every`` steps
 (the masonry's force and moment on each support from the contacts, weighted by the support's motion per unit of
-the settlement, as ``masonryfw.settlement_reaction`` weighs them).
+the settlement, as ``masonryfw.settlement_reaction`` weighs them). Dead loads besides the blocks' weight (a model's
+floors and roofs, ``extra_load``: a force per block through its centroid) are constant external forces from the start,
+as gravity is.
 
 Run it with the Python that has compas_lmgc90 (a separate environment: it pulls compas_viewer and Qt):
 ``python run_lmgc90.py model.json out.json --settlement 0.01 --time 2.0 --dt 0.002``.
@@ -68,6 +70,10 @@ def main() -> None:
         for k, name in enumerate(COMPONENTS):
             v = direction[b, k] * rate
             solver.apply_velocity(int(b), name, np.array([[v, 0.0, 0.0, 0.0, 0.0, 1.0 / ramp]]) if v else 0.0)
+    for b, force in enumerate(spec["extra_load"]):
+        for name, value in zip(("Fx", "Fy", "Fz"), force):
+            if value:
+                solver.apply_force(b, name, float(value))
     solver.contact_law("IQS_CLB", spec["friction"], alert=1e-3)
     solver.preprocess()
     steps = int(round((args.time + ramp / 2) / args.dt))
